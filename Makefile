@@ -1,0 +1,57 @@
+# cdlab: top-level driver. Two commands do all set-up on a fresh Debian 12:
+#   make run    install what is missing, build Release, run the default scene
+#   make test   install what is missing, build Release, run the whole suite
+SHELL := /bin/bash
+BUILD ?= build
+JOBS  ?= $(shell nproc)
+SCENE ?= configs/default.toml
+OUT   ?= outputs/default
+
+# Debian 12 packages the build needs (docs in README, facts in shared/docs/deps.md).
+DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
+            libvtk9-dev libgtest-dev libtoml11-dev libcli11-dev libfmt-dev \
+            libbenchmark-dev gnuplot-nox
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+.PHONY: all deps build run test bench clean help
+
+all: build
+
+help:
+	@echo "make run     build and run the default scene into $(OUT)/"
+	@echo "make test    build and run the test suite (ctest)"
+	@echo "make bench   build and run the benchmarks (results in outputs/bench/)"
+	@echo "make deps    install the missing Debian packages (idempotent)"
+
+# Idempotent: asks dpkg which packages are missing and installs only those.
+deps:
+	@missing=$$(for p in $(DEB_PKGS); do \
+	    dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  echo "make deps: installing $$missing"; \
+	  $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
+	else echo "make deps: all Debian packages present"; fi
+
+$(BUILD)/CMakeCache.txt: | deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+
+build: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS)
+
+run: build
+	$(BUILD)/cd/cdsim $(SCENE) --out $(OUT)
+	@echo ""
+	@echo "Outputs in $(OUT)/: series.csv (time series), scene.toml (resolved scene),"
+	@echo "particles.pvd and contacts.pvd (VTK collections)."
+	@echo "Open in ParaView:  paraview $(OUT)/particles.pvd"
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 900
+
+bench: build
+	mkdir -p outputs/bench
+	$(BUILD)/cd/bench/cdbench --benchmark_out=outputs/bench/bench.json --benchmark_out_format=json
+
+clean:
+	rm -rf $(BUILD)

@@ -1,0 +1,42 @@
+#include "bodies.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace cd {
+
+int Bodies::add_disk(Vec2 x, double r, double density, Vec2 v, double omega) {
+  const double m = density * std::numbers::pi * r * r;
+  const double I = 0.5 * m * r * r;
+  vel.push_back({v.x(), v.y(), omega, 1.0 / m, 1.0 / I});
+  pos.push_back(x);
+  angle.push_back(0.0);
+  shape.push_back(Shape::Disk);
+  radius.push_back(r);
+  mass.push_back(m);
+  inertia.push_back(I);
+  driven.push_back(0);
+  return static_cast<int>(pos.size()) - 1;
+}
+
+int Bodies::add_wall(Vec2 a, Vec2 b, Vec2 v, double omega) {
+  const Vec2 mid = 0.5 * (a + b);
+  const Vec2 d = b - a;
+  vel.push_back({v.x(), v.y(), omega, 0.0, 0.0});
+  pos.push_back(mid);
+  angle.push_back(std::atan2(d.y(), d.x()));
+  shape.push_back(Shape::Segment);
+  radius.push_back(0.5 * d.norm());
+  mass.push_back(0.0);
+  inertia.push_back(0.0);
+  driven.push_back(1);
+  return static_cast<int>(pos.size()) - 1;
+}
+
+void Bodies::segment_ends(std::size_t i, Vec2& a, Vec2& b) const {
+  const Vec2 e(std::cos(angle[i]), std::sin(angle[i]));
+  a = pos[i] - radius[i] * e;
+  b = pos[i] + radius[i] * e;
+}
+
+}  // namespace cd

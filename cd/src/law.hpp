@@ -1,0 +1,104 @@
+// Contact laws and their exact local solver (method.md sections 2 and 4).
+//
+// One contact, others frozen: the law sees the affine relation
+//     u = b + W p
+// between the (restitution-weighted) relative velocity u = (u_n, u_t) and the
+// impulse p = f dt, with W the 2x2 Delassus block. The law, with adhesion
+// impulse a = f_a dt >= 0 (a = 0: plain Signorini-Coulomb):
+//     0 <= p_n + a  _|_  u_n >= 0
+//     |p_t| <= mu (p_n + a),   p_t = -mu (p_n + a) sign(u_t) if u_t != 0.
+// The solver enumerates the candidates open / stick / slide+ / slide- and
+// returns the first one whose (u, p) satisfies the law. Enumeration rather
+// than the "stick, then test g_n" shortcut because the shortcut is exact only
+// for W_nt = 0; polygons have W_nt != 0.
+#pragma once
+#include <algorithm>
+#include <cmath>
+
+namespace cd {
+
+// Law features are compile-time, chosen once per scene: the sweep is a
+// template over the law, so a frictionless or non-cohesive scene carries no
+// friction or adhesion work in its inner loop.
+template <bool Friction, bool Adhesion>
+struct Law {
+  static constexpr bool friction = Friction;
+  static constexpr bool adhesion = Adhesion;
+};
+
+struct Block {
+  double wnn, wnt, wtt;
+};
+
+enum class LocalBranch { Open, Stick, SlidePlus, SlideMinus, Fallback };
+
+// Frictional local solve. Returns the branch taken (tests check every one).
+inline LocalBranch solve_coulomb(double bn, double bt, const Block& W, double mu, double a,
+                                 double& pn, double& pt) {
+  // Open: p = (-a, 0) is valid if the normal velocity it leaves is >= 0.
+  if (bn - W.wnn * a >= 0.0) {
+    pn = -a;
+    pt = 0.0;
+    return LocalBranch::Open;
+  }
+  // Stick: both velocities zero.
+  const double det = W.wnn * W.wtt - W.wnt * W.wnt;
+  const double gn = (-bn * W.wtt + bt * W.wnt) / det;
+  const double gt = (-bt * W.wnn + bn * W.wnt) / det;
+  const double bound = mu * (gn + a);
+  if (gn + a >= 0.0 && std::abs(gt) <= bound) {
+    pn = gn;
+    pt = gt;
+    return LocalBranch::Stick;
+  }
+  // Slide: p_t = s mu (p_n + a), u_n = 0; valid if p_n + a >= 0 and s u_t <= 0.
+  const double s0 = gt >= 0.0 ? 1.0 : -1.0;
+  for (double s : {s0, -s0}) {
+    const double den = W.wnn + s * mu * W.wnt;
+    if (den <= 0.0) continue;
+    const double qn = -(bn + s * mu * W.wnt * a) / den;
+    const double qt = s * mu * (qn + a);
+    const double ut = bt + W.wnt * qn + W.wtt * qt;
+    if (qn + a >= 0.0 && s * ut <= 0.0) {
+      pn = qn;
+      pt = qt;
+      return s > 0 ? LocalBranch::SlidePlus : LocalBranch::SlideMinus;
+    }
+  }
+  // Only reachable for an ill-posed block (mu |W_nt| >= W_nn, a Painleve-like
+  // case): keep the stick normal impulse, clamp the tangential one.
+  pn = std::max(gn, -a);
+  pt = std::clamp(gt, -mu * (pn + a), mu * (pn + a));
+  return LocalBranch::Fallback;
+}
+
+// Frictionless local solve: p_t stays 0.
+inline void solve_frictionless(double bn, const Block& W, double a, double& pn) {
+  pn = std::max(-a, -bn / W.wnn);
+}
+
+template <class L>
+inline void solve_local(double bn, double bt, const Block& W, double mu, double a, double& pn,
+                        double& pt) {
+  if constexpr (L::friction) {
+    solve_coulomb(bn, bt, W, mu, a, pn, pt);
+  } else {
+    solve_frictionless(bn, W, a, pn);
+    pt = 0.0;
+  }
+}
+
+// Natural-map residual of the law at (u, p), in impulse units (rho = 1/W_nn):
+//   r_n = (p_n + a) - max(0, p_n + a - rho u_n)
+//   r_t = p_t - clamp(p_t - rho u_t, -mu (p_n + a), mu (p_n + a))
+// r = 0 exactly when (u, p) satisfies the law.
+inline double law_residual(double un, double ut, double pn, double pt, double mu, double a,
+                           double rho) {
+  const double sn = pn + a;
+  const double rn = sn - std::max(0.0, sn - rho * un);
+  const double lim = mu * std::max(sn, 0.0);
+  const double rt = pt - std::clamp(pt - rho * ut, -lim, lim);
+  return std::sqrt(rn * rn + rt * rt);
+}
+
+}  // namespace cd

@@ -1,0 +1,77 @@
+// Nonlinear Gauss-Seidel over contact rows coupled through body velocities
+// (method.md section 5). The solver sees rows (frames, lever arms, W blocks,
+// velocity offsets, impulses) and the hot body velocities; it knows nothing
+// of shapes or boundaries.
+//
+// Parallel sweep: rows are coloured so that no two rows of a colour share a
+// dynamic body; each colour is one parallel loop. A row's update depends only
+// on the colours before it, so the result is the same for any thread count.
+// Reductions that decide convergence are either max (order-free) or sums over
+// fixed blocks of rows added in block order, never per-thread partial sums.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "bodies.hpp"
+#include "contact.hpp"
+
+namespace cd {
+
+struct SolverParams {
+  double tol = 1e-4;       // eps_f: max |dp| / mean |p| over a sweep, and law residual
+  int max_iter = 2000;     // iteration cap
+  bool friction = true;    // law chosen once per scene
+  bool adhesion = false;
+  bool rotation = true;
+  int min_parallel = 512;  // below this many rows the sweep runs on one thread
+};
+
+struct SolveStats {
+  int iterations = 0;
+  bool cap_hit = false;
+  double dp_rel = 0;         // last sweep's max |dp| / mean |p|
+  double residual_max = 0;   // law residual, max over contacts / mean |p|
+  double residual_mean = 0;  // law residual, mean over contacts / mean |p|
+  double p_mean = 0;         // mean |p| (impulse scale)
+};
+
+// Colouring: rows are permuted so that colour c is [start[c], start[c+1]);
+// inside a colour the rows whose body 1 is driven come first, up to split[c].
+// The last colour may be an overflow colour, solved on one thread.
+struct Colouring {
+  std::vector<std::int32_t> start, split;
+  bool overflow = false;
+  std::vector<std::int32_t> perm;  // new index -> old index
+};
+
+// Colours rows (greedy, in row order: deterministic) and returns the
+// permutation; the caller applies it to rows and to any parallel arrays.
+Colouring colour_rows(const std::vector<ContactRow>& rows, const Bodies& bodies);
+
+// Adds the impulses held in the rows to the body velocities (warm start).
+void apply_impulses(const std::vector<ContactRow>& rows, std::vector<BodyVel>& vel, bool rotation);
+
+// Solves the rows in place (p and the body velocities), starting from the
+// impulses already held in the rows, which must already be applied to vel.
+SolveStats nlgs_solve(std::vector<ContactRow>& rows, const Colouring& col,
+                      std::vector<BodyVel>& vel, const SolverParams& prm);
+
+// Relative velocity (u_n, u_t) of a row from body velocities.
+inline void row_velocity(const ContactRow& r, const std::vector<BodyVel>& vel, bool rotation,
+                         double& un, double& ut) {
+  const BodyVel& A = vel[r.b1];
+  const BodyVel& B = vel[r.b2];
+  const double dx = B.vx - A.vx, dy = B.vy - A.vy;
+  un = r.nx * dx + r.ny * dy;
+  ut = -r.ny * dx + r.nx * dy;
+  if (rotation) {
+    un += -B.w * r.c2t + A.w * r.c1t;
+    ut += B.w * r.c2n - A.w * r.c1n;
+  }
+}
+
+// Law residual of every row (normalised by mean |p|), computed read-only.
+void law_residuals(const std::vector<ContactRow>& rows, const std::vector<BodyVel>& vel,
+                   const SolverParams& prm, SolveStats& st);
+
+}  // namespace cd

@@ -1,0 +1,76 @@
+// Scene: every parameter of a run, as plain data. The defaults written here are
+// the only defaults (config.cpp binds each field to its TOML key, documents it
+// and validates it; the resolved scene.toml written with every run is printed
+// from the same table).
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+namespace cd {
+
+struct DiskSpec {            // [[disk]]: one explicit disk
+  std::array<double, 2> pos{0.0, 0.0};
+  std::array<double, 2> vel{0.0, 0.0};
+  double radius = 0.5e-3;
+  double omega = 0.0;
+  double density = -1.0;     // < 0: particles.density
+};
+
+struct WallSpec {            // [[wall]]: a rigid segment with imposed velocity
+  std::array<double, 2> a{0.0, 0.0};   // end points at t = 0
+  std::array<double, 2> b{1.0, 0.0};
+  std::array<double, 2> vel{0.0, 0.0};
+  double omega = 0.0;        // imposed angular velocity about the midpoint
+};
+
+struct Scene {
+  std::string name = "default";
+  std::string source;        // file the scene came from (for messages)
+
+  // [time]
+  double dt = 1e-4;          // time step (s)
+  double duration = 0.5;     // simulated time (s)
+
+  // [gravity]
+  std::array<double, 2> gravity{0.0, -9.81};
+
+  // [contact]
+  double mu = 0.4;           // particle-particle friction coefficient
+  double mu_wall = -1.0;     // particle-wall friction (< 0: same as mu)
+  double e_n = 0.0;          // normal restitution
+  double e_t = 0.0;          // tangential restitution
+  double alert = 0.1;        // alert distance, in mean diameters
+  bool rotation = true;      // integrate rotations
+
+  // [solver]
+  double tol = 1e-4;         // NLGS tolerance eps_f (relative)
+  int max_iter = 2000;       // iteration cap per step
+  int threads = 0;           // 0: OpenMP default
+
+  // [particles]: random generation (n = 0 for none)
+  int n = 0;
+  double d_mean = 1e-3;      // mean diameter (m)
+  double size_ratio = 2.0;   // d_max / d_min
+  std::string size_dist = "uniform_area";  // "uniform" | "uniform_area"
+  double density = 2.6;      // mass per unit area (kg/m^2): 2600 kg/m^3 x 1 mm
+  unsigned seed = 1;
+  // generation region [xmin, ymin, xmax, ymax]; empty: inside the box
+  std::vector<double> region;
+
+  // [box]: four static walls (width = 0: no box)
+  double box_width = 0.0;
+  double box_height = 0.0;
+
+  std::vector<DiskSpec> disks;
+  std::vector<WallSpec> walls;
+
+  // [output]
+  double series_interval = 0.005;    // time between series rows (s)
+  double snapshot_interval = 0.025;  // time between VTK snapshots (s); 0: none
+  bool quiet = false;
+
+  double mu_w() const { return mu_wall < 0 ? mu : mu_wall; }
+};
+
+}  // namespace cd

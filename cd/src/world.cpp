@@ -1,0 +1,195 @@
+#include "world.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+namespace cd {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+}  // namespace
+
+void World::configure() {
+  gravity_on_ = prm_.gravity.squaredNorm() > 0.0;
+  restitution_on_ = prm_.e_n > 0.0 || prm_.e_t > 0.0;
+  // With restitution the law acts at effective contacts only (gap <= 0), as in
+  // Moreau's impact law: a predictive gap term would stop a body at the
+  // contact with a small velocity and the impact speed would be lost.
+  // Without restitution, contacts within the alert distance enter the solver
+  // with the gap term u_n + 2 g_m/dt >= 0, which closes gaps without overlap.
+  alert_ = restitution_on_ ? 0.0 : prm_.alert;
+  prm_.solver.friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
+}
+
+void World::step() {
+  auto t0 = Clock::now();
+  predict();
+  detect_stage();
+  build();
+  times.detect += since(t0);
+
+  t0 = Clock::now();
+  solve();
+  times.solve += since(t0);
+
+  t0 = Clock::now();
+  integrate();
+  times.integrate += since(t0);
+  time += prm_.dt;
+  ++steps;
+}
+
+void World::predict() {
+  const std::size_t n = bodies.size();
+  const double h = 0.5 * prm_.dt;
+  xm_.resize(n);
+  thm_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodyVel& v = bodies.vel[i];
+    xm_[i] = bodies.pos[i] + h * Vec2(v.vx, v.vy);
+    thm_[i] = bodies.angle[i] + h * v.w;
+  }
+}
+
+void World::detect_stage() { detect(bodies, xm_, thm_, alert_, grid_, rows_, info_); }
+
+void World::build() {
+  const double dt = prm_.dt;
+  const bool rot = prm_.solver.rotation;
+  const auto& V = bodies.vel;
+  const std::size_t nr = rows_.size();
+  for (std::size_t k = 0; k < nr; ++k) {
+    ContactRow& r = rows_[k];
+    const BodyVel& A = V[r.b1];
+    const BodyVel& B = V[r.b2];
+    const double iI1 = rot ? A.inv_I : 0.0, iI2 = rot ? B.inv_I : 0.0;
+    const double im = A.inv_m + B.inv_m;
+    r.wnn = im + r.c1t * r.c1t * iI1 + r.c2t * r.c2t * iI2;
+    r.wtt = im + r.c1n * r.c1n * iI1 + r.c2n * r.c2n * iI2;
+    r.wnt = -(r.c1n * r.c1t * iI1 + r.c2n * r.c2t * iI2);
+    r.mu = bodies.driven[r.b1] ? prm_.mu_wall : prm_.mu;
+    const double gap = info_[k].gap;
+    r.bn = gap > 0.0 ? 2.0 * gap / dt : 0.0;
+    r.bt = 0.0;
+  }
+  if (restitution_on_) {
+    // Law on u+ + e u-, with u- the relative velocity at the start of the
+    // step (before external forces) in the midpoint frame. Only approaching
+    // normal velocities are restituted.
+    for (std::size_t k = 0; k < nr; ++k) {
+      ContactRow& r = rows_[k];
+      double un, ut;
+      row_velocity(r, V, rot, un, ut);
+      r.bn += prm_.e_n * std::min(un, 0.0);
+      r.bt += prm_.e_t * ut;
+    }
+  }
+  // Warm start from the previous step's impulses, matched by contact key.
+  for (std::size_t k = 0; k < nr; ++k) {
+    const auto it = std::lower_bound(prev_keys_.begin(), prev_keys_.end(), info_[k].key);
+    if (it != prev_keys_.end() && *it == info_[k].key) {
+      const auto& p = prev_p_[it - prev_keys_.begin()];
+      rows_[k].pn = p.first;
+      rows_[k].pt = p.second;
+    }
+  }
+}
+
+void World::external() {
+  const Vec2 dv = prm_.dt * prm_.gravity;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies.is_dynamic(i)) continue;
+    bodies.vel[i].vx += dv.x();
+    bodies.vel[i].vy += dv.y();
+  }
+}
+
+void World::solve() {
+  // Colour and permute rows so that each colour is contiguous.
+  col_ = colour_rows(rows_, bodies);
+  {
+    std::vector<ContactRow> r(rows_.size());
+    std::vector<ContactInfo> f(info_.size());
+    for (std::size_t k = 0; k < rows_.size(); ++k) {
+      r[k] = rows_[col_.perm[k]];
+      f[k] = info_[col_.perm[k]];
+    }
+    rows_.swap(r);
+    info_.swap(f);
+  }
+  if (gravity_on_) external();
+  apply_impulses(rows_, bodies.vel, prm_.solver.rotation);
+  last_.solve = nlgs_solve(rows_, col_, bodies.vel, prm_.solver);
+
+  // Keep the impulses for the next step's warm start.
+  const std::size_t nr = rows_.size();
+  std::vector<std::size_t> idx(nr);
+  std::iota(idx.begin(), idx.end(), 0);
+  std::sort(idx.begin(), idx.end(),
+            [&](std::size_t a, std::size_t b) { return info_[a].key < info_[b].key; });
+  prev_keys_.resize(nr);
+  prev_p_.resize(nr);
+  for (std::size_t k = 0; k < nr; ++k) {
+    prev_keys_[k] = info_[idx[k]].key;
+    prev_p_[k] = {rows_[idx[k]].pn, rows_[idx[k]].pt};
+  }
+
+  // Step quality: contacts, overlaps.
+  last_.contacts = static_cast<int>(nr);
+  int active = 0, nover = 0;
+  double omax = 0, osum = 0;
+  for (std::size_t k = 0; k < nr; ++k) {
+    if (rows_[k].pn + rows_[k].adh > 0.0) ++active;
+    const double ov = -info_[k].gap;
+    if (ov > 0) {
+      ++nover;
+      osum += ov;
+      omax = std::max(omax, ov);
+    }
+  }
+  last_.active = active;
+  last_.max_overlap = omax / prm_.d_ref;
+  last_.mean_overlap = nover ? osum / nover / prm_.d_ref : 0.0;
+}
+
+void World::integrate() {
+  const double h = 0.5 * prm_.dt;
+  const bool rot = prm_.solver.rotation;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const BodyVel& v = bodies.vel[i];
+    bodies.pos[i] = xm_[i] + h * Vec2(v.vx, v.vy);
+    if (rot || !bodies.is_dynamic(i)) bodies.angle[i] = thm_[i] + h * v.w;
+  }
+}
+
+double World::kinetic_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies.is_dynamic(i)) continue;
+    const BodyVel& v = bodies.vel[i];
+    e += 0.5 * bodies.mass[i] * (v.vx * v.vx + v.vy * v.vy) + 0.5 * bodies.inertia[i] * v.w * v.w;
+  }
+  return e;
+}
+
+double World::potential_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies.is_dynamic(i)) e -= bodies.mass[i] * prm_.gravity.dot(bodies.pos[i]);
+  return e;
+}
+
+ContactStatus World::status(std::size_t k) const {
+  const ContactRow& r = rows_[k];
+  const double s = r.pn + r.adh;
+  if (s <= 0.0) return ContactStatus::Open;
+  if (r.mu > 0.0 && std::abs(r.pt) >= r.mu * s * (1.0 - 1e-9)) return ContactStatus::Slide;
+  return ContactStatus::Stick;
+}
+
+}  // namespace cd
