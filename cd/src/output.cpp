@@ -1,0 +1,302 @@
+#include "output.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkXMLPolyDataWriter.h>
+
+namespace cd {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Unique per process, so two runs writing into one folder do not collide.
+std::string tmp_name(const std::string& path) {
+  return path + ".tmp." + std::to_string(::getpid());
+}
+
+void rename_into_place(const std::string& tmp, const std::string& path) {
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw OutputError(fmt::format("cannot write '{}': {}", path, ec.message()));
+  }
+}
+
+}  // namespace
+
+void check_output_dir(const std::string& dir) {
+  const fs::path p = fs::absolute(fs::path(dir.empty() ? "." : dir)).lexically_normal();
+  auto fail = [&](const std::string& why) {
+    throw OutputError(fmt::format("output folder '{}' {}", dir, why));
+  };
+  std::error_code ec;
+  // status() reports not_found for ENOENT and ENOTDIR alike, so a path below
+  // a regular file walks up to that file and fails there.
+  if (fs::exists(fs::status(p, ec))) {
+    if (!fs::is_directory(p, ec)) fail("exists and is not a folder");
+    if (::access(p.c_str(), W_OK | X_OK) != 0) fail("is not writable");
+    return;
+  }
+  fs::path a = p.has_filename() ? p.parent_path() : p.parent_path().parent_path();
+  while (!fs::exists(fs::status(a, ec)) && a != a.root_path()) a = a.parent_path();
+  if (!fs::is_directory(a, ec))
+    fail(fmt::format("cannot be created: '{}' is not a folder", a.string()));
+  if (::access(a.c_str(), W_OK | X_OK) != 0)
+    fail(fmt::format("cannot be created: '{}' is not writable", a.string()));
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  const std::string tmp = tmp_name(path);
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << text;
+    f.close();
+    if (!f) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw OutputError(fmt::format("cannot write '{}'", path));
+    }
+  }
+  rename_into_place(tmp, path);
+}
+
+// ---------------------------------------------------------------------------
+// Series
+
+// The file is truncated here, so a rerun into the same folder does not append
+// to an old series; the header goes out with the first flush.
+Series::Series(const std::string& path) : path_(path) {
+  std::ofstream f(path_, std::ios::trunc);
+  if (!f) throw OutputError(fmt::format("cannot write '{}'", path_));
+}
+
+void Series::row(const std::vector<std::pair<std::string, double>>& cols) {
+  if (names_.empty()) {
+    if (cols.empty()) throw std::logic_error("Series::row: no columns");
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      names_.push_back(cols[c].first);
+      buf_ += (c ? "," : "") + cols[c].first;
+    }
+    buf_ += '\n';
+  } else {
+    bool same = cols.size() == names_.size();
+    for (std::size_t c = 0; same && c < cols.size(); ++c) same = cols[c].first == names_[c];
+    if (!same)
+      throw std::logic_error(fmt::format("Series::row: columns differ from the header of '{}'", path_));
+  }
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    const double v = cols[c].second;
+    if (c) buf_ += ',';
+    // Counts (step, contacts) print as integers; 2^53 bounds exact integers.
+    if (v == std::trunc(v) && std::abs(v) < 9007199254740992.0)
+      buf_ += fmt::format("{:.0f}", v);
+    else
+      buf_ += fmt::format("{:.10g}", v);
+  }
+  buf_ += '\n';
+}
+
+void Series::flush() {
+  if (buf_.empty()) return;
+  std::ofstream f(path_, std::ios::app);
+  f << buf_;
+  f.close();
+  if (!f) throw OutputError(fmt::format("cannot write '{}'", path_));
+  buf_.clear();
+}
+
+// ---------------------------------------------------------------------------
+// Snapshots
+
+namespace {
+
+template <class A>
+vtkNew<A> make_array(const char* name, int comps, vtkIdType n) {
+  vtkNew<A> a;
+  a->SetName(name);
+  a->SetNumberOfComponents(comps);
+  a->SetNumberOfTuples(n);
+  return a;
+}
+
+template <class... A>
+void add_arrays(vtkFieldData* fd, A&... arrays) {
+  (fd->AddArray(arrays), ...);
+}
+
+// Writes to a temporary name, then renames, so ParaView never opens a
+// partial file.
+void write_vtp(vtkPolyData* pd, const std::string& path) {
+  const std::string tmp = tmp_name(path);
+  vtkNew<vtkXMLPolyDataWriter> w;
+  w->SetInputData(pd);
+  w->SetFileName(tmp.c_str());
+  w->SetDataModeToAppended();
+  w->EncodeAppendedDataOff();  // raw binary, not base64
+  w->SetCompressorTypeToZLib();
+  w->SetHeaderTypeToUInt64();  // no 4 GB limit on a data block
+  if (w->Write() != 1 || w->GetErrorCode() != 0) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw OutputError(fmt::format("cannot write '{}'", path));
+  }
+  rename_into_place(tmp, path);
+}
+
+vtkSmartPointer<vtkPolyData> particles(const World& w) {
+  const Bodies& b = w.bodies;
+  vtkIdType n = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) n += b.is_dynamic(i);
+
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(n);
+  vtkNew<vtkCellArray> verts;
+  auto id = make_array<vtkIntArray>("id", 1, n);
+  auto radius = make_array<vtkDoubleArray>("radius", 1, n);
+  auto vel = make_array<vtkDoubleArray>("velocity", 3, n);
+  auto omega = make_array<vtkDoubleArray>("omega", 1, n);
+  auto angle = make_array<vtkDoubleArray>("angle", 1, n);
+  auto mass = make_array<vtkDoubleArray>("mass", 1, n);
+  vtkIdType k = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (!b.is_dynamic(i)) continue;
+    pts->SetPoint(k, b.pos[i].x(), b.pos[i].y(), 0.0);
+    verts->InsertNextCell(1, &k);
+    id->SetValue(k, static_cast<int>(i));
+    radius->SetValue(k, b.radius[i]);
+    vel->SetTuple3(k, b.vel[i].vx, b.vel[i].vy, 0.0);
+    omega->SetValue(k, b.vel[i].w);
+    angle->SetValue(k, b.angle[i]);
+    mass->SetValue(k, b.mass[i]);
+    ++k;
+  }
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->SetPoints(pts);
+  pd->SetVerts(verts);
+  add_arrays(pd->GetPointData(), id, radius, vel, omega, angle, mass);
+  return pd;
+}
+
+vtkSmartPointer<vtkPolyData> contacts(const World& w) {
+  const Bodies& b = w.bodies;
+  const auto& rows = w.rows();
+  const auto& infos = w.infos();
+  const vtkIdType n = static_cast<vtkIdType>(rows.size());
+  const double dt = w.params().dt;
+
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(2 * n);
+  vtkNew<vtkCellArray> lines;
+  auto fn = make_array<vtkDoubleArray>("fn", 1, n);
+  auto ft = make_array<vtkDoubleArray>("ft", 1, n);
+  auto force = make_array<vtkDoubleArray>("force", 3, n);
+  auto normal = make_array<vtkDoubleArray>("normal", 3, n);
+  auto status = make_array<vtkUnsignedCharArray>("status", 1, n);
+  auto type = make_array<vtkUnsignedCharArray>("type", 1, n);
+  auto gap = make_array<vtkDoubleArray>("gap", 1, n);
+  auto b1 = make_array<vtkIntArray>("b1", 1, n);
+  auto b2 = make_array<vtkIntArray>("b2", 1, n);
+  for (vtkIdType k = 0; k < n; ++k) {
+    const ContactRow& r = rows[k];
+    const ContactInfo& c = infos[k];
+    // A wall's centre says nothing about where it is touched: draw the wall
+    // end of the line at the contact point.
+    auto end = [&](std::int32_t i) {
+      return b.shape[i] == Shape::Segment ? Vec2(c.px, c.py) : b.pos[i];
+    };
+    const Vec2 x1 = end(r.b1), x2 = end(r.b2);
+    pts->SetPoint(2 * k, x1.x(), x1.y(), 0.0);
+    pts->SetPoint(2 * k + 1, x2.x(), x2.y(), 0.0);
+    const vtkIdType ids[2] = {2 * k, 2 * k + 1};
+    lines->InsertNextCell(2, ids);
+    const double f_n = r.pn / dt, f_t = r.pt / dt;  // impulses over the step -> forces
+    fn->SetValue(k, f_n);
+    ft->SetValue(k, f_t);
+    force->SetTuple3(k, f_n * r.nx - f_t * r.ny, f_n * r.ny + f_t * r.nx, 0.0);
+    normal->SetTuple3(k, r.nx, r.ny, 0.0);
+    status->SetValue(k, static_cast<unsigned char>(w.status(k)));
+    type->SetValue(k, static_cast<unsigned char>(c.type));
+    gap->SetValue(k, c.gap);
+    b1->SetValue(k, r.b1);
+    b2->SetValue(k, r.b2);
+  }
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->SetPoints(pts);
+  pd->SetLines(lines);
+  add_arrays(pd->GetCellData(), fn, ft, force, normal, status, type, gap, b1, b2);
+  return pd;
+}
+
+vtkSmartPointer<vtkPolyData> walls(const World& w) {
+  const Bodies& b = w.bodies;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> lines;
+  vtkNew<vtkIntArray> id;
+  id->SetName("id");
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.shape[i] != Shape::Segment) continue;
+    Vec2 a, e;
+    b.segment_ends(i, a, e);
+    const vtkIdType ids[2] = {pts->InsertNextPoint(a.x(), a.y(), 0.0),
+                              pts->InsertNextPoint(e.x(), e.y(), 0.0)};
+    lines->InsertNextCell(2, ids);
+    id->InsertNextValue(static_cast<int>(i));
+  }
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->SetPoints(pts);
+  pd->SetLines(lines);
+  pd->GetCellData()->AddArray(id);
+  return pd;
+}
+
+std::string pvd(const std::vector<std::pair<double, std::string>>& frames, const char* stem) {
+  std::string s =
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      "  <Collection>\n";
+  for (const auto& [t, num] : frames)
+    s += fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}_{}.vtp\"/>\n",
+                     t, stem, num);
+  s += "  </Collection>\n</VTKFile>\n";
+  return s;
+}
+
+}  // namespace
+
+Snapshots::Snapshots(const std::string& dir) : dir_(dir) {}
+
+void Snapshots::write(const World& w) {
+  const std::string num = fmt::format("{:05d}", n_);
+  const fs::path d(dir_);
+  write_vtp(particles(w), (d / ("particles_" + num + ".vtp")).string());
+  write_vtp(contacts(w), (d / ("contacts_" + num + ".vtp")).string());
+  write_vtp(walls(w), (d / ("walls_" + num + ".vtp")).string());
+  // The collections are rewritten only once all three files of the frame are
+  // in place, so they never list a missing file.
+  frames_.emplace_back(w.time, num);
+  for (const char* stem : {"particles", "contacts", "walls"})
+    write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd(frames_, stem));
+  ++n_;
+}
+
+}  // namespace cd
