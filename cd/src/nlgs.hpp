@@ -70,6 +70,16 @@ inline void row_velocity(const ContactRow& r, const std::vector<BodyVel>& vel, b
   }
 }
 
+// Fills the Delassus block of a row from its lever arms and the bodies'
+// inverse inertia (contact.hpp gives the formula and its sign convention).
+inline void set_block(ContactRow& r, const BodyVel& A, const BodyVel& B, bool rotation) {
+  const double iI1 = rotation ? A.inv_I : 0.0, iI2 = rotation ? B.inv_I : 0.0;
+  const double im = A.inv_m + B.inv_m;
+  r.wnn = im + r.c1t * r.c1t * iI1 + r.c2t * r.c2t * iI2;
+  r.wtt = im + r.c1n * r.c1n * iI1 + r.c2n * r.c2n * iI2;
+  r.wnt = -(r.c1n * r.c1t * iI1 + r.c2n * r.c2t * iI2);
+}
+
 // Law residual of every row (normalised by mean |p|), computed read-only.
 void law_residuals(const std::vector<ContactRow>& rows, const std::vector<BodyVel>& vel,
                    const SolverParams& prm, SolveStats& st);

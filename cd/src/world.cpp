@@ -40,8 +40,8 @@ void World::step() {
   t0 = Clock::now();
   integrate();
   times.integrate += since(t0);
-  time += prm_.dt;
   ++steps;
+  time = static_cast<double>(steps) * prm_.dt;  // not a running sum: no drift
 }
 
 void World::predict() {
@@ -65,13 +65,7 @@ void World::build() {
   const std::size_t nr = rows_.size();
   for (std::size_t k = 0; k < nr; ++k) {
     ContactRow& r = rows_[k];
-    const BodyVel& A = V[r.b1];
-    const BodyVel& B = V[r.b2];
-    const double iI1 = rot ? A.inv_I : 0.0, iI2 = rot ? B.inv_I : 0.0;
-    const double im = A.inv_m + B.inv_m;
-    r.wnn = im + r.c1t * r.c1t * iI1 + r.c2t * r.c2t * iI2;
-    r.wtt = im + r.c1n * r.c1n * iI1 + r.c2n * r.c2n * iI2;
-    r.wnt = -(r.c1n * r.c1t * iI1 + r.c2n * r.c2t * iI2);
+    set_block(r, V[r.b1], V[r.b2], rot);
     r.mu = bodies.driven[r.b1] ? prm_.mu_wall : prm_.mu;
     const double gap = info_[k].gap;
     r.bn = gap > 0.0 ? 2.0 * gap / dt : 0.0;

@@ -1,0 +1,32 @@
+// A run: the time loop around World::step, writing series rows, VTK
+// snapshots and a progress line.
+#pragma once
+#include <string>
+
+#include "scene.hpp"
+#include "world.hpp"
+
+namespace cd {
+
+struct RunOptions {
+  std::string out;          // output folder
+  bool quiet = false;       // no progress line
+  std::string scene_toml;   // resolved scene, written as scene.toml
+};
+
+struct RunSummary {
+  std::int64_t steps = 0;
+  double mean_iterations = 0;
+  int max_iterations = 0;
+  std::int64_t cap_hits = 0;
+  double max_residual = 0;
+  double max_overlap = 0;
+  double wall_time = 0;
+  double kinetic_energy = 0;
+};
+
+// Runs the world for the scene's duration. The caller has validated the
+// scene and checked the output folder; this creates it and writes into it.
+RunSummary run(World& w, const Scene& s, const RunOptions& opt);
+
+}  // namespace cd

@@ -1,0 +1,27 @@
+// From a Scene to a World: generated and explicit disks, walls, and the
+// per-scene settings. Checks what the parser cannot: that particles fit in
+// their region and that no two bodies overlap at t = 0.
+#pragma once
+#include <stdexcept>
+
+#include "scene.hpp"
+#include "world.hpp"
+
+namespace cd {
+
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Mean diameter of the scene's disks (number mean), known before placement.
+double mean_diameter(const Scene& s);
+
+WorldParams world_params(const Scene& s);
+
+// Builds the world; throws SceneError naming the bodies at fault.
+World build_world(const Scene& s);
+
+// Diameters of the n generated disks (deterministic for a seed).
+std::vector<double> generated_diameters(const Scene& s);
+
+}  // namespace cd

@@ -1,0 +1,71 @@
+// Small helpers shared by the physics tests.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+
+#include "world.hpp"
+
+namespace cdtest {
+
+inline cd::WorldParams params(double dt, double g, double mu, double e_n = 0.0) {
+  cd::WorldParams p;
+  p.dt = dt;
+  p.gravity = cd::Vec2(0.0, -g);
+  p.mu = p.mu_wall = mu;
+  p.e_n = e_n;
+  p.d_ref = 1.0;
+  p.alert = 0.1;
+  p.solver.tol = 1e-10;
+  p.solver.max_iter = 10000;
+  return p;
+}
+
+// FNV-1a over the raw bytes of positions, angles and velocities.
+inline std::uint64_t state_hash(const cd::World& w) {
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* p, std::size_t n) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 1099511628211ull;
+  };
+  const cd::Bodies& b = w.bodies;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    mix(b.pos[i].data(), 2 * sizeof(double));
+    mix(&b.angle[i], sizeof(double));
+    mix(&b.vel[i], 3 * sizeof(double));
+  }
+  return h;
+}
+
+inline bool all_finite(const cd::World& w) {
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    const auto& v = w.bodies.vel[i];
+    if (!std::isfinite(w.bodies.pos[i].x()) || !std::isfinite(w.bodies.pos[i].y()) ||
+        !std::isfinite(v.vx) || !std::isfinite(v.vy) || !std::isfinite(v.w))
+      return false;
+  }
+  return true;
+}
+
+// A box of walls [0, W] x [0, H] with n disks of diameters in [d_min, d_max]
+// on a loose jittered lattice (no overlap), for piles.
+inline void fill_box(cd::World& w, int n, double W, double H, double dmin, double dmax,
+                     unsigned seed, double density = 1.0) {
+  std::mt19937_64 g(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const double pitch = 1.02 * dmax;
+  const int nx = static_cast<int>(W / pitch);
+  for (int k = 0; k < n; ++k) {
+    const double d = dmin + (dmax - dmin) * U(g);
+    const double slack = 0.5 * (pitch - d);
+    const double x = (k % nx + 0.5) * pitch + slack * (2 * U(g) - 1);
+    const double y = (k / nx + 0.5) * pitch + slack * (2 * U(g) - 1);
+    w.bodies.add_disk({x, y}, 0.5 * d, density);
+  }
+  w.bodies.add_wall({0, 0}, {W, 0});
+  w.bodies.add_wall({0, H}, {0, 0});
+  w.bodies.add_wall({W, 0}, {W, H});
+}
+
+}  // namespace cdtest
