@@ -9,6 +9,8 @@ namespace cd {
 
 namespace {
 
+constexpr int kMinParallelDetect = 2000;
+
 // Lever arms of a contact point in the frame (n, t = n rotated +90 degrees).
 inline void set_frame(ContactRow& row, const Vec2& n, const Vec2& c1, const Vec2& c2) {
   row.nx = n.x();
@@ -115,7 +117,9 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
     }
     const std::vector<int>& cs = grid.cell_start;
     const std::vector<int>& it = grid.items;
-#pragma omp parallel
+    // Small systems detect on one thread: waking a team costs more than the
+    // work, and much more on a loaded machine.
+#pragma omp parallel if (nd >= kMinParallelDetect)
     {
       auto& R = grid.rows_t[omp_get_thread_num()];
       auto& I = grid.info_t[omp_get_thread_num()];

@@ -62,17 +62,18 @@ struct RowBlock {
 };
 
 struct BlockStats {
-  double dp2max = 0, psum = 0, rmax = 0, rsum = 0;
+  double dp2max = 0, dp2sum = 0, psum = 0, rmax = 0, rsum = 0;
 };
 
 template <class L, bool Rot>
 void run_block(const RowBlock& k, ContactRow* rows, BodyVel* vel, BlockStats& s) {
-  double dmax = 0, psum = 0;
+  double dmax = 0, dsum = 0, psum = 0;
   if (k.write1) {
     for (int i = k.begin; i < k.end; ++i) {
       double dp2, pabs;
       update_row<L, Rot, true>(rows[i], vel, dp2, pabs);
       dmax = std::max(dmax, dp2);
+      dsum += dp2;
       psum += pabs;
     }
   } else {
@@ -80,10 +81,12 @@ void run_block(const RowBlock& k, ContactRow* rows, BodyVel* vel, BlockStats& s)
       double dp2, pabs;
       update_row<L, Rot, false>(rows[i], vel, dp2, pabs);
       dmax = std::max(dmax, dp2);
+      dsum += dp2;
       psum += pabs;
     }
   }
   s.dp2max = dmax;
+  s.dp2sum = dsum;
   s.psum = psum;
 }
 
@@ -134,7 +137,14 @@ SolveStats nlgs_impl(std::vector<ContactRow>& rows, const Colouring& col,
 #pragma omp parallel if (parallel)
   {
     while (!done) {
-      for (int c = 0; c < ncol; ++c) {
+      // Symmetric Gauss-Seidel: colours forward on odd sweeps, backward on
+      // even ones, so that forces travel both ways along a chain (a pile's
+      // weight down, the floor's reaction up) within two sweeps. Inside a
+      // colour the order does not matter. The overflow colour stays last.
+      const bool backward = (it % 2) == 1;
+      const int nreg = col.overflow ? ncol - 1 : ncol;
+      for (int cc = 0; cc < ncol; ++cc) {
+        const int c = (cc < nreg && backward) ? nreg - 1 - cc : cc;
         if (col.overflow && c == ncol - 1) {
 #pragma omp single
           for (int b = cb[c]; b < cb[c + 1]; ++b) run_block<L, Rot>(blocks[b], R, V, bs[b]);
@@ -146,14 +156,16 @@ SolveStats nlgs_impl(std::vector<ContactRow>& rows, const Colouring& col,
 #pragma omp single
       {
         ++it;
-        double dmax = 0, psum = 0;
+        double dmax = 0, dsum = 0, psum = 0;
         for (int b = 0; b < nb; ++b) {
           dmax = std::max(dmax, bs[b].dp2max);
+          dsum += bs[b].dp2sum;
           psum += bs[b].psum;
         }
         st.p_mean = psum / n;
         const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
-        st.dp_rel = std::sqrt(dmax) / scale;
+        st.dp_max_rel = std::sqrt(dmax) / scale;
+        st.dp_rel = std::sqrt(dsum / n) / scale;
         st.iterations = it;
         if (it >= prm.max_iter) done = true;
         if (st.dp_rel < prm.tol) done = true;

@@ -18,18 +18,22 @@
 namespace cd {
 
 struct SolverParams {
-  double tol = 1e-4;       // eps_f: max |dp| / mean |p| over a sweep, and law residual
+  double tol = 1e-4;       // eps_f on rms |dp| / mean |p| over a sweep (LMGC90's "Quad" norm)
   int max_iter = 2000;     // iteration cap
   bool friction = true;    // law chosen once per scene
   bool adhesion = false;
   bool rotation = true;
-  int min_parallel = 512;  // below this many rows the sweep runs on one thread
+  // Below this many rows the sweep runs on one thread: a colour of a few
+  // dozen rows costs less than the barrier that ends it (measured: a
+  // 600-row pile ran 3x slower on 2 threads than on 1).
+  int min_parallel = 4096;
 };
 
 struct SolveStats {
   int iterations = 0;
   bool cap_hit = false;
-  double dp_rel = 0;         // last sweep's max |dp| / mean |p|
+  double dp_rel = 0;         // last sweep's rms |dp| / mean |p| (the convergence test)
+  double dp_max_rel = 0;     // last sweep's max |dp| / mean |p|
   double residual_max = 0;   // law residual, max over contacts / mean |p|
   double residual_mean = 0;  // law residual, mean over contacts / mean |p|
   double p_mean = 0;         // mean |p| (impulse scale)
