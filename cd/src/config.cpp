@@ -1,0 +1,511 @@
+// Scene files. The parameter tables below bind every TOML key to its Scene
+// member, unit, rule and meaning; reading, validation, error messages, the
+// resolved scene.toml and the Markdown table are all generated from them.
+// Defaults are never written here: they are the initialisers in scene.hpp.
+#include "config.hpp"
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <string_view>
+#include <tuple>
+#include <utility>
+#include <variant>
+
+#include <fmt/format.h>
+#include <toml.hpp>
+
+namespace cd {
+namespace {
+
+// ---- rules ----------------------------------------------------------------
+// A rule sees the value as a number (integers included), a bool, a string or
+// a list of numbers; `text` completes "must be ...".
+using Val = std::variant<double, bool, std::string, std::vector<double>>;
+
+struct Rule {
+  std::string text;                       // empty: any value of the right type
+  std::function<bool(const Val&)> ok;
+};
+
+double num(const Val& v) { return std::get<double>(v); }
+Rule any() { return {}; }
+Rule gt(double lo) { return {fmt::format("> {}", lo), [=](const Val& v) { return num(v) > lo; }}; }
+Rule ge(double lo) { return {fmt::format(">= {}", lo), [=](const Val& v) { return num(v) >= lo; }}; }
+Rule in(double lo, double hi) {
+  return {fmt::format("in [{}, {}]", lo, hi),
+          [=](const Val& v) { return num(v) >= lo && num(v) <= hi; }};
+}
+Rule non_empty() {
+  return {"non-empty", [](const Val& v) { return !std::get<std::string>(v).empty(); }};
+}
+Rule size_dist() {
+  return {"\"uniform\" or \"uniform_area\"", [](const Val& v) {
+            return std::get<std::string>(v) == "uniform" || std::get<std::string>(v) == "uniform_area";
+          }};
+}
+Rule region() {
+  return {"[] or [xmin, ymin, xmax, ymax] with xmin < xmax, ymin < ymax", [](const Val& v) {
+            const auto& r = std::get<std::vector<double>>(v);
+            return r.empty() || (r.size() == 4 && r[0] < r[2] && r[1] < r[3]);
+          }};
+}
+Rule disk_density() {
+  return {"> 0, or -1 (particles.density)", [](const Val& v) { return num(v) > 0 || num(v) == -1; }};
+}
+
+// ---- the parameter table -----------------------------------------------------
+template <class T>
+using Field = std::variant<double T::*, int T::*, unsigned T::*, bool T::*, std::string T::*,
+                           std::array<double, 2> T::*, std::vector<double> T::*>;
+
+template <class T>
+struct Param {
+  const char* section;  // "" : top-level key; "disk", "wall": [[disk]], [[wall]]
+  const char* key;
+  Field<T> field;
+  const char* unit;
+  Rule rule;
+  const char* doc;
+};
+
+const std::vector<Param<Scene>>& scene_params() {
+  static const std::vector<Param<Scene>> t = {
+      {"", "name", &Scene::name, "", non_empty(), "run name (output folder outputs/<name> unless --out)"},
+      {"time", "dt", &Scene::dt, "s", gt(0), "time step"},
+      {"time", "duration", &Scene::duration, "s", ge(0), "simulated time"},
+      {"gravity", "g", &Scene::gravity, "m/s^2", any(), "gravity vector [gx, gy]"},
+      {"contact", "mu", &Scene::mu, "", ge(0), "particle-particle friction coefficient"},
+      {"contact", "mu_wall", &Scene::mu_wall, "", any(), "particle-wall friction coefficient; < 0: same as mu"},
+      {"contact", "e_n", &Scene::e_n, "", in(0, 1), "normal restitution coefficient"},
+      {"contact", "e_t", &Scene::e_t, "", in(0, 1), "tangential restitution coefficient"},
+      {"contact", "alert", &Scene::alert, "d_mean", ge(0), "alert distance of contact detection, in mean diameters"},
+      {"contact", "rotation", &Scene::rotation, "", any(), "integrate particle rotations"},
+      {"solver", "tol", &Scene::tol, "", gt(0), "NLGS convergence tolerance (relative)"},
+      {"solver", "max_iter", &Scene::max_iter, "", ge(1), "NLGS iteration cap per time step"},
+      {"solver", "threads", &Scene::threads, "", ge(0), "OpenMP threads; 0: OpenMP default"},
+      {"particles", "n", &Scene::n, "", ge(0), "number of randomly generated disks; 0: none"},
+      {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
+      {"particles", "size_ratio", &Scene::size_ratio, "", ge(1), "d_max / d_min"},
+      {"particles", "size_dist", &Scene::size_dist, "", size_dist(), "diameter distribution: uniform in d, or uniform_area (equal area per size class)"},
+      {"particles", "density", &Scene::density, "kg/m^2", gt(0), "mass per unit area (2600 kg/m^3 x 1 mm = 2.6)"},
+      {"particles", "seed", &Scene::seed, "", any(), "random seed of sizes and positions"},
+      {"particles", "region", &Scene::region, "m", region(), "generation region [xmin, ymin, xmax, ymax]; []: inside the box"},
+      {"box", "width", &Scene::box_width, "m", ge(0), "box of four static walls [0, width] x [0, height]; width and height both 0 (no box) or both > 0"},
+      {"box", "height", &Scene::box_height, "m", ge(0), "box height"},
+      {"output", "series_interval", &Scene::series_interval, "s", gt(0), "time between rows of series.csv"},
+      {"output", "snapshot_interval", &Scene::snapshot_interval, "s", ge(0), "time between VTK snapshots; 0: none"},
+      {"output", "quiet", &Scene::quiet, "", any(), "no progress output"},
+  };
+  return t;
+}
+
+const std::vector<Param<DiskSpec>>& disk_params() {
+  static const std::vector<Param<DiskSpec>> t = {
+      {"disk", "pos", &DiskSpec::pos, "m", any(), "centre [x, y] (one [[disk]] table per explicit disk)"},
+      {"disk", "vel", &DiskSpec::vel, "m/s", any(), "initial velocity"},
+      {"disk", "radius", &DiskSpec::radius, "m", gt(0), "radius"},
+      {"disk", "omega", &DiskSpec::omega, "rad/s", any(), "initial angular velocity"},
+      {"disk", "density", &DiskSpec::density, "kg/m^2", disk_density(), "mass per unit area; -1: particles.density"},
+  };
+  return t;
+}
+
+const std::vector<Param<WallSpec>>& wall_params() {
+  static const std::vector<Param<WallSpec>> t = {
+      {"wall", "a", &WallSpec::a, "m", any(), "first end point at t = 0 (one [[wall]] table per rigid segment)"},
+      {"wall", "b", &WallSpec::b, "m", any(), "second end point at t = 0 (must differ from a)"},
+      {"wall", "vel", &WallSpec::vel, "m/s", any(), "imposed velocity"},
+      {"wall", "omega", &WallSpec::omega, "rad/s", any(), "imposed angular velocity about the midpoint"},
+  };
+  return t;
+}
+
+// "contact.mu", "name", or "disk[3].radius" for an entry of an array of tables.
+std::string label(std::string_view section, std::string_view key, const std::string& index = "") {
+  if (!index.empty()) return fmt::format("{}[{}].{}", section, index, key);
+  return section.empty() ? std::string(key) : fmt::format("{}.{}", section, key);
+}
+
+template <class T>
+const Param<T>* find(const std::vector<Param<T>>& params, std::string_view section,
+                     std::string_view key) {
+  for (const Param<T>& p : params)
+    if (p.section == section && p.key == key) return &p;
+  return nullptr;
+}
+
+bool is_section(std::string_view name) {
+  return name == "disk" || name == "wall" ||
+         std::any_of(scene_params().begin(), scene_params().end(),
+                     [&](const Param<Scene>& p) { return *p.section && p.section == name; });
+}
+
+// ---- values: TOML -> C++ (converters return "" or what is wrong) ------------
+std::string type_name(const toml::value& v) {
+  switch (v.type()) {
+    case toml::value_t::boolean: return "a boolean";
+    case toml::value_t::integer: return "an integer";
+    case toml::value_t::floating: return "a float";
+    case toml::value_t::string: return "a string";
+    case toml::value_t::array: return fmt::format("an array of {}", v.as_array().size());
+    case toml::value_t::table: return "a table";
+    default: return "a date/time";
+  }
+}
+
+std::string get(const toml::value& v, double& x) {
+  if (v.is_floating()) x = v.as_floating();
+  else if (v.is_integer()) x = static_cast<double>(v.as_integer());
+  else return ": expected a number, got " + type_name(v);
+  return "";
+}
+
+template <class I>
+std::string get_integer(const toml::value& v, I& x) {
+  if (!v.is_integer()) return ": expected an integer, got " + type_name(v);
+  if (!std::in_range<I>(v.as_integer()))
+    return fmt::format(" = {}: must be an integer in [{}, {}]", v.as_integer(),
+                       std::numeric_limits<I>::min(), std::numeric_limits<I>::max());
+  x = static_cast<I>(v.as_integer());
+  return "";
+}
+std::string get(const toml::value& v, int& x) { return get_integer(v, x); }
+std::string get(const toml::value& v, unsigned& x) { return get_integer(v, x); }
+
+std::string get(const toml::value& v, bool& x) {
+  if (!v.is_boolean()) return ": expected true or false, got " + type_name(v);
+  x = v.as_boolean();
+  return "";
+}
+
+std::string get(const toml::value& v, std::string& x) {
+  if (!v.is_string()) return ": expected a string, got " + type_name(v);
+  x = v.as_string().str;
+  return "";
+}
+
+std::string get(const toml::value& v, std::vector<double>& x) {
+  if (!v.is_array()) return ": expected an array of numbers, got " + type_name(v);
+  std::vector<double> out(v.as_array().size());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    if (!get(v.as_array()[i], out[i]).empty())
+      return ": expected an array of numbers, got an array containing " + type_name(v.as_array()[i]);
+  x = std::move(out);
+  return "";
+}
+
+std::string get(const toml::value& v, std::array<double, 2>& x) {
+  if (!v.is_array() || v.as_array().size() != 2)
+    return ": expected an array of 2 numbers, got " + type_name(v);
+  std::vector<double> a;
+  if (std::string e = get(v, a); !e.empty()) return e;
+  x = {a[0], a[1]};
+  return "";
+}
+
+// ---- values: C++ -> TOML text (toml = false: for messages, 1 not 1.0) ---------
+std::string text(double x, bool toml) {
+  std::string s = fmt::format("{}", x);  // shortest text that reads back exactly
+  if (toml && s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+std::string text(int x, bool) { return fmt::format("{}", x); }
+std::string text(unsigned x, bool) { return fmt::format("{}", x); }
+std::string text(bool x, bool) { return x ? "true" : "false"; }
+std::string text(const std::string& x, bool) {
+  std::string out = "\"";
+  for (const char c : x) {
+    if (c == '"' || c == '\\') out += {'\\', c};
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) out += fmt::format("\\u{:04X}", int(c));
+    else out += c;
+  }
+  return out + '"';
+}
+std::string text(const std::vector<double>& x, bool toml) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < x.size(); ++i) out += (i ? ", " : "") + text(x[i], toml);
+  return out + "]";
+}
+template <std::size_t N>
+std::string text(const std::array<double, N>& x, bool toml) {
+  return text(std::vector<double>(x.begin(), x.end()), toml);
+}
+
+template <class X>
+Val to_val(const X& x) {
+  if constexpr (std::is_same_v<X, bool> || std::is_same_v<X, std::string>) return x;
+  else if constexpr (std::is_arithmetic_v<X>) return static_cast<double>(x);
+  else return std::vector<double>(x.begin(), x.end());
+}
+
+// ---- reading ------------------------------------------------------------------
+// Problems found while reading, each prefixed with where it is: "file:line:col"
+// (the column of the key when it is on the value's line), "--set k=v" for an
+// override, or the bare path when the value has no position. All are reported
+// at once, in file order.
+struct Problems {
+  const std::string& path;
+  std::vector<std::tuple<int, unsigned, std::size_t, std::string>> list;  // rank, line, col, text
+
+  void add(const toml::value& at, std::string_view key, const std::string& msg) {
+    const toml::source_location loc = at.location();
+    if (loc.file_name().rfind("--set ", 0) == 0) {
+      list.emplace_back(1, 0, 0, loc.file_name() + ": " + msg);
+    } else if (loc.file_name() != path || loc.line_str() == "unknown line") {
+      list.emplace_back(2, 0, 0, path + ": " + msg);
+    } else {
+      std::size_t col = loc.column();
+      if (const auto k = loc.line_str().rfind(key, col - 1); !key.empty() && k != std::string::npos)
+        col = k + 1;
+      list.emplace_back(0, loc.line(), col, fmt::format("{}:{}:{}: {}", path, loc.line(), col, msg));
+    }
+  }
+  void throw_if_any() {
+    if (list.empty()) return;
+    std::stable_sort(list.begin(), list.end(), [](const auto& a, const auto& b) {
+      return std::tie(std::get<0>(a), std::get<1>(a), std::get<2>(a)) <
+             std::tie(std::get<0>(b), std::get<1>(b), std::get<2>(b));
+    });
+    std::string msg;
+    for (const auto& p : list) msg += (msg.empty() ? "" : "\n") + std::get<3>(p);
+    throw ConfigError(msg);
+  }
+};
+
+// Optimal string alignment distance (edits, adjacent swaps).
+std::size_t distance(std::string_view a, std::string_view b) {
+  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i)
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1])});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+// " (did you mean 'x'?)" for the closest candidate, compared as a whole and by
+// its last component (so 'solver.mu' finds 'contact.mu'), if reasonably close.
+std::string did_you_mean(std::string_view name, const std::vector<std::string>& candidates) {
+  const auto last = [](std::string_view s) { return s.substr(s.rfind('.') + 1); };
+  std::size_t best = 1 + last(name).size() / 5;  // the largest distance accepted
+  std::string hint;
+  for (const std::string& c : candidates)
+    if (const std::size_t d = std::min(distance(name, c), distance(last(name), last(c)) + 1); d <= best)
+      if (d < best || hint.empty()) best = d, hint = c;
+  return hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint);
+}
+
+template <class T>
+std::vector<std::string> labels(const std::vector<Param<T>>& params, const std::string& index = "") {
+  std::vector<std::string> out;
+  for (const Param<T>& p : params) out.push_back(label(p.section, p.key, index));
+  return out;
+}
+
+std::vector<std::string> section_names() {
+  std::vector<std::string> out;
+  for (const Param<Scene>& p : scene_params())
+    if (*p.section && (out.empty() || out.back() != p.section)) out.push_back(p.section);
+  out.insert(out.end(), {"disk", "wall"});
+  return out;
+}
+
+// Reads `key = v` of `section` (entry `index` of an array of tables) into obj.
+template <class T>
+void read_key(const std::vector<Param<T>>& params, std::string_view section, const std::string& key,
+              const toml::value& v, const std::string& index, T& obj, Problems& out) {
+  const std::string name = label(section, key, index);
+  const Param<T>* p = find(params, section, key);
+  const bool table = v.is_table() || (v.is_array() && !v.as_array().empty() && v.as_array()[0].is_table());
+  if (!p && section.empty() && table)
+    return out.add(v, key, fmt::format("unknown section '{}'{}", key, did_you_mean(key, section_names())));
+  if (!p) return out.add(v, key, fmt::format("unknown key '{}'{}", name, did_you_mean(name, labels(params, index))));
+  std::visit([&](auto member) {
+    auto x = obj.*member;
+    if (const std::string e = get(v, x); !e.empty()) return out.add(v, key, name + e);
+    if (p->rule.ok && !p->rule.ok(to_val(x)))
+      return out.add(v, key, fmt::format("{} = {}: must be {}", name, text(x, false), p->rule.text));
+    obj.*member = x;
+  }, p->field);
+}
+
+template <class T>
+void read_table(const toml::value& table, const std::vector<Param<T>>& params, std::string_view section,
+                const std::string& index, T& obj, Problems& out) {
+  for (const auto& [key, v] : table.as_table()) read_key(params, section, key, v, index, obj, out);
+}
+
+template <class T>
+void read_array(const toml::value& v, const std::vector<Param<T>>& params, const std::string& name,
+                std::vector<T>& list, Problems& out) {
+  if (!v.is_array())
+    return out.add(v, name, fmt::format("{}: expected [[{}]] tables, got {}", name, name, type_name(v)));
+  for (std::size_t i = 0; i < v.as_array().size(); ++i) {
+    const toml::value& e = v.as_array()[i];
+    T obj;
+    if (e.is_table()) read_table(e, params, name, std::to_string(i), obj, out);
+    else out.add(e, "", fmt::format("{}[{}]: expected a table, got {}", name, i, type_name(e)));
+    list.push_back(obj);
+  }
+}
+
+const toml::value& child(const toml::value& t, const std::string& key) {
+  static const toml::value none;
+  return t.is_table() && t.contains(key) ? t.at(key) : none;
+}
+
+Scene read_scene(const toml::value& root, const std::string& path) {
+  Problems out{path, {}};
+  Scene s;
+  s.source = path;
+  for (const auto& [name, v] : root.as_table()) {
+    if (name == "disk") read_array(v, disk_params(), name, s.disks, out);
+    else if (name == "wall") read_array(v, wall_params(), name, s.walls, out);
+    else if (!is_section(name)) read_key(scene_params(), "", name, v, "", s, out);
+    else if (v.is_table()) read_table(v, scene_params(), name, "", s, out);
+    else out.add(v, name, fmt::format("{}: expected a [{}] table, got {}", name, name, type_name(v)));
+  }
+  out.throw_if_any();
+
+  // Rules that involve two keys.
+  if ((s.box_width > 0) != (s.box_height > 0))
+    out.add(child(root, "box"), "box",
+            fmt::format("box.width = {}, box.height = {}: must be both 0 (no box) or both > 0",
+                        text(s.box_width, false), text(s.box_height, false)));
+  for (std::size_t i = 0; i < s.walls.size(); ++i)
+    if (s.walls[i].a == s.walls[i].b)
+      out.add(child(root, "wall").as_array().at(i), "wall",
+              fmt::format("wall[{}]: a = b = {}: the end points must differ", i, text(s.walls[i].a, false)));
+  out.throw_if_any();
+  return s;
+}
+
+// ---- overrides -----------------------------------------------------------------
+std::string trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+  return b == std::string_view::npos ? "" : std::string(s.substr(b, e - b + 1));
+}
+
+// `section.key=value`: the value is read as TOML and put into the tree. For a
+// string key, a value that is not TOML is taken as is (the shell turns
+// name="x" into name=x).
+void apply_override(toml::value& root, const std::string& set) {
+  const std::string src = "--set " + set;
+  const auto eq = set.find('=');
+  if (eq == std::string::npos) throw ConfigError(src + ": expected section.key=value");
+  const std::string key = trim(std::string_view(set).substr(0, eq)), value = trim(set.substr(eq + 1));
+  const auto dot = key.find('.');
+  const Param<Scene>* p = dot == std::string::npos ? find(scene_params(), "", key)
+                                                   : find(scene_params(), key.substr(0, dot), key.substr(dot + 1));
+  if (!p)
+    throw ConfigError(fmt::format("{}: unknown key '{}'{}", src, key, did_you_mean(key, labels(scene_params()))));
+
+  const auto parse = [&](const std::string& v) {
+    std::istringstream in("v = " + v);
+    return toml::value(toml::parse(in, src).at("v"));
+  };
+  toml::value v;
+  try {
+    v = parse(value);
+  } catch (const std::exception&) {
+    if (!std::holds_alternative<std::string Scene::*>(p->field))
+      throw ConfigError(fmt::format("{}: '{}' is not a TOML value (a number, true, false, "
+                                    "\"string\" or [array])", src, value));
+    v = parse(text(value, true));
+  }
+  toml::value* table = &root;
+  if (*p->section) {
+    table = &root.as_table()[p->section];
+    if (table->is_uninitialized()) *table = toml::table{};
+    if (!table->is_table()) return;  // reported as a bad section when read
+  }
+  table->as_table()[p->key] = v;
+}
+
+}  // namespace
+
+// ---- public API -------------------------------------------------------------------
+Scene parse_scene(const std::string& text, const std::string& path,
+                  const std::vector<std::string>& overrides) {
+  toml::value root;
+  try {
+    std::istringstream in(text);
+    root = toml::parse(in, path);
+  } catch (const toml::syntax_error& e) {
+    std::string what = e.what();
+    if (what.rfind("[error] ", 0) == 0) what.erase(0, 8);
+    throw ConfigError(fmt::format("{}:{}: TOML syntax error: {}", path, e.location().line(), what));
+  } catch (const std::exception& e) {
+    throw ConfigError(fmt::format("{}: {}", path, e.what()));
+  }
+  for (const std::string& o : overrides) apply_override(root, o);
+  return read_scene(root, path);
+}
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  std::error_code ec;
+  if (!in || std::filesystem::is_directory(path, ec))
+    throw ConfigError(fmt::format("cannot open scene file '{}'", path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), path, overrides);
+}
+
+std::string resolved_toml(const Scene& s) {
+  std::string out = "# Resolved scene: every parameter with the value used";
+  out += s.source.empty() ? ".\n" : fmt::format(" (read from {}).\n", s.source);
+  std::string section;
+  const auto line = [&](const auto& p, const auto& obj) {
+    const std::string kv =
+        fmt::format("{} = {}", p.key, std::visit([&](auto m) { return text(obj.*m, true); }, p.field));
+    out += fmt::format("{:<32} # {}{}\n", kv, *p.unit ? fmt::format("[{}] ", p.unit) : "", p.doc);
+  };
+  for (const Param<Scene>& p : scene_params()) {
+    if (p.section != section) out += fmt::format("\n[{}]\n", section = p.section);
+    line(p, s);
+  }
+  const auto array = [&](const auto& list, const auto& params) {
+    for (const auto& obj : list) {
+      out += fmt::format("\n[[{}]]\n", params.front().section);
+      for (const auto& p : params) line(p, obj);
+    }
+  };
+  array(s.disks, disk_params());
+  array(s.walls, wall_params());
+  return out;
+}
+
+std::string parameter_table_markdown() {
+  std::string md = "| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n";
+  const auto cell = [](std::string s) {
+    for (std::size_t k = 0; (k = s.find('|', k)) != std::string::npos; k += 2) s.insert(k, "\\");
+    return s;
+  };
+  const auto rows = [&](const auto& params, const auto& defaults, const std::string& index) {
+    for (const auto& p : params) {
+      const auto [value, rule] = std::visit([&](auto m) {
+        using F = std::remove_cvref_t<decltype(defaults.*m)>;
+        const bool integer = std::is_integral_v<F> && !std::is_same_v<F, bool>;
+        return std::pair(text(defaults.*m, true),
+                         integer ? trim("integer " + p.rule.text) : p.rule.text);
+      }, p.field);
+      md += fmt::format("| `{}` | `{}` | {} | {} | {} |\n", label(p.section, p.key, index),
+                        cell(value), p.unit, cell(rule), cell(p.doc));
+    }
+  };
+  rows(scene_params(), Scene{}, "");
+  rows(disk_params(), DiskSpec{}, "i");
+  rows(wall_params(), WallSpec{}, "i");
+  return md;
+}
+
+}  // namespace cd

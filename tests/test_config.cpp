@@ -1,0 +1,320 @@
+// Scene files: defaults, every key, error messages, overrides, the resolved
+// scene.toml round trip and the parameter table.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+
+namespace {
+
+using cd::ConfigError;
+using cd::DiskSpec;
+using cd::Scene;
+using cd::WallSpec;
+
+const std::string kFull = std::string(CDLAB_SOURCE_DIR) + "/tests/data/config/full.toml";
+
+// Field-by-field comparison: same = true expects equality, false expects every
+// field to differ. The structured bindings stop compiling when a member is added
+// to Scene, DiskSpec or WallSpec: add it here, to full.toml, to nondefault() and
+// to the table in config.cpp.
+#define CHECK_FIELD(f) \
+  if (same) { EXPECT_EQ(f, y.f) << #f; } else { EXPECT_NE(f, y.f) << #f; }
+
+void compare(const DiskSpec& x, const DiskSpec& y, bool same) {
+  const auto& [pos, vel, radius, omega, density] = x;
+  CHECK_FIELD(pos); CHECK_FIELD(vel); CHECK_FIELD(radius); CHECK_FIELD(omega); CHECK_FIELD(density);
+}
+
+void compare(const WallSpec& x, const WallSpec& y, bool same) {
+  const auto& [a, b, vel, omega] = x;
+  CHECK_FIELD(a); CHECK_FIELD(b); CHECK_FIELD(vel); CHECK_FIELD(omega);
+}
+
+void compare(const Scene& x, const Scene& y, bool same) {
+  const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, tol,
+               max_iter, threads, n, d_mean, size_ratio, size_dist, density, seed, region,
+               box_width, box_height, disks, walls, series_interval, snapshot_interval, quiet] = x;
+  (void)source;  // not a parameter: the file the scene was read from
+  CHECK_FIELD(name); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
+  CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
+  CHECK_FIELD(rotation); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(threads);
+  CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
+  CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(region); CHECK_FIELD(box_width);
+  CHECK_FIELD(box_height); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
+  CHECK_FIELD(quiet);
+  if (same) {
+    ASSERT_EQ(disks.size(), y.disks.size());
+    ASSERT_EQ(walls.size(), y.walls.size());
+  }
+  for (std::size_t i = 0; i < std::min(disks.size(), y.disks.size()); ++i) compare(disks[i], y.disks[i], same);
+  for (std::size_t i = 0; i < std::min(walls.size(), y.walls.size()); ++i) compare(walls[i], y.walls[i], same);
+}
+
+// The scene of tests/data/config/full.toml.
+Scene nondefault() {
+  Scene s;
+  s.name = "silo \"A\"\\1 é";
+  s.dt = 2.5e-5;
+  s.duration = 1.0 / 3.0;
+  s.gravity = {0.1, -9.80665};
+  s.mu = 0.3;
+  s.mu_wall = 0.7;
+  s.e_n = 0.2;
+  s.e_t = 1.0;
+  s.alert = 0.05;
+  s.rotation = false;
+  s.tol = 1e-6;
+  s.max_iter = 500;
+  s.threads = 2;
+  s.n = 300;
+  s.d_mean = 2e-3;
+  s.size_ratio = 1.5;
+  s.size_dist = "uniform";
+  s.density = 7.8;
+  s.seed = 4294967295u;
+  s.region = {0.0, 0.01, 0.1, 0.2};
+  s.box_width = 0.1;
+  s.box_height = 0.2;
+  s.series_interval = 1e-3;
+  s.snapshot_interval = 0.0;
+  s.quiet = true;
+  s.disks = {{{0.05, 0.1}, {1.0, -2.0}, 1e-3, 3.0, 5.0}, {{0.02, 0.03}, {0.0, 0.5}, 2e-3, -1.0, -1.0}};
+  s.walls = {{{0.0, 0.3}, {0.1, 0.25}, {0.0, -0.01}, 0.5}, {{-1.0, 0.0}, {-1.0, 1.0}, {0.2, 0.0}, -0.5}};
+  return s;
+}
+
+// The message of the ConfigError thrown by parse_scene (fails if none).
+std::string error(const std::string& text, const std::vector<std::string>& sets = {}) {
+  try {
+    cd::parse_scene(text, "x.toml", sets);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no ConfigError for:\n" << text;
+  return "";
+}
+
+TEST(Defaults, EmptyFileGivesSceneDefaults) {
+  const Scene s = cd::parse_scene("", "empty.toml");
+  compare(s, Scene{}, true);
+  EXPECT_EQ(s.source, "empty.toml");
+  EXPECT_TRUE(s.disks.empty());
+  EXPECT_TRUE(s.walls.empty());
+}
+
+TEST(FullFile, EveryKeyIsReadAndDiffersFromItsDefault) {
+  const Scene s = cd::load_scene(kFull);
+  EXPECT_EQ(s.source, kFull);
+  compare(s, nondefault(), true);
+  // Every field of the file differs from its default, so each key was bound.
+  compare(nondefault(), Scene{}, false);
+  compare(nondefault().disks[0], DiskSpec{}, false);
+  compare(nondefault().walls[0], WallSpec{}, false);
+}
+
+TEST(FullFile, IntegersAreAcceptedForFloats) {
+  const Scene s = cd::parse_scene("[time]\ndt = 1\n[gravity]\ng = [0, -10]\n", "x.toml");
+  EXPECT_EQ(s.dt, 1.0);
+  EXPECT_EQ(s.gravity, (std::array<double, 2>{0.0, -10.0}));
+}
+
+TEST(Errors, UnknownKeyNamesLineColumnAndClosestKey) {
+  EXPECT_EQ(error("[time]\ndt = 1e-3\n\n[contact]\n  muu = 0.3\n"),
+            "x.toml:5:3: unknown key 'contact.muu' (did you mean 'contact.mu'?)");
+  EXPECT_EQ(error("[particles]\ndesnity = 2\n"),
+            "x.toml:2:1: unknown key 'particles.desnity' (did you mean 'particles.density'?)");
+}
+
+TEST(Errors, KeyInTheWrongSectionSuggestsTheRightOne) {
+  EXPECT_EQ(error("[solver]\nmu = 0.3\n"),
+            "x.toml:2:1: unknown key 'solver.mu' (did you mean 'contact.mu'?)");
+  EXPECT_EQ(error("dt = 1e-3\n"), "x.toml:1:1: unknown key 'dt' (did you mean 'time.dt'?)");
+}
+
+TEST(Errors, NoSuggestionWhenNothingIsClose) {
+  EXPECT_EQ(error("[contact]\nstiffness = 1e6\n"), "x.toml:2:1: unknown key 'contact.stiffness'");
+}
+
+TEST(Errors, UnknownSection) {
+  EXPECT_EQ(error("[time]\ndt = 1e-3\n[contct]\nmu = 0.3\n"),
+            "x.toml:3:1: unknown section 'contct' (did you mean 'contact'?)");
+  EXPECT_EQ(error("[[disks]]\nradius = 1\n"),
+            "x.toml:1:1: unknown section 'disks' (did you mean 'disk'?)");
+}
+
+TEST(Errors, WrongType) {
+  EXPECT_EQ(error("[time]\ndt = \"fast\"\n"), "x.toml:2:1: time.dt: expected a number, got a string");
+  EXPECT_EQ(error("[solver]\nmax_iter = 100.0\n"),
+            "x.toml:2:1: solver.max_iter: expected an integer, got a float");
+  EXPECT_EQ(error("[contact]\nrotation = 1\n"),
+            "x.toml:2:1: contact.rotation: expected true or false, got an integer");
+  EXPECT_EQ(error("[gravity]\ng = [0, -9.81, 0]\n"),
+            "x.toml:2:1: gravity.g: expected an array of 2 numbers, got an array of 3");
+  EXPECT_EQ(error("[gravity]\ng = [0, \"down\"]\n"),
+            "x.toml:2:1: gravity.g: expected an array of numbers, got an array containing a string");
+  EXPECT_EQ(error("name = 3\n"), "x.toml:1:1: name: expected a string, got an integer");
+  EXPECT_EQ(error("time = 3\n"), "x.toml:1:1: time: expected a [time] table, got an integer");
+  EXPECT_EQ(error("[disk]\nradius = 1\n"),
+            "x.toml:1:1: disk: expected [[disk]] tables, got a table");
+}
+
+TEST(Errors, ValueOutOfRange) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"[contact]\ne_n = 1.5", "x.toml:2:1: contact.e_n = 1.5: must be in [0, 1]"},
+      {"[contact]\ne_t = -0.1", "x.toml:2:1: contact.e_t = -0.1: must be in [0, 1]"},
+      {"[contact]\nmu = -0.1", "x.toml:2:1: contact.mu = -0.1: must be >= 0"},
+      {"[time]\ndt = 0", "x.toml:2:1: time.dt = 0: must be > 0"},
+      {"[time]\nduration = -1", "x.toml:2:1: time.duration = -1: must be >= 0"},
+      {"[solver]\ntol = 0.0", "x.toml:2:1: solver.tol = 0: must be > 0"},
+      {"[solver]\nmax_iter = 0", "x.toml:2:1: solver.max_iter = 0: must be >= 1"},
+      {"[solver]\nthreads = -2", "x.toml:2:1: solver.threads = -2: must be >= 0"},
+      {"[particles]\nsize_ratio = 0.5", "x.toml:2:1: particles.size_ratio = 0.5: must be >= 1"},
+      {"[particles]\nd_mean = -1e-3", "x.toml:2:1: particles.d_mean = -0.001: must be > 0"},
+      {"[particles]\nsize_dist = \"gaussian\"",
+       "x.toml:2:1: particles.size_dist = \"gaussian\": must be \"uniform\" or \"uniform_area\""},
+      {"[particles]\nseed = -1", "x.toml:2:1: particles.seed = -1: must be an integer in [0, 4294967295]"},
+      {"[particles]\nregion = [0, 0, 1]",
+       "x.toml:2:1: particles.region = [0, 0, 1]: must be [] or [xmin, ymin, xmax, ymax] with "
+       "xmin < xmax, ymin < ymax"},
+      {"[particles]\nregion = [1, 0, 0, 1]",
+       "x.toml:2:1: particles.region = [1, 0, 0, 1]: must be [] or [xmin, ymin, xmax, ymax] with "
+       "xmin < xmax, ymin < ymax"},
+      {"[output]\nseries_interval = 0", "x.toml:2:1: output.series_interval = 0: must be > 0"},
+      {"[output]\nsnapshot_interval = -1", "x.toml:2:1: output.snapshot_interval = -1: must be >= 0"},
+      {"name = \"\"", "x.toml:1:1: name = \"\": must be non-empty"},
+      {"[box]\nwidth = 1", "x.toml:1:1: box.width = 1, box.height = 0: must be both 0 (no box) or both > 0"},
+  };
+  for (const auto& [text, message] : cases) EXPECT_EQ(error(text), message) << text;
+}
+
+TEST(Errors, BoundaryValuesAreAccepted) {
+  const Scene s = cd::parse_scene(
+      "[contact]\ne_n = 1\ne_t = 0\nmu = 0\nmu_wall = -1\n[solver]\nmax_iter = 1\n"
+      "[particles]\nsize_ratio = 1\nregion = []\n[output]\nsnapshot_interval = 0\n",
+      "x.toml");
+  EXPECT_EQ(s.e_n, 1.0);
+  EXPECT_EQ(s.mu_w(), 0.0);  // mu_wall < 0: same as mu
+  EXPECT_EQ(s.max_iter, 1);
+}
+
+TEST(Errors, DiskAndWallEntriesAreNamedByIndex) {
+  const std::string disks =
+      "[[disk]]\nradius = 1e-3\n[[disk]]\nradius = 1e-3\n[[disk]]\nradius = 1e-3\n"
+      "[[disk]]\npos = [0, 1]\nradius = -1\n";
+  EXPECT_EQ(error(disks), "x.toml:9:1: disk[3].radius = -1: must be > 0");
+  EXPECT_EQ(error("[[disk]]\ndensity = 0\n"),
+            "x.toml:2:1: disk[0].density = 0: must be > 0, or -1 (particles.density)");
+  EXPECT_EQ(error("[[disk]]\nradus = 1e-3\n"),
+            "x.toml:2:1: unknown key 'disk[0].radus' (did you mean 'disk[0].radius'?)");
+  EXPECT_EQ(error("[[wall]]\na = [0, 0]\n[[wall]]\na = [1, 1]\nb = [1, 1]\n"),
+            "x.toml:3:1: wall[1]: a = b = [1, 1]: the end points must differ");
+  EXPECT_EQ(cd::parse_scene("disk = [{radius = 1e-3}, {radius = 2e-3}]", "x.toml").disks.at(1).radius, 2e-3);
+}
+
+TEST(Errors, AllProblemsAreReportedInFileOrder) {
+  EXPECT_EQ(error("[time]\ndt = -1\n[contact]\nmuu = 1\ne_n = 2\n"),
+            "x.toml:2:1: time.dt = -1: must be > 0\n"
+            "x.toml:4:1: unknown key 'contact.muu' (did you mean 'contact.mu'?)\n"
+            "x.toml:5:1: contact.e_n = 2: must be in [0, 1]");
+}
+
+TEST(Errors, SyntaxErrorNamesFileAndLineAndKeepsTomlMessage) {
+  const std::string e = error("[time]\ndt = 1e-3\nduration = = 2\n");
+  EXPECT_EQ(e.rfind("x.toml:3: TOML syntax error: ", 0), 0u) << e;
+  EXPECT_NE(e.find("duration = = 2"), std::string::npos) << e;  // toml11's excerpt
+  EXPECT_EQ(error("[time]\ndt = 1\ndt = 2\n").rfind("x.toml:", 0), 0u);  // duplicate key
+}
+
+TEST(Errors, MissingFile) {
+  try {
+    cd::load_scene("no/such/scene.toml");
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(), "cannot open scene file 'no/such/scene.toml'");
+  }
+}
+
+TEST(Errors, PositionsInARealFile) {
+  try {
+    cd::load_scene(kFull, {"contact.e_n=2"});
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(), "--set contact.e_n=2: contact.e_n = 2: must be in [0, 1]");
+  }
+}
+
+TEST(Overrides, AreAppliedAfterTheFile) {
+  const Scene s = cd::parse_scene("[contact]\nmu = 0.2\n", "x.toml",
+                                  {"contact.mu=0.3", "gravity.g=[0,-1]", "name=\"x y\"",
+                                   "particles.size_dist = uniform", "solver.max_iter=7",
+                                   "output.quiet=true", "time.dt=1e-5", "time.dt=2e-5"});
+  EXPECT_EQ(s.mu, 0.3);
+  EXPECT_EQ(s.gravity, (std::array<double, 2>{0.0, -1.0}));
+  EXPECT_EQ(s.name, "x y");
+  EXPECT_EQ(s.size_dist, "uniform");  // a bare word (the shell ate the quotes) is a string
+  EXPECT_EQ(s.max_iter, 7);
+  EXPECT_TRUE(s.quiet);
+  EXPECT_EQ(s.dt, 2e-5);  // the last one wins
+  EXPECT_EQ(s.duration, Scene{}.duration);
+}
+
+TEST(Overrides, UnknownKeyOrBadValueIsAnError) {
+  EXPECT_EQ(error("", {"contact.muu=0.3"}),
+            "--set contact.muu=0.3: unknown key 'contact.muu' (did you mean 'contact.mu'?)");
+  EXPECT_EQ(error("", {"mu=0.3"}), "--set mu=0.3: unknown key 'mu' (did you mean 'contact.mu'?)");
+  EXPECT_EQ(error("", {"contact.e_n=1.5"}), "--set contact.e_n=1.5: contact.e_n = 1.5: must be in [0, 1]");
+  EXPECT_EQ(error("", {"solver.max_iter=1e3"}),
+            "--set solver.max_iter=1e3: solver.max_iter: expected an integer, got a float");
+  EXPECT_EQ(error("", {"time.dt=fast"}),
+            "--set time.dt=fast: 'fast' is not a TOML value (a number, true, false, \"string\" or [array])");
+  EXPECT_EQ(error("", {"gravity.g=[0,-1"}),
+            "--set gravity.g=[0,-1: '[0,-1' is not a TOML value (a number, true, false, \"string\" or [array])");
+  EXPECT_EQ(error("", {"time.dt=\"fast\""}), "--set time.dt=\"fast\": time.dt: expected a number, got a string");
+  EXPECT_EQ(error("", {"contact.mu"}), "--set contact.mu: expected section.key=value");
+}
+
+TEST(Resolved, RoundTripsANonDefaultSceneExactly) {
+  Scene s = nondefault();
+  s.gravity = {0.1 + 0.2, -1e-300};  // doubles that need 17 digits or an exponent
+  s.disks[0].pos = {1.7976931348623157e308, 4.9406564584124654e-324};
+  s.disks[1].vel = {-0.0, 2.0 / 3.0};
+  s.walls[1].omega = 1e22;
+  s.name = "tab\there, newline\nthere";
+  s.source = "scene.toml";  // named in the first comment line
+  const std::string toml = cd::resolved_toml(s);
+  const Scene r = cd::parse_scene(toml, "scene.toml");
+  compare(r, s, true);
+  EXPECT_EQ(r.source, "scene.toml");
+  EXPECT_EQ(cd::resolved_toml(r), cd::resolved_toml(s)) << toml;  // stable
+}
+
+TEST(Resolved, DefaultsRoundTripAndShowUnitsAndMeaning) {
+  const std::string toml = cd::resolved_toml(Scene{});
+  compare(cd::parse_scene(toml, "scene.toml"), Scene{}, true);
+  EXPECT_NE(toml.find("\n[time]\ndt = 0.0001"), std::string::npos) << toml;
+  EXPECT_NE(toml.find("# [s] time step\n"), std::string::npos) << toml;
+  EXPECT_NE(toml.find("size_ratio = 2.0 "), std::string::npos) << toml;  // a float stays a float
+  EXPECT_NE(toml.find("max_iter = 2000 "), std::string::npos) << toml;
+  EXPECT_EQ(toml.find("[[disk]]"), std::string::npos);
+}
+
+TEST(Markdown, OneRowPerParameter) {
+  const std::string md = cd::parameter_table_markdown();
+  EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
+  std::size_t rows = 0;
+  for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
+  // 25 scene keys + 5 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // DiskSpec and WallSpec but Scene::source, disks and walls.
+  EXPECT_EQ(rows, 25u + 5u + 4u) << md;
+  EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
+            std::string::npos) << md;
+  EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer >= 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| `contact.rotation` | `true` |  |  | integrate"), std::string::npos) << md;
+  EXPECT_NE(md.find("| `disk[i].radius` | `0.0005` | m | > 0 | radius |"), std::string::npos) << md;
+  EXPECT_NE(md.find("`particles.size_dist` | `\"uniform_area\"`"), std::string::npos) << md;
+}
+
+}  // namespace
