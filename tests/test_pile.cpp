@@ -113,7 +113,7 @@ TEST(Pile, SettlesToRestWithBoundedOverlapAndConvergedLaw) {
   //  - rest: final KE below 1e-4 of its peak during the fall (measured
   //    ~1e-6: the pile stops, up to the motion left by unconverged steps);
   //  - overlap: gaps close through the gap term, so overlaps come only from
-  //    the midpoint frame; 1e-2 d bounds them (measured ~3e-3 d);
+  //    the midpoint frame; 1e-2 d bounds them (measured 2e-5 d);
   //  - law residual of the last step below the tolerance's order (1e-2 with
   //    tol = 1e-4 on the rms force change: the residual is a max).
   // The top row starts ~17 d up: free fall takes ~1.9 s, settling about

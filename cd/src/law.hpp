@@ -42,9 +42,12 @@ inline LocalBranch solve_coulomb(double bn, double bt, const Block& W, double mu
     return LocalBranch::Open;
   }
   // Stick: both velocities zero.
+  // g_n from the first row of W g = -b given g_t: with W_nt = 0 it is
+  // exactly -b_n / W_nn, so mu = 0 here matches the frictionless path to
+  // the bit (tests/test_pile.cpp).
   const double det = W.wnn * W.wtt - W.wnt * W.wnt;
-  const double gn = (-bn * W.wtt + bt * W.wnt) / det;
   const double gt = (-bt * W.wnn + bn * W.wnt) / det;
+  const double gn = -(bn + W.wnt * gt) / W.wnn;
   const double bound = mu * (gn + a);
   if (gn + a >= 0.0 && std::abs(gt) <= bound) {
     pn = gn;
