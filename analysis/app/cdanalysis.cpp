@@ -1,0 +1,211 @@
+// cdanalysis: steady-state statistics, fabric, fits and reports of cdsim
+// runs. Every failure that is the input's fault prints one line naming the
+// file or quantity at fault and exits with status 1; usage errors exit with
+// CLI11's own non-zero codes.
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+
+#include "analysis/src/fabric_bounds.hpp"
+#include "analysis/src/fit.hpp"
+#include "analysis/src/report.hpp"
+#include "analysis/src/run.hpp"
+
+namespace fs = std::filesystem;
+using namespace cda;
+
+namespace {
+
+void print_stats(const RunSteady& r) {
+  const auto& s = r.stats;
+  fmt::print("run        {}\ncolumn     {}\nwindow     {} {} .. {} ({} rows, {})\n", r.run, r.column,
+             r.x_column, s.window.x_begin, s.window.x_end, s.window.end - s.window.begin,
+             r.detected ? "detected" : "given");
+  fmt::print("mean       {:.8g} +- {:.3g}\n", s.mean, s.error());
+  fmt::print("blocking   sem {:.3g} +- {:.2g} at block size {}{}\n", s.blocks.sem, s.blocks.sem_err,
+             s.blocks.block_size, s.blocks.converged ? "" : " (no plateau: lower bound)");
+  fmt::print("autocorr   tau_int {:.3g} +- {:.2g} rows, N_eff {:.1f}, sem {:.3g}{}\n", s.acf.tau,
+             s.acf.tau_err, s.acf.n_eff, s.acf.sem, s.acf.converged ? "" : " (window not converged)");
+  fmt::print("trend      slope {:.3g} +- {:.3g} per unit {}\n", s.trend.slope, s.trend.slope_se,
+             r.x_column);
+}
+
+void print_harmonics(const char* label, const Anisotropy& a) {
+  fmt::print("{:<8} a_c {:.4f} ({:.1f} deg)  a_ln {:.4f}  a_lt {:.4f}  a_fn {:.4f} ({:.1f} deg)  "
+             "a_ft {:.4f} ({:.1f} deg)  sum/2 {:.4f}\n",
+             label, a.c.a(), a.c.theta() * 180 / M_PI, a.ln.a(), a.lt.a(), a.fn.a(),
+             a.fn.theta() * 180 / M_PI, a.ft.a(), a.ft.theta() * 180 / M_PI, a.sum_half());
+}
+
+void print_fit(const FitResult& r, const Model& m) {
+  fmt::print("{}  ({})\n", r.model, m.formula);
+  for (std::size_t i = 0; i < r.names.size(); ++i)
+    fmt::print("  {:<10} {:.6g} +- {:.3g}\n", r.names[i], r.value[i], r.error[i]);
+  fmt::print("  chi2/dof {:.3f} (dof {}), error scale {:.3g}, {}{}\n", r.chi2_dof, r.dof, r.scale,
+             r.converged ? "converged" : "NOT converged: ", r.message);
+}
+
+void write_toml(const std::string& path, const std::vector<FitResult>& f, const std::vector<Model>& m) {
+  if (path.empty()) return;
+  std::ofstream out(path);
+  if (!out) throw AnalysisError(fmt::format("cannot write '{}'", path));
+  out << fits_to_toml(f, m);
+  fmt::print("wrote {}\n", path);
+}
+
+std::vector<double> col_or_empty(const Table& t, const std::string& name) {
+  return t.has(name) ? t.column(name) : std::vector<double>{};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"cdanalysis: analysis of cdsim runs (steady state, fabric, rheology fits, reports)"};
+  app.require_subcommand(1);
+
+  // steady
+  auto* steady = app.add_subcommand("steady", "steady-state mean and error bar of one series column");
+  std::string run, column = "q_over_p", xcol, window, out;
+  steady->add_option("run", run, "run folder (holding series.csv)")->required();
+  steady->add_option("--column", column, "column of series.csv")->capture_default_str();
+  steady->add_option("--x", xcol, "abscissa column (default: strain if present, else time)");
+  steady->add_option("--window", window, "steady window a:b in the abscissa (default: detected)");
+  steady->add_option("--out", out, "folder for the time-series plot (png, svg) and its data");
+
+  // fabric
+  auto* fabric = app.add_subcommand("fabric", "anisotropies, stress and connectivity of a contact snapshot");
+  int snapshot = -1, bins = 36;
+  double volume = -1;
+  fabric->add_option("run", run, "run folder (holding contacts_NNNNN.vtp)")->required();
+  fabric->add_option("--snapshot", snapshot, "snapshot index (negative: from the end)")->capture_default_str();
+  fabric->add_option("--bins", bins, "angular bins over [0, pi)")->capture_default_str();
+  fabric->add_option("--volume", volume, "volume (area) V for the stress; default: stress times V");
+  fabric->add_option("--out", out, "folder for the angular profiles and polar plots");
+
+  // fit
+  auto* fit = app.add_subcommand("fit", "rheology fits (method.md section 11)");
+  fit->require_subcommand(1);
+  std::vector<std::string> runs;
+  std::string table, toml_out;
+  auto* mu_i = fit->add_subcommand("mu-i", "mu(I) = mu1 + (mu2 - mu1)/(1 + I0/I) over steady runs");
+  mu_i->add_option("runs", runs, "run folders (each: steady mean of q_over_p and inertial_number)");
+  mu_i->add_option("--table", table, "CSV with columns I, mu and optionally mu_err, instead of runs");
+  mu_i->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
+  auto* coh = fit->add_subcommand("cohesion", "c/p = k0 eta/(1 - beta ln(1 - I/(1 + alpha eta)^(1/2)))");
+  coh->add_option("--table", table, "CSV with columns eta, I, c_over_p and optionally c_over_p_err")->required();
+  coh->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
+  auto* bounds = fit->add_subcommand("fabric-bounds", "envelope z_min, z_max of (z, a_c) points");
+  double k_bound = 1.0;
+  bounds->add_option("--table", table, "CSV with columns z, a_c (optionally z_err, a_c_err)")->required();
+  bounds->add_option("--k", k_bound, "bound prefactor (1 from method.md's definition)")->capture_default_str();
+
+  // report
+  auto* report = app.add_subcommand("report", "tables, fits, plots and index.html for a campaign");
+  std::string campaign;
+  report->add_option("campaign", campaign, "campaign folder (its subfolders are runs)")->required();
+  report->add_option("--out", out, "report folder (default: CAMPAIGN/report)");
+  report->add_option("--bins", bins, "angular bins over [0, pi)")->capture_default_str();
+
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (steady->parsed()) {
+      const auto series = read_series(run);
+      const std::string x = xcol.empty() ? default_x_column(series) : xcol;
+      std::optional<std::pair<double, double>> range;
+      if (!window.empty()) range = parse_range(window);
+      const auto r = run_steady(run, series, column, x, range);
+      print_stats(r);
+      if (!out.empty()) {
+        fs::create_directories(out);
+        if (!plot_series(out, "series_" + column, series, x, column, &r.stats.window))
+          fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
+      }
+    } else if (fabric->parsed()) {
+      const auto f = run_fabric(run, snapshot, bins, volume);
+      fmt::print("snapshot   {}\ncontacts   {} ({} force-bearing physical)\n", f.file, f.contacts,
+                 f.physical_contacts);
+      print_harmonics("fft", f.fft);
+      print_harmonics("tensor", f.tensor);
+      fmt::print("stress     p {:.6g}  q {:.6g}  q/p {:.4f}  theta_s {:.1f} deg  skew {:.3g}{}\n",
+                 f.stress.p(), f.stress.q(), f.stress.q_over_p(), f.stress.theta() * 180 / M_PI,
+                 f.stress.skew(), f.has_volume ? "" : "  (times V: no --volume)");
+      fmt::print("check      q/p {:.4f} vs (sum a)/2 {:.4f} (fft), {:.4f} (tensor, with directions)\n",
+                 f.stress.q_over_p(), f.fft.sum_half(), f.tensor.sum_half_vector());
+      fmt::print("sliding    {:.4f} of force-bearing contacts\n", f.sliding);
+      if (f.sv) print_harmonics("sv", *f.sv);
+      if (f.ss) print_harmonics("ss", *f.ss);
+      if (f.sv_stress) fmt::print("sv stress  p {:.6g} q {:.6g}\n", f.sv_stress->p(), f.sv_stress->q());
+      if (f.ss_stress) fmt::print("ss stress  p {:.6g} q {:.6g}\n", f.ss_stress->p(), f.ss_stress->q());
+      if (f.connectivity) {
+        const auto& c = *f.connectivity;
+        fmt::print("connect.   z {:.4f}  rattlers {} of {}  non-floating {:.4f}  P_c", c.z, c.rattlers,
+                   c.particles, c.non_floating);
+        for (std::size_t i = 0; i < c.P.size(); ++i) fmt::print(" {}:{:.3f}", i, c.P[i]);
+        fmt::print("\n");
+      } else {
+        fmt::print("connect.   no particles snapshot next to the contacts: z not computed\n");
+      }
+      if (!out.empty()) {
+        fs::create_directories(out);
+        if (!plot_polar(out, "polar", f)) fmt::print(stderr, "warning: gnuplot failed; scripts in {}\n", out);
+      }
+    } else if (mu_i->parsed()) {
+      std::vector<double> I, mu, err;
+      if (!table.empty()) {
+        const auto t = Table::read_csv(table);
+        I = t.column("I");
+        mu = t.column("mu");
+        err = col_or_empty(t, "mu_err");
+      } else {
+        if (runs.empty()) throw AnalysisError("fit mu-i: give run folders or --table");
+        for (const auto& r : runs) {
+          const auto series = read_series(r);
+          const auto x = default_x_column(series);
+          const auto s = run_steady(r, series, "q_over_p", x, std::nullopt);
+          const auto si = stats_over(series, "inertial_number", x, s.stats.window);
+          I.push_back(si.mean);
+          mu.push_back(s.stats.mean);
+          err.push_back(s.stats.error());
+          fmt::print("{}: I = {:.4g} +- {:.2g}, mu = {:.4f} +- {:.4f}\n", r, si.mean, si.error(),
+                     s.stats.mean, s.stats.error());
+        }
+      }
+      const auto r = fit_mu_I(I, mu, err);
+      print_fit(r, mu_of_I());
+      write_toml(toml_out, {r}, {mu_of_I()});
+    } else if (coh->parsed()) {
+      const auto t = Table::read_csv(table);
+      const auto r = fit_cohesion(t.column("eta"), t.column("I"), t.column("c_over_p"),
+                                  col_or_empty(t, "c_over_p_err"));
+      print_fit(r, cohesion());
+      write_toml(toml_out, {r}, {cohesion()});
+    } else if (bounds->parsed()) {
+      const auto t = Table::read_csv(table);
+      const auto b = fabric_bounds(t.column("z"), t.column("a_c"), col_or_empty(t, "z_err"),
+                                   col_or_empty(t, "a_c_err"), k_bound);
+      fmt::print("fabric bounds (k = {}): z_min {:.4f} +- {:.2g} (row {}), z_max {:.4f} +- {:.2g} (row {})\n"
+                 "peak a_c* {:.4f} at z* {:.4f}\n",
+                 b.k, b.z_min, b.z_min_err, b.i_min + 1, b.z_max, b.z_max_err, b.i_max + 1, b.a_star(),
+                 b.z_star());
+    } else if (report->parsed()) {
+      const std::string dir = out.empty() ? (fs::path(campaign) / "report").string() : out;
+      const auto s = write_report(campaign, dir, bins);
+      fmt::print("report in {}: {} runs, {} steady, {} with fabric{}\n", dir, s.runs, s.steady, s.fabric,
+                 s.plots_ok ? "" : " (some plots failed: see the .gp.log files)");
+      for (const auto& p : s.problems) fmt::print(stderr, "problem: {}\n", p);
+      fmt::print("open {}/index.html\n", dir);
+    }
+  } catch (const AnalysisError& e) {
+    fmt::print(stderr, "cdanalysis: {}\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "cdanalysis: error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

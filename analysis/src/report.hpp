@@ -1,0 +1,49 @@
+// Campaign report: a folder of tables (CSV), fit parameters (TOML), plots
+// (gnuplot, pngcairo and svg) and an index.html that links them.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "fit.hpp"
+#include "run.hpp"
+
+namespace cda {
+
+// Fit results as TOML: one table per fit,
+//   [mu_I]  formula, chi2, dof, chi2_dof, error_scale, converged
+//   [mu_I.params.mu1]  value, error
+// plus the covariance as an array of rows.
+std::string fits_to_toml(const std::vector<FitResult>& fits, const std::vector<Model>& models);
+
+// Runs gnuplot on a script; returns false (and leaves the script for a rerun)
+// when gnuplot is missing or fails.
+bool run_gnuplot(const std::string& script_path);
+
+// Writes `<stem>.gp` that draws `body` to both <stem>.png and <stem>.svg, and
+// runs it. `body` holds the set/plot commands of one plot.
+bool plot_both(const std::string& dir, const std::string& stem, const std::string& body,
+               int width = 800, int height = 500);
+
+// Time series of `column` with its steady window shaded.
+bool plot_series(const std::string& dir, const std::string& stem, const Table& series,
+                 const std::string& x_column, const std::string& column, const Window* w);
+
+// Polar diagrams of P(theta), <fn>(theta), <ft>(theta) with their Fourier
+// (second-harmonic) fits; 3 plots named <stem>_P, <stem>_fn, <stem>_ft.
+bool plot_polar(const std::string& dir, const std::string& stem, const RunFabric& f);
+
+// Runs of a campaign folder: its subfolders holding series.csv, sorted; the
+// folder itself if it holds series.csv. Throws AnalysisError naming the
+// folder when there is none.
+std::vector<std::string> campaign_runs(const std::string& campaign);
+
+struct ReportSummary {
+  std::size_t runs = 0, steady = 0, fabric = 0;
+  std::vector<std::string> problems;  // one line per run or step that failed
+  bool plots_ok = true;
+};
+
+// The whole report of a campaign into out_dir (created).
+ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins = 36);
+
+}  // namespace cda

@@ -1,0 +1,101 @@
+#include "run.hpp"
+
+#include <fmt/core.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+namespace fs = std::filesystem;
+
+namespace cda {
+
+Table read_series(const std::string& run_dir) {
+  std::error_code ec;
+  if (!fs::is_directory(run_dir, ec))
+    throw AnalysisError(fmt::format("run folder '{}' does not exist", run_dir));
+  const std::string path = (fs::path(run_dir) / "series.csv").string();
+  if (!fs::exists(path, ec))
+    throw AnalysisError(fmt::format("run folder '{}' has no series.csv", run_dir));
+  return Table::read_csv(path);
+}
+
+std::string default_x_column(const Table& series) {
+  return series.has("strain") ? "strain" : "time";
+}
+
+RunSteady run_steady(const std::string& run_dir, const Table& series, const std::string& column,
+                     const std::string& x_column,
+                     const std::optional<std::pair<double, double>>& range,
+                     const SteadyOptions& opt) {
+  RunSteady r;
+  r.run = run_dir;
+  r.column = column;
+  r.x_column = x_column;
+  const auto& x = series.column(x_column);
+  const auto& y = series.column(column);
+  const std::string what = fmt::format("'{}' column '{}'", series.source(), column);
+  Window w;
+  if (range) {
+    w = window_from_range(x, range->first, range->second);
+  } else {
+    w = detect_steady_window(x, y, opt, what);
+    r.detected = true;
+  }
+  r.stats = steady_stats(x, y, w, what);
+  return r;
+}
+
+SteadyStats stats_over(const Table& series, const std::string& column, const std::string& x_column,
+                       const Window& w) {
+  return steady_stats(series.column(x_column), series.column(column), w,
+                      fmt::format("'{}' column '{}'", series.source(), column));
+}
+
+RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume) {
+  RunFabric f;
+  f.file = snapshot_path(run_dir, "contacts", k);
+  const auto raw = read_contacts(f.file);
+  f.contacts = raw.size();
+  // Fabric over force-bearing physical contacts: an open contact (alert
+  // distance, or a bond that just broke) carries no force and is no part
+  // of the network whose anisotropy is measured.
+  ContactSet cs;
+  for (const auto& c : merge_side_side(raw))
+    if (c.fn != 0 || c.ft != 0) cs.push_back(c);
+  f.physical_contacts = cs.size();
+  if (cs.empty()) throw AnalysisError(fmt::format("'{}' has no force-bearing contact", f.file));
+  f.fft = anisotropy_fft(cs, bins);
+  f.tensor = anisotropy_tensor(cs);
+  f.profile = angular_profile(cs, bins);
+  f.has_volume = volume > 0;
+  const double V = f.has_volume ? volume : 1.0;
+  f.stress = contact_stress(raw, V);
+  f.sliding = sliding_share(cs);
+  for (int type : {1, 2}) {
+    const auto sub = of_type(cs, type);
+    if (sub.empty()) continue;
+    (type == 1 ? f.sv : f.ss) = anisotropy_tensor(sub);
+    (type == 1 ? f.sv_stress : f.ss_stress) = contact_stress(of_type(raw, type), V);
+  }
+  // The particles snapshot with the same number, for rattlers and z.
+  const std::string pfile =
+      (fs::path(f.file).parent_path() /
+       ("particles" + fs::path(f.file).filename().string().substr(std::string("contacts").size())))
+          .string();
+  std::error_code ec;
+  if (fs::exists(pfile, ec)) f.connectivity = connectivity(raw, read_particles(pfile));
+  return f;
+}
+
+std::pair<double, double> parse_range(const std::string& s) {
+  const auto colon = s.find(':');
+  auto bad = [&] { return AnalysisError(fmt::format("window '{}' is not of the form a:b with a < b", s)); };
+  if (colon == std::string::npos) throw bad();
+  const std::string a = s.substr(0, colon), b = s.substr(colon + 1);
+  char *ea = nullptr, *eb = nullptr;
+  const double va = std::strtod(a.c_str(), &ea), vb = std::strtod(b.c_str(), &eb);
+  if (a.empty() || b.empty() || *ea || *eb || !(va < vb)) throw bad();
+  return {va, vb};
+}
+
+}  // namespace cda

@@ -1,0 +1,63 @@
+// One run folder as the analysis sees it: series.csv plus snapshots. Joins
+// the reader to the steady-state and fabric measurements, so the command
+// line and the report share one path.
+#pragma once
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "anisotropy.hpp"
+#include "coordination.hpp"
+#include "steady.hpp"
+#include "stress.hpp"
+#include "table.hpp"
+
+namespace cda {
+
+// series.csv of a run folder. Throws AnalysisError naming the folder if it
+// is missing, or the file if it is empty or malformed.
+Table read_series(const std::string& run_dir);
+
+// The abscissa of a run: `strain` when the series has it (shear runs), else
+// `time`.
+std::string default_x_column(const Table& series);
+
+struct RunSteady {
+  std::string run, column, x_column;
+  bool detected = false;  // false: the window was given
+  SteadyStats stats;
+};
+
+// Steady statistics of `column`: over [a, b] of the x column when `range` is
+// given, else over the detected steady window (steady.hpp).
+RunSteady run_steady(const std::string& run_dir, const Table& series, const std::string& column,
+                     const std::string& x_column,
+                     const std::optional<std::pair<double, double>>& range,
+                     const SteadyOptions& opt = {});
+
+// Statistics of `column` over a window already found (e.g. for q_over_p).
+SteadyStats stats_over(const Table& series, const std::string& column, const std::string& x_column,
+                       const Window& w);
+
+// Fabric of one contact snapshot (physical contacts: ss points merged).
+struct RunFabric {
+  std::string file;
+  std::size_t contacts = 0, physical_contacts = 0;
+  Anisotropy fft, tensor;
+  AngularProfile profile;
+  Stress stress;               // with the given volume (1 if none: stress times V)
+  bool has_volume = false;
+  double sliding = 0;
+  std::optional<Connectivity> connectivity;  // when the particles snapshot exists
+  // Per-type partial results (sv, ss), when the set has such contacts.
+  std::optional<Anisotropy> sv, ss;
+  std::optional<Stress> sv_stress, ss_stress;
+};
+
+// snapshot k of contacts_NNNNN.vtp (k < 0 from the end). volume <= 0: none.
+RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume);
+
+// "a:b" -> (a, b); throws AnalysisError on bad syntax or a >= b.
+std::pair<double, double> parse_range(const std::string& s);
+
+}  // namespace cda

@@ -1,0 +1,291 @@
+#include "snapshot.hpp"
+
+#include <fmt/core.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkIdList.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkXMLPolyDataReader.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <regex>
+
+namespace fs = std::filesystem;
+
+namespace cda {
+
+double Contact::nx() const { return std::cos(theta); }
+double Contact::ny() const { return std::sin(theta); }
+double Contact::ln() const { return lx * nx() + ly * ny(); }
+double Contact::lt() const { return -lx * ny() + ly * nx(); }
+
+ContactSet of_type(const ContactSet& cs, int type) {
+  ContactSet out;
+  for (const auto& c : cs)
+    if (c.type == type) out.push_back(c);
+  return out;
+}
+
+ContactSet merge_side_side(const ContactSet& cs) {
+  ContactSet out;
+  std::map<std::pair<int, int>, std::size_t> ss;  // (b1, b2) -> index in out
+  for (const auto& c : cs) {
+    if (c.type != 2) {
+      out.push_back(c);
+      continue;
+    }
+    const auto key = std::make_pair(c.b1, c.b2);
+    const auto it = ss.find(key);
+    if (it == ss.end()) {
+      ss.emplace(key, out.size());
+      out.push_back(c);
+    } else {
+      auto& m = out[it->second];
+      m.fn += c.fn;
+      m.ft += c.ft;
+      m.status = std::max(m.status, c.status);  // sliding if either point slides
+    }
+  }
+  return out;
+}
+
+namespace {
+
+vtkSmartPointer<vtkPolyData> read_polydata(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw AnalysisError(fmt::format("snapshot '{}' does not exist", path));
+  vtkNew<vtkXMLPolyDataReader> reader;
+  if (!reader->CanReadFile(path.c_str()))
+    throw AnalysisError(fmt::format("'{}' is not a VTK XML PolyData file", path));
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (reader->GetErrorCode() != 0)
+    throw AnalysisError(fmt::format("cannot read '{}' (VTK error code {})", path,
+                                    static_cast<int>(reader->GetErrorCode())));
+  vtkSmartPointer<vtkPolyData> pd = reader->GetOutput();
+  return pd;
+}
+
+vtkDataArray* need(vtkDataSetAttributes* attr, const char* name, int comps,
+                   const std::string& path) {
+  vtkDataArray* a = attr->GetArray(name);
+  if (!a) throw AnalysisError(fmt::format("'{}' has no array '{}'", path, name));
+  if (a->GetNumberOfComponents() < comps)
+    throw AnalysisError(fmt::format("'{}': array '{}' has {} components, {} expected", path, name,
+                                    a->GetNumberOfComponents(), comps));
+  return a;
+}
+
+}  // namespace
+
+ContactSet read_contacts(const std::string& path) {
+  auto pd = read_polydata(path);
+  ContactSet cs;
+  const vtkIdType n = pd->GetNumberOfCells();
+  if (n == 0) return cs;
+  auto* cd = pd->GetCellData();
+  auto* fn = need(cd, "fn", 1, path);
+  auto* ft = need(cd, "ft", 1, path);
+  auto* normal = need(cd, "normal", 2, path);
+  auto* status = need(cd, "status", 1, path);
+  auto* type = need(cd, "type", 1, path);
+  auto* b1 = need(cd, "b1", 1, path);
+  auto* b2 = need(cd, "b2", 1, path);
+  vtkDataArray* branch = cd->GetArray("branch");
+  cs.reserve(static_cast<std::size_t>(n));
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType i = 0; i < n; ++i) {
+    Contact c;
+    const double* nv = normal->GetTuple(i);
+    c.theta = std::atan2(nv[1], nv[0]);
+    c.fn = fn->GetTuple1(i);
+    c.ft = ft->GetTuple1(i);
+    c.status = static_cast<int>(status->GetTuple1(i));
+    c.type = static_cast<int>(type->GetTuple1(i));
+    c.b1 = static_cast<int>(b1->GetTuple1(i));
+    c.b2 = static_cast<int>(b2->GetTuple1(i));
+    if (branch) {
+      const double* l = branch->GetTuple(i);
+      c.lx = l[0];
+      c.ly = l[1];
+    } else {
+      pd->GetCellPoints(i, ids);
+      if (ids->GetNumberOfIds() != 2)
+        throw AnalysisError(fmt::format("'{}': contact cell {} is not a line of 2 points", path, i));
+      double p1[3], p2[3];
+      pd->GetPoint(ids->GetId(0), p1);
+      pd->GetPoint(ids->GetId(1), p2);
+      c.lx = p2[0] - p1[0];
+      c.ly = p2[1] - p1[1];
+    }
+    cs.push_back(c);
+  }
+  return cs;
+}
+
+ParticleSet read_particles(const std::string& path) {
+  auto pd = read_polydata(path);
+  ParticleSet ps;
+  const vtkIdType n = pd->GetNumberOfPoints();
+  if (n == 0) return ps;
+  auto* pdat = pd->GetPointData();
+  auto* id = need(pdat, "id", 1, path);
+  auto* radius = need(pdat, "radius", 1, path);
+  vtkDataArray* vel = pdat->GetArray("velocity");
+  vtkDataArray* omega = pdat->GetArray("omega");
+  vtkDataArray* angle = pdat->GetArray("angle");
+  vtkDataArray* mass = pdat->GetArray("mass");
+  for (vtkIdType i = 0; i < n; ++i) {
+    Particle p;
+    double x[3];
+    pd->GetPoint(i, x);
+    p.x = x[0];
+    p.y = x[1];
+    p.id = static_cast<int>(id->GetTuple1(i));
+    p.radius = radius->GetTuple1(i);
+    if (vel) {
+      p.vx = vel->GetComponent(i, 0);
+      p.vy = vel->GetComponent(i, 1);
+    }
+    if (omega) p.omega = omega->GetTuple1(i);
+    if (angle) p.angle = angle->GetTuple1(i);
+    if (mass) p.mass = mass->GetTuple1(i);
+    ps.push_back(p);
+  }
+  return ps;
+}
+
+void write_contacts(const std::string& path, const ContactSet& cs, const ParticleSet& centres,
+                    bool with_branch) {
+  std::map<int, const Particle*> by_id;
+  for (const auto& p : centres) by_id[p.id] = &p;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();  // float32 would cost 1e-7 relative on branch vectors
+  vtkNew<vtkCellArray> lines;
+  auto darr = [](const char* name, int comps) {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name);
+    a->SetNumberOfComponents(comps);
+    return vtkSmartPointer<vtkDoubleArray>(a.GetPointer());
+  };
+  auto iarr = [](const char* name) {
+    vtkNew<vtkIntArray> a;
+    a->SetName(name);
+    return vtkSmartPointer<vtkIntArray>(a.GetPointer());
+  };
+  auto fn = darr("fn", 1), ft = darr("ft", 1), force = darr("force", 3), normal = darr("normal", 3),
+       gap = darr("gap", 1), branch = darr("branch", 3);
+  auto status = iarr("status"), type = iarr("type"), b1 = iarr("b1"), b2 = iarr("b2");
+  for (const auto& c : cs) {
+    double x1 = 0, y1 = 0;
+    if (auto it = by_id.find(c.b1); it != by_id.end()) {
+      x1 = it->second->x;
+      y1 = it->second->y;
+    }
+    const vtkIdType i1 = pts->InsertNextPoint(x1, y1, 0);
+    const vtkIdType i2 = pts->InsertNextPoint(x1 + c.lx, y1 + c.ly, 0);
+    const vtkIdType line[2] = {i1, i2};
+    lines->InsertNextCell(2, line);
+    const double nx = c.nx(), ny = c.ny();
+    fn->InsertNextValue(c.fn);
+    ft->InsertNextValue(c.ft);
+    force->InsertNextTuple3(c.fn * nx - c.ft * ny, c.fn * ny + c.ft * nx, 0);
+    normal->InsertNextTuple3(nx, ny, 0);
+    gap->InsertNextValue(0);
+    branch->InsertNextTuple3(c.lx, c.ly, 0);
+    status->InsertNextValue(c.status);
+    type->InsertNextValue(c.type);
+    b1->InsertNextValue(c.b1);
+    b2->InsertNextValue(c.b2);
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->SetLines(lines);
+  for (auto& a : {fn, ft, force, normal, gap}) pd->GetCellData()->AddArray(a);
+  if (with_branch) pd->GetCellData()->AddArray(branch);
+  for (auto& a : {status, type, b1, b2}) pd->GetCellData()->AddArray(a);
+  vtkNew<vtkXMLPolyDataWriter> w;
+  w->SetFileName(path.c_str());
+  w->SetInputData(pd);
+  w->SetDataModeToAppended();
+  w->EncodeAppendedDataOff();
+  if (w->Write() != 1) throw AnalysisError(fmt::format("cannot write '{}'", path));
+}
+
+void write_particles(const std::string& path, const ParticleSet& ps) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();  // float32 would cost 1e-7 relative on branch vectors
+  vtkNew<vtkIntArray> id;
+  id->SetName("id");
+  vtkNew<vtkDoubleArray> radius, vel, omega, angle, mass;
+  radius->SetName("radius");
+  vel->SetName("velocity");
+  vel->SetNumberOfComponents(3);
+  omega->SetName("omega");
+  angle->SetName("angle");
+  mass->SetName("mass");
+  for (const auto& p : ps) {
+    pts->InsertNextPoint(p.x, p.y, 0);
+    id->InsertNextValue(p.id);
+    radius->InsertNextValue(p.radius);
+    vel->InsertNextTuple3(p.vx, p.vy, 0);
+    omega->InsertNextValue(p.omega);
+    angle->InsertNextValue(p.angle);
+    mass->InsertNextValue(p.mass);
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->GetPointData()->AddArray(id);
+  for (vtkDataArray* a : {static_cast<vtkDataArray*>(radius), static_cast<vtkDataArray*>(vel),
+                          static_cast<vtkDataArray*>(omega), static_cast<vtkDataArray*>(angle),
+                          static_cast<vtkDataArray*>(mass)})
+    pd->GetPointData()->AddArray(a);
+  vtkNew<vtkXMLPolyDataWriter> w;
+  w->SetFileName(path.c_str());
+  w->SetInputData(pd);
+  w->SetDataModeToAppended();
+  w->EncodeAppendedDataOff();
+  if (w->Write() != 1) throw AnalysisError(fmt::format("cannot write '{}'", path));
+}
+
+std::vector<std::string> list_snapshots(const std::string& run_dir, const std::string& prefix) {
+  std::error_code ec;
+  if (!fs::is_directory(run_dir, ec))
+    throw AnalysisError(fmt::format("run folder '{}' does not exist", run_dir));
+  const std::regex re(prefix + R"(_(\d+)\.vtp)");
+  std::vector<std::pair<long, std::string>> found;
+  for (const auto& e : fs::directory_iterator(run_dir)) {
+    std::smatch m;
+    const std::string name = e.path().filename().string();
+    if (std::regex_match(name, m, re)) found.emplace_back(std::stol(m[1].str()), e.path().string());
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> out;
+  for (auto& f : found) out.push_back(f.second);
+  return out;
+}
+
+std::string snapshot_path(const std::string& run_dir, const std::string& prefix, int k) {
+  const auto all = list_snapshots(run_dir, prefix);
+  if (all.empty())
+    throw AnalysisError(fmt::format("run folder '{}' has no {}_NNNNN.vtp snapshot", run_dir, prefix));
+  const long n = static_cast<long>(all.size());
+  const long i = k < 0 ? n + k : k;
+  if (i < 0 || i >= n)
+    throw AnalysisError(fmt::format("run folder '{}' has {} {} snapshots; snapshot {} does not exist",
+                                    run_dir, n, prefix, k));
+  return all[static_cast<std::size_t>(i)];
+}
+
+}  // namespace cda

@@ -1,0 +1,71 @@
+// Contact and particle snapshots as plain data, read from the simulator's
+// contacts_NNNNN.vtp / particles_NNNNN.vtp (format in cd/src/output.hpp).
+//
+// Frame convention (method.md §1): n points from body 1 to body 2 and
+// t = n rotated by +90 degrees; f = fn n + ft t is the force exerted by body 1
+// on body 2 (fn > 0 repulsive); the branch vector l points from the centre of
+// body 1 to the centre of body 2 (periodic image included).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "error.hpp"
+
+namespace cda {
+
+struct Contact {
+  double theta = 0;       // angle of n, in (-pi, pi]
+  double lx = 0, ly = 0;  // branch vector, body 1 -> body 2
+  double fn = 0, ft = 0;  // force components in (n, t)
+  int status = 0;         // 0 open, 1 stick, 2 slide
+  int type = 0;           // 0 disk, 1 side-vertex, 2 side-side
+  int b1 = 0, b2 = 0;     // body ids
+
+  double nx() const;
+  double ny() const;
+  double ln() const;  // l.n
+  double lt() const;  // l.t
+};
+
+using ContactSet = std::vector<Contact>;
+
+struct Particle {
+  int id = 0;
+  double x = 0, y = 0;
+  double radius = 0;
+  double vx = 0, vy = 0, omega = 0, angle = 0, mass = 0;
+};
+
+using ParticleSet = std::vector<Particle>;
+
+// Contacts of one type (0 disk, 1 sv, 2 ss).
+ContactSet of_type(const ContactSet& cs, int type);
+
+// The points of a side-side contact (same bodies, type 2) merged into one
+// physical contact: forces summed (method.md §7), normal and branch of the
+// first point. Other contacts are copied as they are. Fabric statistics use
+// physical contacts; stress may use either (the sum is the same).
+ContactSet merge_side_side(const ContactSet& cs);
+
+// Readers. Throw AnalysisError naming the file when it is missing, unreadable,
+// or lacks a required array. The branch vector comes from the cell array
+// `branch` when present (periodic runs), else from the line's two points.
+ContactSet read_contacts(const std::string& vtp_path);
+ParticleSet read_particles(const std::string& vtp_path);
+
+// Writers of the same format, for synthetic fixtures (tests, examples).
+// Contact lines start at the centre of body b1 (from `centres`, the origin
+// if absent) and end at that centre plus the branch vector; with_branch
+// also writes the `branch` cell array of periodic runs.
+void write_contacts(const std::string& vtp_path, const ContactSet& cs,
+                    const ParticleSet& centres, bool with_branch = true);
+void write_particles(const std::string& vtp_path, const ParticleSet& ps);
+
+// Snapshot files of a run folder, sorted by their number:
+// prefix "contacts" lists contacts_NNNNN.vtp. Throws if the folder is missing.
+std::vector<std::string> list_snapshots(const std::string& run_dir, const std::string& prefix);
+// The k-th snapshot (k < 0 counts from the end: -1 is the last). Throws with
+// the folder name when there is none or k is out of range.
+std::string snapshot_path(const std::string& run_dir, const std::string& prefix, int k);
+
+}  // namespace cda

@@ -1,0 +1,121 @@
+#include "table.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace cda {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return {};
+  const auto e = s.find_last_not_of(" \t\r\n");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, ',')) out.push_back(trim(field));
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+}  // namespace
+
+Table::Table(std::vector<std::string> names) : names_(std::move(names)), cols_(names_.size()) {}
+
+Table Table::read_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw AnalysisError(fmt::format("cannot open '{}'", path));
+  Table t;
+  t.source_ = path;
+  std::string line;
+  std::size_t lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (!trim(line).empty()) break;
+  }
+  if (trim(line).empty()) throw AnalysisError(fmt::format("'{}' is empty (no header row)", path));
+  t.names_ = split(line);
+  for (const auto& n : t.names_)
+    if (n.empty()) throw AnalysisError(fmt::format("'{}': empty column name in the header", path));
+  t.cols_.assign(t.names_.size(), {});
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (trim(line).empty()) continue;
+    const auto fields = split(line);
+    if (fields.size() != t.names_.size())
+      throw AnalysisError(fmt::format("'{}' line {}: {} fields, the header has {}", path, lineno,
+                                      fields.size(), t.names_.size()));
+    for (std::size_t j = 0; j < fields.size(); ++j) {
+      const char* s = fields[j].c_str();
+      char* end = nullptr;
+      errno = 0;
+      const double v = std::strtod(s, &end);
+      if (fields[j].empty() || *end != '\0')
+        throw AnalysisError(fmt::format("'{}' line {}, column '{}': '{}' is not a number", path,
+                                        lineno, t.names_[j], fields[j]));
+      t.cols_[j].push_back(v);
+    }
+  }
+  if (t.rows() == 0) throw AnalysisError(fmt::format("'{}' has a header but no data rows", path));
+  return t;
+}
+
+bool Table::has(const std::string& name) const {
+  return std::find(names_.begin(), names_.end(), name) != names_.end();
+}
+
+const std::vector<double>& Table::column(const std::string& name) const {
+  const auto it = std::find(names_.begin(), names_.end(), name);
+  if (it == names_.end()) {
+    std::string list;
+    for (const auto& n : names_) list += (list.empty() ? "" : ",") + n;
+    throw AnalysisError(
+        fmt::format("'{}' has no column '{}' (columns: {})", source_, name, list));
+  }
+  return cols_[static_cast<std::size_t>(it - names_.begin())];
+}
+
+void Table::add_row(const std::vector<double>& values) {
+  if (values.size() != names_.size())
+    throw AnalysisError(fmt::format("table row of {} values for {} columns", values.size(),
+                                    names_.size()));
+  for (std::size_t j = 0; j < values.size(); ++j) cols_[j].push_back(values[j]);
+}
+
+void Table::add_column(const std::string& name, std::vector<double> values) {
+  if (!cols_.empty() && values.size() != rows())
+    throw AnalysisError(fmt::format("column '{}' has {} rows, the table {}", name, values.size(),
+                                    rows()));
+  names_.push_back(name);
+  cols_.push_back(std::move(values));
+}
+
+std::string Table::to_csv() const {
+  std::string s;
+  for (std::size_t j = 0; j < names_.size(); ++j) s += (j ? "," : "") + names_[j];
+  s += '\n';
+  for (std::size_t i = 0; i < rows(); ++i) {
+    for (std::size_t j = 0; j < names_.size(); ++j)
+      s += fmt::format("{}{:.17g}", j ? "," : "", cols_[j][i]);
+    s += '\n';
+  }
+  return s;
+}
+
+void Table::write_csv(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) throw AnalysisError(fmt::format("cannot write '{}'", path));
+  out << to_csv();
+  if (!out) throw AnalysisError(fmt::format("error while writing '{}'", path));
+}
+
+}  // namespace cda

@@ -1,0 +1,42 @@
+// A table of doubles with named columns: the reader for series.csv and the
+// writer for the analysis tables. Columns are looked up by name, so a reader
+// never depends on the simulator's column order.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "error.hpp"
+
+namespace cda {
+
+class Table {
+ public:
+  Table() = default;
+  explicit Table(std::vector<std::string> names);
+
+  // Reads a CSV file whose first row names the columns. Every later row must
+  // have as many fields, each a number (strtod syntax, so nan/inf are taken).
+  // Throws AnalysisError naming the file for: missing file, no header, no
+  // data row, a short/long row, a non-numeric field (with line and column).
+  static Table read_csv(const std::string& path);
+
+  bool has(const std::string& name) const;
+  // Throws AnalysisError naming the column and the file it was read from.
+  const std::vector<double>& column(const std::string& name) const;
+  const std::vector<std::string>& names() const { return names_; }
+  std::size_t rows() const { return cols_.empty() ? 0 : cols_.front().size(); }
+  const std::string& source() const { return source_; }
+
+  void add_row(const std::vector<double>& values);
+  void add_column(const std::string& name, std::vector<double> values);
+  // Full precision (%.17g), so a round trip is exact.
+  std::string to_csv() const;
+  void write_csv(const std::string& path) const;
+
+ private:
+  std::vector<std::string> names_;
+  std::vector<std::vector<double>> cols_;
+  std::string source_ = "<memory>";
+};
+
+}  // namespace cda

@@ -1,0 +1,240 @@
+// Reading runs (series.csv, contact and particle snapshots), the run-level
+// measurements, and the messages for bad input, through the library and
+// through the cdanalysis command when it is built.
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <random>
+
+#include "analysis/src/report.hpp"
+#include "analysis/src/run.hpp"
+#include "analysis/src/snapshot.hpp"
+
+namespace fs = std::filesystem;
+using namespace cda;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path p = fs::path(CDLAB_BINARY_DIR) / "test_analysis_io" / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+std::string message(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const AnalysisError& e) {
+    return e.what();
+  }
+  return "<no AnalysisError>";
+}
+
+// A steady shear-like run: q_over_p = 0.3 + AR(1) noise, I = 0.01 + noise,
+// after a transient; a square lattice of 16 particles with contacts along x
+// (fn = 2) and y (fn = 1), written without the branch array.
+void make_run(const fs::path& dir, double mu, double I, unsigned seed) {
+  fs::create_directories(dir);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> G(0, 1);
+  std::string csv = "step,time,contacts,strain,q_over_p,inertial_number\n";
+  double e = 0;
+  for (int i = 0; i < 600; ++i) {
+    e = 0.7 * e + 0.01 * G(rng);
+    const double strain = 0.01 * i;
+    csv += fmt::format("{},{},{},{},{},{}\n", i, 0.1 * i, 24, strain,
+                       mu + 0.3 * std::exp(-strain / 0.3) + e, I * (1 + 0.05 * G(rng)));
+  }
+  write(dir / "series.csv", csv);
+  ParticleSet ps;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      Particle p;
+      p.id = 4 * j + i;
+      p.x = i;
+      p.y = j;
+      p.radius = 0.5;
+      ps.push_back(p);
+    }
+  ContactSet cs;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      Contact c;
+      c.status = 1;
+      if (i < 3) {
+        c.b1 = 4 * j + i, c.b2 = c.b1 + 1, c.theta = 0, c.lx = 1, c.ly = 0, c.fn = 2;
+        cs.push_back(c);
+      }
+      if (j < 3) {
+        c.b1 = 4 * j + i, c.b2 = c.b1 + 4, c.theta = std::numbers::pi / 2, c.lx = 0, c.ly = 1, c.fn = 1;
+        cs.push_back(c);
+      }
+    }
+  write_particles((dir / "particles_00000.vtp").string(), ps);
+  write_contacts((dir / "contacts_00000.vtp").string(), cs, ps, false);
+}
+
+}  // namespace
+
+TEST(AnalysisIo, SeriesCsvAndItsErrors) {
+  const auto d = scratch("csv");
+  write(d / "ok.csv", "step, time ,q\n0,0.0,1e-3\n1,0.5,nan\n\n");
+  const auto t = Table::read_csv((d / "ok.csv").string());
+  EXPECT_EQ(t.rows(), 2u);
+  EXPECT_DOUBLE_EQ(t.column("time")[1], 0.5);
+  EXPECT_TRUE(std::isnan(t.column("q")[1]));
+  EXPECT_NE(message([&] { t.column("p"); }).find("has no column 'p' (columns: step,time,q)"), std::string::npos);
+  EXPECT_NE(message([&] { Table::read_csv((d / "none.csv").string()); }).find("cannot open"), std::string::npos);
+  write(d / "empty.csv", "");
+  EXPECT_NE(message([&] { Table::read_csv((d / "empty.csv").string()); }).find("empty.csv' is empty"), std::string::npos);
+  write(d / "header.csv", "a,b\n");
+  EXPECT_NE(message([&] { Table::read_csv((d / "header.csv").string()); }).find("no data rows"), std::string::npos);
+  write(d / "short.csv", "a,b\n1,2\n3\n");
+  EXPECT_NE(message([&] { Table::read_csv((d / "short.csv").string()); }).find("line 3: 1 fields"), std::string::npos);
+  write(d / "text.csv", "a,b\n1,x\n");
+  EXPECT_NE(message([&] { Table::read_csv((d / "text.csv").string()); }).find("column 'b': 'x' is not a number"),
+            std::string::npos);
+  // Round trip at full precision.
+  Table w({"x"});
+  w.add_row({0.1 + 0.2});
+  w.write_csv((d / "rt.csv").string());
+  EXPECT_EQ(Table::read_csv((d / "rt.csv").string()).column("x")[0], 0.1 + 0.2);
+}
+
+TEST(AnalysisIo, ContactSnapshotRoundTripWithAndWithoutBranch) {
+  const auto d = scratch("vtp");
+  ParticleSet ps(2);
+  ps[0].id = 7, ps[0].x = 1, ps[0].y = 2, ps[0].radius = 0.5;
+  ps[1].id = 9, ps[1].x = 1.6, ps[1].y = 2.8, ps[1].radius = 0.5;
+  Contact c;
+  c.b1 = 7, c.b2 = 9, c.theta = std::atan2(0.8, 0.6), c.lx = 0.6, c.ly = 0.8, c.fn = 3, c.ft = -0.5;
+  c.status = 2, c.type = 1;
+  Contact periodic = c;
+  periodic.lx = -9.4;  // image across a periodic boundary: not centre to centre
+  for (bool with_branch : {true, false}) {
+    const auto f = (d / (with_branch ? "b.vtp" : "nb.vtp")).string();
+    write_contacts(f, {c, periodic}, ps, with_branch);
+    const auto r = read_contacts(f);
+    ASSERT_EQ(r.size(), 2u);
+    EXPECT_NEAR(r[0].theta, c.theta, 1e-15);
+    EXPECT_NEAR(r[0].lx, 0.6, 1e-12);
+    EXPECT_NEAR(r[0].ly, 0.8, 1e-12);
+    EXPECT_EQ(r[0].fn, 3);
+    EXPECT_EQ(r[0].ft, -0.5);
+    EXPECT_EQ(r[0].status, 2);
+    EXPECT_EQ(r[0].type, 1);
+    EXPECT_EQ(r[0].b1, 7);
+    EXPECT_EQ(r[0].b2, 9);
+    EXPECT_NEAR(r[1].lx, -9.4, 1e-12);  // from the branch array, or from the line's points
+  }
+  write_particles((d / "p.vtp").string(), ps);
+  const auto rp = read_particles((d / "p.vtp").string());
+  ASSERT_EQ(rp.size(), 2u);
+  EXPECT_EQ(rp[1].id, 9);
+  EXPECT_DOUBLE_EQ(rp[1].y, 2.8);
+  EXPECT_NE(message([&] { read_contacts((d / "missing.vtp").string()); }).find("missing.vtp' does not exist"),
+            std::string::npos);
+  write(d / "junk.vtp", "not xml");
+  EXPECT_NE(message([&] { read_contacts((d / "junk.vtp").string()); }).find("junk.vtp"), std::string::npos);
+  // A particles file read as contacts lacks the contact arrays.
+  write_contacts((d / "c.vtp").string(), {c}, ps);
+  EXPECT_NE(message([&] { read_particles((d / "c.vtp").string()); }).find("has no array 'id'"), std::string::npos);
+}
+
+TEST(AnalysisIo, RunFolderSteadyAndFabric) {
+  const auto d = scratch("campaign");
+  make_run(d / "a", 0.3, 0.01, 1);
+  const auto series = read_series((d / "a").string());
+  EXPECT_EQ(default_x_column(series), "strain");
+  const auto r = run_steady((d / "a").string(), series, "q_over_p", "strain", std::nullopt);
+  EXPECT_TRUE(r.detected);
+  EXPECT_NEAR(r.stats.mean, 0.3, 4 * r.stats.error() + 0.002);
+  const auto given = run_steady((d / "a").string(), series, "q_over_p", "strain", parse_range("3:5"));
+  EXPECT_EQ(given.stats.window.end - given.stats.window.begin, 201u);
+  // Lattice: 12 x-contacts (fn 2, l 1) and 12 y-contacts (fn 1): sigma V =
+  // diag(24, 12); with V = 12: p = 1.5, q = 0.5; a_c = 0 (as many x as y).
+  const auto f = run_fabric((d / "a").string(), -1, 36, 12.0);
+  EXPECT_NEAR(f.stress.p(), 1.5, 1e-12);
+  EXPECT_NEAR(f.stress.q(), 0.5, 1e-12);
+  EXPECT_NEAR(f.tensor.c.a(), 0.0, 1e-12);
+  // Tensor: 2(24 - 12)/36 = 2/3 (see the lattice limit in anisotropy.hpp);
+  // the binned profile holds the exact bin means at 0 and 90 degrees.
+  EXPECT_NEAR(f.tensor.fn.a(), 2.0 / 3.0, 1e-12);
+  EXPECT_DOUBLE_EQ(f.profile.fn[0], 2.0);
+  EXPECT_DOUBLE_EQ(f.profile.fn[18], 1.0);
+  EXPECT_EQ(f.profile.empty_bins, 34u);
+  ASSERT_TRUE(f.connectivity.has_value());
+  // Corner particles have 2 contacts, edges 3, inner 4: z = (4*2 + 8*3 + 4*4)/16 = 3.
+  EXPECT_DOUBLE_EQ(f.connectivity->z, 3.0);
+  EXPECT_EQ(f.connectivity->rattlers, 0u);
+  EXPECT_NE(message([&] { run_fabric((d / "a").string(), 3, 36, 1); }).find("has 1 contacts snapshots; snapshot 3"),
+            std::string::npos);
+  EXPECT_NE(message([&] { read_series((d / "nope").string()); }).find("run folder"), std::string::npos);
+  EXPECT_NE(message([&] { parse_range("5:3"); }).find("a < b"), std::string::npos);
+  fs::create_directories(d / "empty_run");
+  EXPECT_NE(message([&] { read_series((d / "empty_run").string()); }).find("has no series.csv"), std::string::npos);
+}
+
+TEST(AnalysisIo, ReportOfACampaign) {
+  const auto d = scratch("report");
+  const double I[] = {1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3};
+  for (int k = 0; k < 6; ++k)
+    make_run(d / fmt::format("r{}", k), 0.28 + 0.34 / (1 + 0.05 / I[k]), I[k], 10 + k);
+  const auto s = write_report(d.string(), (d / "out").string());
+  EXPECT_EQ(s.runs, 6u);
+  EXPECT_EQ(s.steady, 6u);
+  EXPECT_EQ(s.fabric, 6u);
+  for (const char* f : {"index.html", "steady.csv", "fabric.csv", "runs.csv", "fits.toml"})
+    EXPECT_TRUE(fs::exists(d / "out" / f)) << f;
+  const auto t = Table::read_csv((d / "out" / "steady.csv").string());
+  EXPECT_EQ(t.rows(), 6u);
+  std::ifstream toml(d / "out" / "fits.toml");
+  const std::string text((std::istreambuf_iterator<char>(toml)), {});
+  EXPECT_NE(text.find("[mu_I.params.mu1]"), std::string::npos);
+  if (std::system("gnuplot --version > /dev/null 2>&1") == 0) {
+    EXPECT_TRUE(s.plots_ok);
+    EXPECT_TRUE(fs::exists(d / "out" / "mu_I.png"));
+    EXPECT_TRUE(fs::exists(d / "out" / "mu_I.svg"));
+    EXPECT_TRUE(fs::exists(d / "out" / "run000_polar_P.png"));
+  }
+  EXPECT_NE(message([&] { campaign_runs((d / "out").string()); }).find("holds no run"), std::string::npos);
+}
+
+TEST(AnalysisIo, CommandLineExitsNonZeroNamingTheFile) {
+  const fs::path exe = fs::path(CDLAB_BINARY_DIR) / "analysis" / "cdanalysis";
+  if (!fs::exists(exe)) GTEST_SKIP() << "cdanalysis not built";
+  const auto d = scratch("cli");
+  make_run(d / "a", 0.3, 0.01, 3);
+  const auto err = d / "err.txt";
+  auto run = [&](const std::string& args) {
+    const int rc = std::system(fmt::format("{} {} > /dev/null 2> {}", exe.string(), args, err.string()).c_str());
+    std::ifstream in(err);
+    return std::make_pair(rc, std::string((std::istreambuf_iterator<char>(in)), {}));
+  };
+  auto [rc, msg] = run(fmt::format("steady {}", (d / "missing").string()));
+  EXPECT_NE(rc, 0);
+  EXPECT_NE(msg.find("missing' does not exist"), std::string::npos) << msg;
+  std::tie(rc, msg) = run(fmt::format("steady {} --column pressure", (d / "a").string()));
+  EXPECT_NE(rc, 0);
+  EXPECT_NE(msg.find("has no column 'pressure'"), std::string::npos) << msg;
+  std::tie(rc, msg) = run(fmt::format("steady {} --window 1:1.05", (d / "a").string()));
+  EXPECT_NE(rc, 0);
+  EXPECT_NE(msg.find("at least 16"), std::string::npos) << msg;
+  std::tie(rc, msg) = run(fmt::format("fabric {} --snapshot 4", (d / "a").string()));
+  EXPECT_NE(rc, 0);
+  EXPECT_NE(msg.find("snapshot 4 does not exist"), std::string::npos) << msg;
+  std::tie(rc, msg) = run(fmt::format("steady {}", (d / "a").string()));
+  EXPECT_EQ(rc, 0) << msg;
+  std::tie(rc, msg) = run(fmt::format("fabric {} --volume 12", (d / "a").string()));
+  EXPECT_EQ(rc, 0) << msg;
+}
