@@ -89,9 +89,9 @@ void World::build() {
   }
   // Warm start from the previous step's impulses, matched by contact key.
   for (std::size_t k = 0; k < nr; ++k) {
-    const auto it = std::lower_bound(prev_keys_.begin(), prev_keys_.end(), info_[k].key);
-    if (it != prev_keys_.end() && *it == info_[k].key) {
-      const auto& p = prev_p_[it - prev_keys_.begin()];
+    const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
+    if (it != warm_.keys.end() && *it == info_[k].key) {
+      const auto& p = warm_.p[it - warm_.keys.begin()];
       rows_[k].pn = p.first;
       rows_[k].pt = p.second;
     }
@@ -130,11 +130,11 @@ void World::solve() {
   std::iota(idx.begin(), idx.end(), 0);
   std::sort(idx.begin(), idx.end(),
             [&](std::size_t a, std::size_t b) { return info_[a].key < info_[b].key; });
-  prev_keys_.resize(nr);
-  prev_p_.resize(nr);
+  warm_.keys.resize(nr);
+  warm_.p.resize(nr);
   for (std::size_t k = 0; k < nr; ++k) {
-    prev_keys_[k] = info_[idx[k]].key;
-    prev_p_[k] = {rows_[idx[k]].pn, rows_[idx[k]].pt};
+    warm_.keys[k] = info_[idx[k]].key;
+    warm_.p[k] = {rows_[idx[k]].pn, rows_[idx[k]].pt};
   }
 
   // Step quality: contacts, overlaps.

@@ -67,6 +67,15 @@ class World {
   // Status of a solved row: open, stick or slide.
   ContactStatus status(std::size_t k) const;
 
+  // Warm-start memory: the previous step's impulses by contact key (sorted).
+  // Part of the state a bit-identical restart must restore.
+  struct WarmStart {
+    std::vector<std::uint64_t> keys;
+    std::vector<std::pair<double, double>> p;
+  };
+  const WarmStart& warm_start() const { return warm_; }
+  void set_warm_start(WarmStart w) { warm_ = std::move(w); }
+
  private:
   void configure();
   void predict();
@@ -86,9 +95,7 @@ class World {
   std::vector<ContactInfo> info_;
   CellGrid grid_;
   Colouring col_;
-  // warm start: impulses of the previous step, sorted by contact key
-  std::vector<std::uint64_t> prev_keys_;
-  std::vector<std::pair<double, double>> prev_p_;
+  WarmStart warm_;
 };
 
 }  // namespace cd
