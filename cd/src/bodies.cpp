@@ -13,6 +13,26 @@ int Bodies::add_disk(Vec2 x, double r, double density, Vec2 v, double omega) {
   angle.push_back(0.0);
   shape.push_back(Shape::Disk);
   radius.push_back(r);
+  nsides.push_back(0);
+  mass.push_back(m);
+  inertia.push_back(I);
+  driven.push_back(0);
+  return static_cast<int>(pos.size()) - 1;
+}
+
+int Bodies::add_polygon(Vec2 x, double R, int n, double ang, double density, Vec2 v,
+                        double omega) {
+  // Area (n/2) R^2 sin(2 pi/n); polar moment per unit mass (R^2/6)(2 + cos(2 pi/n)),
+  // which gives s^2/6 for the square, s^2/12 for the triangle, R^2/2 as n -> inf.
+  const double a = 2.0 * std::numbers::pi / n;
+  const double m = density * 0.5 * n * R * R * std::sin(a);
+  const double I = m * R * R * (2.0 + std::cos(a)) / 6.0;
+  vel.push_back({v.x(), v.y(), omega, 1.0 / m, 1.0 / I});
+  pos.push_back(x);
+  angle.push_back(ang);
+  shape.push_back(Shape::Polygon);
+  radius.push_back(R);
+  nsides.push_back(n);
   mass.push_back(m);
   inertia.push_back(I);
   driven.push_back(0);
@@ -27,6 +47,7 @@ int Bodies::add_wall(Vec2 a, Vec2 b, Vec2 v, double omega) {
   angle.push_back(std::atan2(d.y(), d.x()));
   shape.push_back(Shape::Segment);
   radius.push_back(0.5 * d.norm());
+  nsides.push_back(0);
   mass.push_back(0.0);
   inertia.push_back(0.0);
   driven.push_back(1);

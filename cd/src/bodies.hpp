@@ -11,7 +11,7 @@ namespace cd {
 
 using Vec2 = Eigen::Vector2d;
 
-enum class Shape : std::uint8_t { Disk, Segment };
+enum class Shape : std::uint8_t { Disk, Segment, Polygon };
 
 // What the NLGS sweep reads and writes per body. A wall or any body with
 // imposed velocity has inv_m = inv_I = 0 and is never written by the solver.
@@ -28,7 +28,8 @@ struct Bodies {
   std::vector<double> angle;
   // cold
   std::vector<Shape> shape;
-  std::vector<double> radius;   // disk radius; segment half length
+  std::vector<double> radius;   // disk radius; polygon circumradius; segment half length
+  std::vector<std::int32_t> nsides;  // polygon sides (3..60); 0 for disks and segments
   std::vector<double> mass, inertia;
   std::vector<std::uint8_t> driven;  // 1: imposed velocity (walls)
 
@@ -37,6 +38,10 @@ struct Bodies {
 
   // Adds a disk of the given areal density; returns its index.
   int add_disk(Vec2 x, double r, double density, Vec2 v = Vec2::Zero(), double omega = 0.0);
+  // Adds a regular polygon of n sides, circumradius R, orientation angle
+  // (vertex 0 at angle `angle`), with exact mass and moment of inertia.
+  int add_polygon(Vec2 x, double R, int n, double angle, double density, Vec2 v = Vec2::Zero(),
+                  double omega = 0.0);
   // Adds a segment wall from a to b moving with imposed (v, omega).
   int add_wall(Vec2 a, Vec2 b, Vec2 v = Vec2::Zero(), double omega = 0.0);
 

@@ -7,6 +7,7 @@
 
 #include "bodies.hpp"
 #include "contact.hpp"
+#include "polygon.hpp"
 
 namespace cd {
 
@@ -27,6 +28,23 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
 // the gap exceeds alert.
 bool disk_disk(int i, int j, const Vec2& xi, const Vec2& xj, double ri, double rj, double alert,
                ContactRow& row, ContactInfo& info);
+
+// Narrow phase of two polygons (method.md section 7): separating axis over
+// the faces of both, the face of largest separation is the reference (body 1,
+// frame from it); the most opposed face of the other polygon is clipped to it,
+// giving at most two points: side-side (two points, both typed SideSide) when
+// the faces are parallel to within 2 % of the face length, else side-vertex.
+// Appends 0 to 2 contacts.
+int polygon_polygon(int i, int j, const PolyView& A, const PolyView& B, double alert,
+                    std::vector<ContactRow>& rows, std::vector<ContactInfo>& info);
+
+// Polygon p (body 1) and disk k (body 2): one side-vertex point.
+bool polygon_disk(int p, int k, const PolyView& P, const Vec2& xk, double rk, double alert,
+                  ContactRow& row, ContactInfo& info);
+
+// Segment wall w (body 1, reference face) and polygon p: 0 to 2 points.
+int segment_polygon(int w, int p, const Vec2& wa, const Vec2& wb, const Vec2& wc, const PolyView& P,
+                    double alert, std::vector<ContactRow>& rows, std::vector<ContactInfo>& info);
 
 // Narrow phase of a segment wall w (body 1) and a disk k (body 2).
 bool segment_disk(int w, int k, const Vec2& wa, const Vec2& wb, const Vec2& wc, const Vec2& xk,
