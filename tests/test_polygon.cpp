@@ -286,3 +286,46 @@ TEST(PolygonHardCases, SquaresWithDisksTenTimesSmaller) {
   fill_polygons(w, 48, 4, 8, 0.45, 0.55, 13, 4, 0.05);
   expect_hard_case("squares with small disks", w, 1200, 5e-2);
 }
+
+#include <vtkCellArray.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <filesystem>
+
+#include "output.hpp"
+
+TEST(PolygonOutput, ShapesCarryTrueOutlines) {
+  // A hexagon and a disk: the shapes file has one cell each, the hexagon's
+  // six points at its vertices (read back through VTK's XML reader).
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("cd_shapes_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  cd::World w(params(1e-3, 9.81, 0.4));
+  const int h = w.bodies.add_polygon({0.0, 2.0}, 0.5, 6, 0.3, 1.0);
+  w.bodies.add_disk({3.0, 2.0}, 0.5, 1.0);
+  cd::Snapshots snaps(dir.string());
+  snaps.write(w);
+  auto r = vtkSmartPointer<vtkXMLPolyDataReader>::New();
+  r->SetFileName((dir / "shapes_00000.vtp").string().c_str());
+  r->Update();
+  vtkPolyData* pd = r->GetOutput();
+  ASSERT_EQ(pd->GetNumberOfPolys(), 2);
+  vtkNew<vtkIdList> ids;
+  pd->GetPolys()->InitTraversal();
+  ASSERT_TRUE(pd->GetPolys()->GetNextCell(ids));
+  ASSERT_EQ(ids->GetNumberOfIds(), 6);
+  for (int k = 0; k < 6; ++k) {
+    double p[3];
+    pd->GetPoint(ids->GetId(k), p);
+    const double a = 0.3 + k * kPi / 3;
+    EXPECT_NEAR(p[0], w.bodies.pos[h].x() + 0.5 * std::cos(a), 1e-12);
+    EXPECT_NEAR(p[1], w.bodies.pos[h].y() + 0.5 * std::sin(a), 1e-12);
+  }
+  ASSERT_TRUE(pd->GetPolys()->GetNextCell(ids));
+  EXPECT_EQ(ids->GetNumberOfIds(), 36);  // the disk
+  EXPECT_TRUE(fs::exists(dir / "shapes.pvd"));
+  fs::remove_all(dir);
+}

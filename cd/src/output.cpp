@@ -1,5 +1,7 @@
 #include "output.hpp"
 
+#include "polygon.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
@@ -175,6 +177,7 @@ vtkSmartPointer<vtkPolyData> particles(const World& w) {
   auto omega = make_array<vtkDoubleArray>("omega", 1, n);
   auto angle = make_array<vtkDoubleArray>("angle", 1, n);
   auto mass = make_array<vtkDoubleArray>("mass", 1, n);
+  auto nsides = make_array<vtkIntArray>("nsides", 1, n);
   vtkIdType k = 0;
   for (std::size_t i = 0; i < b.size(); ++i) {
     if (!b.is_dynamic(i)) continue;
@@ -186,12 +189,52 @@ vtkSmartPointer<vtkPolyData> particles(const World& w) {
     omega->SetValue(k, b.vel[i].w);
     angle->SetValue(k, b.angle[i]);
     mass->SetValue(k, b.mass[i]);
+    nsides->SetValue(k, b.nsides[i]);
     ++k;
   }
   auto pd = vtkSmartPointer<vtkPolyData>::New();
   pd->SetPoints(pts);
   pd->SetVerts(verts);
-  add_arrays(pd->GetPointData(), id, radius, vel, omega, angle, mass);
+  add_arrays(pd->GetPointData(), id, radius, vel, omega, angle, mass, nsides);
+  return pd;
+}
+
+// True outlines: one polygon cell per particle (a regular polygon's own
+// vertices; a disk drawn as a 36-gon), so ParaView shows hexagons as
+// hexagons, turned by their angle, with no glyph set-up.
+vtkSmartPointer<vtkPolyData> shapes(const World& w) {
+  constexpr int kDiskSides = 36;
+  const Bodies& b = w.bodies;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> polys;
+  vtkNew<vtkIntArray> id, nsides;
+  vtkNew<vtkDoubleArray> vel, omega;
+  id->SetName("id");
+  nsides->SetName("nsides");
+  vel->SetName("velocity");
+  vel->SetNumberOfComponents(3);
+  omega->SetName("omega");
+  std::vector<vtkIdType> cell;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (!b.is_dynamic(i)) continue;
+    const int n = b.nsides[i] > 0 ? b.nsides[i] : kDiskSides;
+    const PolyView P{b.pos[i], b.radius[i], b.angle[i], n};
+    cell.resize(n);
+    for (int k = 0; k < n; ++k) {
+      const Vec2 v = P.vertex(k);
+      cell[k] = pts->InsertNextPoint(v.x(), v.y(), 0.0);
+    }
+    polys->InsertNextCell(n, cell.data());
+    id->InsertNextValue(static_cast<int>(i));
+    nsides->InsertNextValue(b.nsides[i]);
+    vel->InsertNextTuple3(b.vel[i].vx, b.vel[i].vy, 0.0);
+    omega->InsertNextValue(b.vel[i].w);
+  }
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  pd->SetPoints(pts);
+  pd->SetPolys(polys);
+  add_arrays(pd->GetCellData(), id, nsides, vel, omega);
   return pd;
 }
 
@@ -291,10 +334,11 @@ void Snapshots::write(const World& w) {
   write_vtp(particles(w), (d / ("particles_" + num + ".vtp")).string());
   write_vtp(contacts(w), (d / ("contacts_" + num + ".vtp")).string());
   write_vtp(walls(w), (d / ("walls_" + num + ".vtp")).string());
-  // The collections are rewritten only once all three files of the frame are
-  // in place, so they never list a missing file.
+  write_vtp(shapes(w), (d / ("shapes_" + num + ".vtp")).string());
+  // The collections are rewritten only once all files of the frame are in
+  // place, so they never list a missing file.
   frames_.emplace_back(w.time, num);
-  for (const char* stem : {"particles", "contacts", "walls"})
+  for (const char* stem : {"particles", "contacts", "walls", "shapes"})
     write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd(frames_, stem));
   ++n_;
 }

@@ -26,6 +26,10 @@ void write_file_atomic(const std::string& path, const std::string& text);
 class Series {
  public:
   explicit Series(const std::string& path);
+  // Continues a file that already holds the header `names` and earlier rows
+  // (a restart): nothing is truncated and no header is written again.
+  Series(const std::string& path, std::vector<std::string> names)
+      : path_(path), names_(std::move(names)) {}
   void row(const std::vector<std::pair<std::string, double>>& cols);
   void flush();
 
@@ -36,15 +40,22 @@ class Series {
 };
 
 // VTK snapshots through VTK's XML writers (binary, zlib-compressed):
-//   particles_NNNNN.vtp  points, one per disk: id, radius, velocity, omega, angle
+//   particles_NNNNN.vtp  points, one per particle: id, radius, velocity, omega, angle,
+//                        mass, nsides (0 for disks)
 //   contacts_NNNNN.vtp   lines from centre to centre: fn, ft, force vector,
 //                        normal, status (0 open, 1 stick, 2 slide), type, gap
 //   walls_NNNNN.vtp      wall segments as lines
-// and particles.pvd, contacts.pvd, walls.pvd (rewritten atomically after
-// each snapshot, so they list only complete files).
+//   shapes_NNNNN.vtp     true outlines: one polygon cell per particle (disks
+//                        as 36-gons): id, nsides, velocity, omega
+// and particles.pvd, contacts.pvd, walls.pvd, shapes.pvd (rewritten
+// atomically after each snapshot, so they list only complete files).
 class Snapshots {
  public:
   explicit Snapshots(const std::string& dir);
+  // Continues after a restart: `frames` (time, number) are already written;
+  // the collections list them again from the next snapshot on.
+  Snapshots(const std::string& dir, std::vector<std::pair<double, std::string>> frames)
+      : dir_(dir), n_(static_cast<int>(frames.size())), frames_(std::move(frames)) {}
   void write(const World& w);
   int count() const { return n_; }
 
