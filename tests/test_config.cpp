@@ -36,7 +36,8 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 void compare(const Scene& x, const Scene& y, bool same) {
   const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, tol,
                max_iter, threads, n, d_mean, size_ratio, size_dist, density, seed, region,
-               box_width, box_height, disks, walls, series_interval, snapshot_interval, quiet] = x;
+               box_width, box_height, disks, walls, series_interval, snapshot_interval,
+               checkpoint_interval, quiet] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
@@ -44,7 +45,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(region); CHECK_FIELD(box_width);
   CHECK_FIELD(box_height); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
-  CHECK_FIELD(quiet);
+  CHECK_FIELD(checkpoint_interval); CHECK_FIELD(quiet);
   if (same) {
     ASSERT_EQ(disks.size(), y.disks.size());
     ASSERT_EQ(walls.size(), y.walls.size());
@@ -80,6 +81,7 @@ Scene nondefault() {
   s.box_height = 0.2;
   s.series_interval = 1e-3;
   s.snapshot_interval = 0.0;
+  s.checkpoint_interval = 0.05;
   s.quiet = true;
   s.disks = {{{0.05, 0.1}, {1.0, -2.0}, 1e-3, 3.0, 5.0}, {{0.02, 0.03}, {0.0, 0.5}, 2e-3, -1.0, -1.0}};
   s.walls = {{{0.0, 0.3}, {0.1, 0.25}, {0.0, -0.01}, 0.5}, {{-1.0, 0.0}, {-1.0, 1.0}, {0.2, 0.0}, -0.5}};
@@ -184,6 +186,7 @@ TEST(Errors, ValueOutOfRange) {
        "xmin < xmax, ymin < ymax"},
       {"[output]\nseries_interval = 0", "x.toml:2:1: output.series_interval = 0: must be > 0"},
       {"[output]\nsnapshot_interval = -1", "x.toml:2:1: output.snapshot_interval = -1: must be >= 0"},
+      {"[output]\ncheckpoint_interval = -1", "x.toml:2:1: output.checkpoint_interval = -1: must be >= 0"},
       {"name = \"\"", "x.toml:1:1: name = \"\": must be non-empty"},
       {"[box]\nwidth = 1", "x.toml:1:1: box.width = 1, box.height = 0: must be both 0 (no box) or both > 0"},
   };
@@ -306,9 +309,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 25 scene keys + 5 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 26 scene keys + 5 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 25u + 5u + 4u) << md;
+  EXPECT_EQ(rows, 26u + 5u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer >= 1 |"), std::string::npos) << md;

@@ -1,5 +1,5 @@
 // cdsim: runs a scene.
-//   cdsim SCENE.toml [--set section.key=value]... [--out DIR] [--threads N] [--quiet]
+//   cdsim SCENE.toml [--set section.key=value]... [--out DIR] [--threads N] [--quiet] [--fresh]
 // Everything is checked (scene, particles, output folder) before anything is
 // written; any error is one message naming the problem, and exit code 2.
 #include <omp.h>
@@ -20,12 +20,13 @@ int main(int argc, char** argv) {
   std::string scene_path, out;
   std::vector<std::string> sets;
   int threads = -1;
-  bool quiet = false, help_scene = false;
+  bool quiet = false, help_scene = false, fresh = false;
   app.add_option("scene", scene_path, "scene file (TOML)");
   app.add_option("--set", sets, "override a parameter: section.key=value (repeatable)");
   app.add_option("--out", out, "output folder (default: outputs/<scene name>)");
   app.add_option("--threads", threads, "OpenMP threads (default: solver.threads, 0 = all)");
   app.add_flag("--quiet,-q", quiet, "no progress line on stderr");
+  app.add_flag("--fresh", fresh, "start over, discarding a checkpoint in the output folder");
   app.add_flag("--help-scene", help_scene, "print every scene parameter with its default");
   CLI11_PARSE(app, argc, argv);
 
@@ -46,8 +47,11 @@ int main(int argc, char** argv) {
     cd::check_output_dir(out);
     if (scene.threads > 0) omp_set_num_threads(scene.threads);
 
-    cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene)};
+    cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh};
     const cd::RunSummary s = cd::run(world, scene, opt);
+    if (s.first_step > 0)
+      fmt::print("cdsim: resumed from {}/checkpoint.bin at step {} of {}\n", out, s.first_step,
+                 s.first_step + s.steps);
     const double per_step = s.steps ? s.wall_time / s.steps : 0.0;
     fmt::print(
         "cdsim: {} steps in {:.2f} s ({:.3g} ms/step, {} threads); iterations/step mean {:.1f}, "

@@ -99,6 +99,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"box", "height", &Scene::box_height, "m", ge(0), "box height"},
       {"output", "series_interval", &Scene::series_interval, "s", gt(0), "time between rows of series.csv"},
       {"output", "snapshot_interval", &Scene::snapshot_interval, "s", ge(0), "time between VTK snapshots; 0: none"},
+      {"output", "checkpoint_interval", &Scene::checkpoint_interval, "s", ge(0), "time between checkpoints (checkpoint.bin: rerunning the same command resumes), rounded up to whole series intervals; 0: none"},
       {"output", "quiet", &Scene::quiet, "", any(), "no progress output"},
   };
   return t;

@@ -12,10 +12,12 @@ struct RunOptions {
   std::string out;          // output folder
   bool quiet = false;       // no progress line
   std::string scene_toml;   // resolved scene, written as scene.toml
+  bool fresh = false;       // start over even if `out` holds a checkpoint
 };
 
 struct RunSummary {
-  std::int64_t steps = 0;
+  std::int64_t first_step = 0;  // > 0: resumed from a checkpoint at this step
+  std::int64_t steps = 0;       // steps run by this call
   double mean_iterations = 0;
   int max_iterations = 0;
   std::int64_t cap_hits = 0;
@@ -27,6 +29,10 @@ struct RunSummary {
 
 // Runs the world for the scene's duration. The caller has validated the
 // scene and checked the output folder; this creates it and writes into it.
+// If the folder holds a checkpoint.bin (and not opt.fresh), the run resumes
+// from it: w's state is replaced, series.csv is cut back to the checkpoint's
+// step, and the run goes on as if never stopped. A checkpoint of another
+// scene, or an unreadable one, throws before anything is written.
 RunSummary run(World& w, const Scene& s, const RunOptions& opt);
 
 }  // namespace cd

@@ -68,6 +68,7 @@ struct Scene {
   // [output]
   double series_interval = 0.005;    // time between series rows (s)
   double snapshot_interval = 0.025;  // time between VTK snapshots (s); 0: none
+  double checkpoint_interval = 0.0;  // time between checkpoints (s); 0: none
   bool quiet = false;
 
   double mu_w() const { return mu_wall < 0 ? mu : mu_wall; }

@@ -1,0 +1,56 @@
+// Checkpoints: the whole state of a World between two steps (every Bodies
+// array, time, step count, stage timers, warm-start memory), so that a run
+// continued from one is bit-identical to a run never stopped.
+//
+// File format (version 1), little-endian, no padding:
+//   "CDLABCKP"                      8-byte magic
+//   u32 version
+//   u64 scene key                   opaque to this file (run.cpp: hash of the scene)
+//   i64 steps, f64 time, f64 x 4 stage times (detect, solve, integrate, output)
+//   arrays, each: u32 name length, name, u64 count, u32 element size, raw elements
+//     one per Bodies member, then "warm.keys" and "warm.p"
+//   u64 FNV-1a of every byte before it
+// A reader checks every size against the file and the checksum, and names the
+// file in any error.
+#pragma once
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scene.hpp"
+#include "world.hpp"
+
+namespace cd {
+
+struct CheckpointError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// 64-bit FNV-1a (the checksum; also used for the scene key).
+std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 1469598103934665603ull);
+
+// Writes w's state and `scene_key` to path atomically (temporary file, then
+// rename): a killed writer leaves the previous checkpoint intact.
+void save_checkpoint(const std::string& path, const World& w, std::uint64_t scene_key);
+
+// Reads a checkpoint into w (its parameters are kept) and returns the stored
+// scene key. w is changed only if the whole file is valid; otherwise throws
+// CheckpointError naming the file and what is wrong.
+std::uint64_t load_checkpoint(const std::string& path, World& w);
+
+// ---- restarting a run (run.cpp) ----
+
+// What a checkpoint must match: a hash of the resolved scene without the keys
+// that change neither the results nor the outputs, so that a restart may
+// change them: solver.threads (results are bit-identical for any thread
+// count), output.quiet, output.checkpoint_interval, and the scene's file name.
+std::uint64_t scene_key(const Scene& s);
+
+// Cuts series.csv back to its header and the rows up to `step` (a killed run
+// may have written rows after its last checkpoint) and returns the column
+// names. Throws CheckpointError if the file does not reach `step`.
+std::vector<std::string> truncate_series(const std::string& path, std::int64_t step);
+
+}  // namespace cd
