@@ -136,3 +136,31 @@ TEST(Dynamics, FreeFlightEnergyIsConserved) {
   for (int k = 0; k < 5000; ++k) w.step();
   EXPECT_NEAR(w.kinetic_energy(), e0, 1e-12 * e0);
 }
+
+TEST(Dynamics, OverlapCorrectionIsBoundedAndItsEnergyReported) {
+  // Two disks at rest overlapping by 0.01, no gravity. Pure CD (beta = 0)
+  // never pushes them apart: the overlap stays, no work, no energy. With
+  // beta, the law u_n >= beta |g|/dt gives them the separating velocity
+  // u = beta |g|/dt exactly (one exact local solve), which then persists:
+  // the correction injects kinetic energy 1/2 m_eff u^2, and the reported
+  // work p_n u = m_eff u^2 bounds it (here: equals twice it). Round-off: 1e-12.
+  for (double beta : {0.0, 0.3}) {
+    auto p = params(1e-3, 0.0, 0.4);
+    p.overlap_correction = beta;
+    cd::World w(p);
+    w.bodies.add_disk({0, 0}, 0.5, 1.0);
+    w.bodies.add_disk({0.99, 0}, 0.5, 1.0);
+    w.step();
+    EXPECT_NEAR(w.infos()[0].gap, -0.01, 1e-12);
+    const double u = w.bodies.vel[1].vx - w.bodies.vel[0].vx;
+    EXPECT_NEAR(u, beta * 0.01 / p.dt, 1e-12);
+    EXPECT_NEAR(w.kinetic_energy(), 0.5 * w.last().correction_work,
+                1e-12 * (1 + w.last().correction_work));
+    if (beta == 0.0) {
+      EXPECT_EQ(w.last().correction_work, 0.0);
+      for (int k = 0; k < 5; ++k) w.step();
+      EXPECT_NEAR(w.infos()[0].gap, -0.01, 1e-12);  // overlap kept, not pushed out
+      EXPECT_EQ(w.kinetic_energy(), 0.0);
+    }
+  }
+}

@@ -54,6 +54,16 @@ Rule region() {
             return r.empty() || (r.size() == 4 && r[0] < r[2] && r[1] < r[3]);
           }};
 }
+bool valid_sides(double n) { return n == 0 || (n >= 3 && n <= 60 && n == std::floor(n)); }
+Rule sides() {
+  return {"0 (disk) or an integer in [3, 60]", [](const Val& v) { return valid_sides(num(v)); }};
+}
+Rule side_list() {
+  return {"a non-empty list of 0 (disk) or integers in [3, 60]", [](const Val& v) {
+            const auto& r = std::get<std::vector<double>>(v);
+            return !r.empty() && std::all_of(r.begin(), r.end(), valid_sides);
+          }};
+}
 Rule disk_density() {
   return {"> 0, or -1 (particles.density)", [](const Val& v) { return num(v) > 0 || num(v) == -1; }};
 }
@@ -85,6 +95,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"contact", "e_t", &Scene::e_t, "", in(0, 1), "tangential restitution coefficient"},
       {"contact", "alert", &Scene::alert, "d_mean", ge(0), "alert distance of contact detection, in mean diameters"},
       {"contact", "rotation", &Scene::rotation, "", any(), "integrate particle rotations"},
+      {"contact", "overlap_correction", &Scene::overlap_correction, "", in(0, 1), "beta: an overlapping contact must separate at beta |gap|/dt; injects energy (bounded by the series column correction_work); 0: pure CD, overlaps never pushed apart"},
       {"solver", "tol", &Scene::tol, "", gt(0), "NLGS convergence tolerance (relative)"},
       {"solver", "max_iter", &Scene::max_iter, "", ge(1), "NLGS iteration cap per time step"},
       {"solver", "threads", &Scene::threads, "", ge(0), "OpenMP threads; 0: OpenMP default"},
@@ -94,6 +105,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"particles", "size_dist", &Scene::size_dist, "", size_dist(), "diameter distribution: uniform in d, or uniform_area (equal area per size class)"},
       {"particles", "density", &Scene::density, "kg/m^2", gt(0), "mass per unit area (2600 kg/m^3 x 1 mm = 2.6)"},
       {"particles", "seed", &Scene::seed, "", any(), "random seed of sizes and positions"},
+      {"particles", "nsides", &Scene::nsides, "", side_list(), "shapes of the generated particles, drawn uniformly from the list: 0 disk, n >= 3 regular n-gon (sizes are then circumscribed diameters)"},
       {"particles", "region", &Scene::region, "m", region(), "generation region [xmin, ymin, xmax, ymax]; []: inside the box"},
       {"box", "width", &Scene::box_width, "m", ge(0), "box of four static walls [0, width] x [0, height]; width and height both 0 (no box) or both > 0"},
       {"box", "height", &Scene::box_height, "m", ge(0), "box height"},
@@ -112,6 +124,8 @@ const std::vector<Param<DiskSpec>>& disk_params() {
       {"disk", "radius", &DiskSpec::radius, "m", gt(0), "radius"},
       {"disk", "omega", &DiskSpec::omega, "rad/s", any(), "initial angular velocity"},
       {"disk", "density", &DiskSpec::density, "kg/m^2", disk_density(), "mass per unit area; -1: particles.density"},
+      {"disk", "nsides", &DiskSpec::nsides, "", sides(), "0: a disk of this radius; n: a regular n-gon of this circumradius"},
+      {"disk", "angle", &DiskSpec::angle, "rad", any(), "orientation of a polygon (vertex 0 at this angle)"},
   };
   return t;
 }

@@ -42,6 +42,7 @@ struct Interval {
   int cap_hits = 0;
   double res_max = 0, res_mean_sum = 0;
   double ov_max = 0;
+  double corr_work = 0;
   StageTimes t0;
 
   void add(const StepStats& s) {
@@ -52,6 +53,7 @@ struct Interval {
     res_max = std::max(res_max, s.solve.residual_max);
     res_mean_sum += s.solve.residual_mean;
     ov_max = std::max(ov_max, s.max_overlap);
+    corr_work += s.correction_work;
   }
 };
 
@@ -143,6 +145,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
                     {"max_overlap", iv.ov_max},
                     {"mean_overlap", st.mean_overlap},
                     {"kinetic_energy", w.kinetic_energy()},
+                    {"correction_work", iv.corr_work},
                     {"t_detect", t.detect - iv.t0.detect},
                     {"t_solve", t.solve - iv.t0.solve},
                     {"t_integrate", t.integrate - iv.t0.integrate},

@@ -15,6 +15,8 @@ struct DiskSpec {            // [[disk]]: one explicit disk
   double radius = 0.5e-3;
   double omega = 0.0;
   double density = -1.0;     // < 0: particles.density
+  int nsides = 0;            // 0: disk; 3..60: regular polygon of circumradius `radius`
+  double angle = 0.0;        // orientation (vertex 0 at this angle)
 };
 
 struct WallSpec {            // [[wall]]: a rigid segment with imposed velocity
@@ -42,6 +44,7 @@ struct Scene {
   double e_t = 0.0;          // tangential restitution
   double alert = 0.1;        // alert distance, in mean diameters
   bool rotation = true;      // integrate rotations
+  double overlap_correction = 0.0;  // beta: overlaps separate at beta |gap|/dt (0: none)
 
   // [solver]
   double tol = 1e-4;         // NLGS tolerance eps_f (relative)
@@ -55,6 +58,9 @@ struct Scene {
   std::string size_dist = "uniform_area";  // "uniform" | "uniform_area"
   double density = 2.6;      // mass per unit area (kg/m^2): 2600 kg/m^3 x 1 mm
   unsigned seed = 1;
+  // shapes drawn uniformly from this list: 0 disk, 3..60 regular polygon
+  // (sizes then refer to the circumscribed diameter 2R)
+  std::vector<double> nsides{0.0};
   // generation region [xmin, ymin, xmax, ymax]; empty: inside the box
   std::vector<double> region;
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include <fmt/format.h>
@@ -73,6 +74,7 @@ WorldParams world_params(const Scene& s) {
   p.e_t = s.e_t;
   p.d_ref = mean_diameter(s);
   p.alert = s.alert * p.d_ref;
+  p.overlap_correction = s.overlap_correction;
   p.solver.tol = s.tol;
   p.solver.max_iter = s.max_iter;
   p.solver.rotation = s.rotation;
@@ -83,9 +85,14 @@ World build_world(const Scene& s) {
   World w(world_params(s));
   Bodies& B = w.bodies;
 
-  for (const DiskSpec& d : s.disks)
-    B.add_disk({d.pos[0], d.pos[1]}, d.radius, d.density > 0 ? d.density : s.density,
-               {d.vel[0], d.vel[1]}, d.omega);
+  for (const DiskSpec& d : s.disks) {
+    const double rho = d.density > 0 ? d.density : s.density;
+    if (d.nsides > 0)
+      B.add_polygon({d.pos[0], d.pos[1]}, d.radius, d.nsides, d.angle, rho, {d.vel[0], d.vel[1]},
+                    d.omega);
+    else
+      B.add_disk({d.pos[0], d.pos[1]}, d.radius, rho, {d.vel[0], d.vel[1]}, d.omega);
+  }
   const int first_generated = static_cast<int>(B.size());
 
   if (s.n > 0) {
@@ -108,12 +115,22 @@ World build_world(const Scene& s) {
           "of the largest diameter {:.4g} on a loose lattice; enlarge the region or the box",
           s.n, region[0], region[2], region[1], region[3], static_cast<long>(nx) * ny, dmax));
     std::mt19937_64 g(s.seed + 1);
+    std::mt19937_64 gs(s.seed + 2);  // shapes and orientations: their own stream, so a
+                                     // disk-only scene places exactly as before
     for (int k = 0; k < s.n; ++k) {
       const int ix = k % nx, iy = k / nx;
       const double slack = 0.5 * (pitch - d[k]);
       const double x = region[0] + (ix + 0.5) * pitch + slack * (2 * uniform01(g) - 1);
       const double y = region[1] + (iy + 0.5) * pitch + slack * (2 * uniform01(g) - 1);
-      B.add_disk({x, y}, 0.5 * d[k], s.density);
+      const int sides =
+          s.nsides.size() == 1
+              ? static_cast<int>(s.nsides[0])
+              : static_cast<int>(s.nsides[std::min<std::size_t>(
+                    s.nsides.size() - 1, static_cast<std::size_t>(uniform01(gs) * s.nsides.size()))]);
+      if (sides > 0)
+        B.add_polygon({x, y}, 0.5 * d[k], sides, 2 * std::numbers::pi * uniform01(gs), s.density);
+      else
+        B.add_disk({x, y}, 0.5 * d[k], s.density);
     }
   }
 

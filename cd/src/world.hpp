@@ -24,6 +24,11 @@ struct WorldParams {
   double mu = 0.0, mu_wall = 0.0;
   double e_n = 0.0, e_t = 0.0;
   double alert = 0.0;     // absolute alert distance
+  // Overlap correction beta: an overlapping contact must separate at
+  // beta |g|/dt (0: pure CD, overlaps are never pushed apart). The velocity
+  // it gives persists, so it injects energy; its work p_n beta |g|/dt, an
+  // upper bound of that energy, is reported in StepStats::correction_work.
+  double overlap_correction = 0.0;
   double d_ref = 1.0;     // length scale for overlaps (mean diameter)
   SolverParams solver;
 };
@@ -38,6 +43,7 @@ struct StepStats {
   int active = 0;          // rows carrying a force (p_n + a > 0)
   double max_overlap = 0;  // max over contacts of -gap / d_ref (midpoint configuration)
   double mean_overlap = 0; // mean of -gap / d_ref over overlapping contacts
+  double correction_work = 0;  // sum of p_n x bias velocity of the overlap correction (J)
 };
 
 class World {
