@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli_util.hpp"
 #include "config.hpp"
 
 namespace fs = std::filesystem;
@@ -19,20 +20,8 @@ namespace {
 
 const std::string kCdsim = CDLAB_BINARY_DIR "/cd/cdsim";
 
-struct Result {
-  int code;
-  std::string out;  // stdout and stderr
-};
-
-Result run(const std::string& args) {
-  const std::string cmd = kCdsim + " " + args + " 2>&1";
-  std::unique_ptr<FILE, int (*)(FILE*)> p(popen(cmd.c_str(), "r"), pclose);
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p.get())) out += buf.data();
-  const int status = pclose(p.release());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using Result = cdtest::CmdResult;
+Result run(const std::string& args) { return cdtest::run_command(kCdsim + " " + args); }
 
 fs::path temp_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("cdsim_cli_" + name + "_" + std::to_string(getpid()));

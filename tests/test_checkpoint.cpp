@@ -31,6 +31,7 @@
 #include <vtkXMLPolyDataReader.h>
 
 #include "checkpoint.hpp"
+#include "cli_util.hpp"
 #include "world_util.hpp"
 
 namespace fs = std::filesystem;
@@ -132,20 +133,8 @@ TEST(Checkpoint, DamagedFilesAreNamedAndLeaveTheWorldUnchanged) {
 
 // ---- cdsim --------------------------------------------------------------------
 
-struct Result {
-  int code;
-  std::string out;  // stdout and stderr
-};
-
-Result cdsim(const std::string& args) {
-  const std::string cmd = kCdsim + " " + args + " 2>&1";
-  std::unique_ptr<FILE, int (*)(FILE*)> p(popen(cmd.c_str(), "r"), pclose);
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p.get())) out += buf.data();
-  const int status = pclose(p.release());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using Result = cdtest::CmdResult;
+Result cdsim(const std::string& args) { return cdtest::run_command(kCdsim + " " + args); }
 
 // Steps of a series.csv's rows.
 std::vector<long> row_steps(const fs::path& p) {

@@ -11,48 +11,10 @@
 
 using cdtest::params;
 
-namespace {
-
-double total_mass(const cd::World& w) {
-  double m = 0;
-  for (std::size_t i = 0; i < w.bodies.size(); ++i)
-    if (w.bodies.is_dynamic(i)) m += w.bodies.mass[i];
-  return m;
-}
-
-// Runs `steps` steps and checks the hard-case invariants at every step: no
-// NaN, overlap bounded, and no growth of the mechanical energy KE + PE (no
-// driving, e_n = 0: the scheme may only dissipate). Returns mean iterations.
-struct Watch {
-  double max_overlap = 0, max_energy_gain = 0, mean_iter = 0;
-  int max_iter = 0, cap_hits = 0;
-};
-Watch run_watched(cd::World& w, int steps) {
-  Watch r;
-  const double e0 = w.kinetic_energy() + w.potential_energy();
-  long it = 0;
-  for (int k = 0; k < steps; ++k) {
-    w.step();
-    EXPECT_TRUE(cdtest::all_finite(w)) << "NaN at step " << k;
-    if (!cdtest::all_finite(w)) break;
-    r.max_overlap = std::max(r.max_overlap, w.last().max_overlap);
-    r.max_energy_gain =
-        std::max(r.max_energy_gain, w.kinetic_energy() + w.potential_energy() - e0);
-    it += w.last().solve.iterations;
-    r.max_iter = std::max(r.max_iter, w.last().solve.iterations);
-    r.cap_hits += w.last().solve.cap_hit;
-  }
-  r.mean_iter = double(it) / steps;
-  return r;
-}
-
-void report(const char* name, const Watch& r) {
-  std::printf("[ hard case ] %s: iterations mean %.1f max %d, cap hits %d, max overlap %.2e d, "
-              "max energy gain %.2e\n",
-              name, r.mean_iter, r.max_iter, r.cap_hits, r.max_overlap, r.max_energy_gain);
-}
-
-}  // namespace
+using cdtest::report;
+using cdtest::run_watched;
+using cdtest::total_mass;
+using cdtest::Watch;
 
 TEST(Determinism, StateHashIsTheSameForOneAndTwoThreads) {
   // 1500 disks dropped in a box: many contacts and colours. min_parallel = 0

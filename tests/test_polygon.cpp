@@ -13,14 +13,9 @@ using cd::Vec2;
 using cdtest::params;
 constexpr double kPi = std::numbers::pi;
 
-namespace {
+using cdtest::total_mass;
 
-double total_mass(const cd::World& w) {
-  double m = 0;
-  for (std::size_t i = 0; i < w.bodies.size(); ++i)
-    if (w.bodies.is_dynamic(i)) m += w.bodies.mass[i];
-  return m;
-}
+namespace {
 
 // A polygon of n sides and side s resting with a face on a line through the
 // origin inclined at theta (downhill along (cos, -sin)).
@@ -196,27 +191,6 @@ TEST(Polygon, DetectionTypesAndCounts) {
 
 namespace {
 
-struct Watch {
-  double max_overlap = 0, max_gain = 0, mean_iter = 0;
-  int cap_hits = 0;
-};
-Watch run_watched(cd::World& w, int steps) {
-  Watch r;
-  const double e0 = w.kinetic_energy() + w.potential_energy();
-  long it = 0;
-  for (int k = 0; k < steps; ++k) {
-    w.step();
-    EXPECT_TRUE(cdtest::all_finite(w)) << "NaN at step " << k;
-    if (!cdtest::all_finite(w)) break;
-    r.max_overlap = std::max(r.max_overlap, w.last().max_overlap);
-    r.max_gain = std::max(r.max_gain, w.kinetic_energy() + w.potential_energy() - e0);
-    it += w.last().solve.iterations;
-    r.cap_hits += w.last().solve.cap_hit;
-  }
-  r.mean_iter = double(it) / steps;
-  return r;
-}
-
 // n-gons (0 = disks) of circumradius in [rmin, rmax] on a loose lattice in a box.
 void fill_polygons(cd::World& w, int count, int n, double W, double rmin, double rmax, unsigned seed,
                    int every_small = 0, double small_r = 0.0) {
@@ -243,14 +217,12 @@ void fill_polygons(cd::World& w, int count, int n, double W, double rmin, double
 
 void expect_hard_case(const char* name, cd::World& w, int steps, double overlap_bound) {
   const double mgd = total_mass(w) * 9.81;
-  const Watch r = run_watched(w, steps);
-  std::printf("[ hard case ] %s: iterations mean %.1f, cap hits %d, max overlap %.2e d, "
-              "max energy gain %.2e m g d\n",
-              name, r.mean_iter, r.cap_hits, r.max_overlap, r.max_gain / mgd);
+  const cdtest::Watch r = cdtest::run_watched(w, steps);
+  cdtest::report(name, r, mgd);
   EXPECT_LT(r.max_overlap, overlap_bound) << name;
   // Energy: a converged step only dissipates; capped steps may return ~tol
   // of it (see test_pile.cpp): 1e-5 m g d.
-  EXPECT_LT(r.max_gain, 1e-5 * mgd) << name;
+  EXPECT_LT(r.max_energy_gain, 1e-5 * mgd) << name;
 }
 
 }  // namespace

@@ -1,0 +1,27 @@
+// Runs a command line and collects its exit code and output (stdout and
+// stderr), for the tests that drive the executables as a user would.
+#pragma once
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+namespace cdtest {
+
+struct CmdResult {
+  int code;         // exit code, -1 if killed by a signal
+  std::string out;  // stdout and stderr
+};
+
+inline CmdResult run_command(const std::string& cmd) {
+  std::unique_ptr<FILE, int (*)(FILE*)> p(popen((cmd + " 2>&1").c_str(), "r"), pclose);
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p.get())) out += buf.data();
+  const int status = pclose(p.release());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+}  // namespace cdtest
