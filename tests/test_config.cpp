@@ -24,9 +24,9 @@ const std::string kFull = std::string(CDLAB_SOURCE_DIR) + "/tests/data/config/fu
   if (same) { EXPECT_EQ(f, y.f) << #f; } else { EXPECT_NE(f, y.f) << #f; }
 
 void compare(const DiskSpec& x, const DiskSpec& y, bool same) {
-  const auto& [pos, vel, radius, omega, density, nsides, angle] = x;
+  const auto& [pos, vel, radius, omega, density, nsides, angle, force] = x;
   CHECK_FIELD(pos); CHECK_FIELD(vel); CHECK_FIELD(radius); CHECK_FIELD(omega); CHECK_FIELD(density);
-  CHECK_FIELD(nsides); CHECK_FIELD(angle);
+  CHECK_FIELD(nsides); CHECK_FIELD(angle); CHECK_FIELD(force);
 }
 
 void compare(const WallSpec& x, const WallSpec& y, bool same) {
@@ -35,14 +35,14 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 }
 
 void compare(const Scene& x, const Scene& y, bool same) {
-  const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, tol,
+  const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, adhesion, debond, tol,
                max_iter, threads, n, d_mean, size_ratio, size_dist, density, seed, nsides, region,
                box_width, box_height, disks, walls, series_interval, snapshot_interval,
                checkpoint_interval, quiet] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
-  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(threads);
+  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(adhesion); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(threads);
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
   CHECK_FIELD(box_height); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
@@ -69,6 +69,8 @@ Scene nondefault() {
   s.alert = 0.05;
   s.rotation = false;
   s.overlap_correction = 0.25;
+  s.adhesion = 2.5e-3;
+  s.debond = 0.02;
   s.tol = 1e-6;
   s.max_iter = 500;
   s.threads = 2;
@@ -86,8 +88,8 @@ Scene nondefault() {
   s.snapshot_interval = 0.0;
   s.checkpoint_interval = 0.05;
   s.quiet = true;
-  s.disks = {{{0.05, 0.1}, {1.0, -2.0}, 1e-3, 3.0, 5.0, 4, 0.25},
-             {{0.02, 0.03}, {0.0, 0.5}, 2e-3, -1.0, -1.0, 60, -1.5}};
+  s.disks = {{{0.05, 0.1}, {1.0, -2.0}, 1e-3, 3.0, 5.0, 4, 0.25, {0.5, -0.5}},
+             {{0.02, 0.03}, {0.0, 0.5}, 2e-3, -1.0, -1.0, 60, -1.5, {-1.0, 2.0}}};
   s.walls = {{{0.0, 0.3}, {0.1, 0.25}, {0.0, -0.01}, 0.5}, {{-1.0, 0.0}, {-1.0, 1.0}, {0.2, 0.0}, -0.5}};
   return s;
 }
@@ -313,9 +315,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 28 scene keys + 7 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 30 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 28u + 7u + 4u) << md;
+  EXPECT_EQ(rows, 30u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer >= 1 |"), std::string::npos) << md;

@@ -17,6 +17,7 @@ int Bodies::add_disk(Vec2 x, double r, double density, Vec2 v, double omega) {
   mass.push_back(m);
   inertia.push_back(I);
   driven.push_back(0);
+  force.push_back(Vec2::Zero());
   return static_cast<int>(pos.size()) - 1;
 }
 
@@ -36,6 +37,7 @@ int Bodies::add_polygon(Vec2 x, double R, int n, double ang, double density, Vec
   mass.push_back(m);
   inertia.push_back(I);
   driven.push_back(0);
+  force.push_back(Vec2::Zero());
   return static_cast<int>(pos.size()) - 1;
 }
 
@@ -51,6 +53,7 @@ int Bodies::add_wall(Vec2 a, Vec2 b, Vec2 v, double omega) {
   mass.push_back(0.0);
   inertia.push_back(0.0);
   driven.push_back(1);
+  force.push_back(Vec2::Zero());
   return static_cast<int>(pos.size()) - 1;
 }
 

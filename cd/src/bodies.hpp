@@ -32,6 +32,7 @@ struct Bodies {
   std::vector<std::int32_t> nsides;  // polygon sides (3..60); 0 for disks and segments
   std::vector<double> mass, inertia;
   std::vector<std::uint8_t> driven;  // 1: imposed velocity (walls)
+  std::vector<Vec2> force;           // constant applied force (besides gravity)
 
   std::size_t size() const { return pos.size(); }
   bool is_dynamic(std::size_t i) const { return driven[i] == 0; }

@@ -35,6 +35,7 @@ constexpr std::tuple kBodiesArrays{
     std::pair{"mass", &Bodies::mass},
     std::pair{"inertia", &Bodies::inertia},
     std::pair{"driven", &Bodies::driven},
+    std::pair{"force", &Bodies::force},
 };
 // Bodies holds only vectors, so a member left out of the list shows here.
 static_assert(sizeof(Bodies) ==

@@ -95,6 +95,8 @@ const std::vector<Param<Scene>>& scene_params() {
       {"contact", "e_t", &Scene::e_t, "", in(0, 1), "tangential restitution coefficient"},
       {"contact", "alert", &Scene::alert, "d_mean", ge(0), "alert distance of contact detection, in mean diameters"},
       {"contact", "rotation", &Scene::rotation, "", any(), "integrate particle rotations"},
+      {"contact", "adhesion", &Scene::adhesion, "N", ge(0), "pull-off force f_a of the adhesion-shifted Signorini law, on contacts with gap <= debond; 0: no cohesion (no adhesion work at all)"},
+      {"contact", "debond", &Scene::debond, "d_mean", ge(0), "debonding distance delta_a, in mean diameters: a bond breaks beyond it"},
       {"contact", "overlap_correction", &Scene::overlap_correction, "", in(0, 1), "beta: an overlapping contact must separate at beta |gap|/dt; injects energy (bounded by the series column correction_work); 0: pure CD, overlaps never pushed apart"},
       {"solver", "tol", &Scene::tol, "", gt(0), "NLGS convergence tolerance (relative)"},
       {"solver", "max_iter", &Scene::max_iter, "", ge(1), "NLGS iteration cap per time step"},
@@ -126,6 +128,7 @@ const std::vector<Param<DiskSpec>>& disk_params() {
       {"disk", "density", &DiskSpec::density, "kg/m^2", disk_density(), "mass per unit area; -1: particles.density"},
       {"disk", "nsides", &DiskSpec::nsides, "", sides(), "0: a disk of this radius; n: a regular n-gon of this circumradius"},
       {"disk", "angle", &DiskSpec::angle, "rad", any(), "orientation of a polygon (vertex 0 at this angle)"},
+      {"disk", "force", &DiskSpec::force, "N", any(), "constant applied force [fx, fy] (besides gravity)"},
   };
   return t;
 }

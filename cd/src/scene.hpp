@@ -17,6 +17,7 @@ struct DiskSpec {            // [[disk]]: one explicit disk
   double density = -1.0;     // < 0: particles.density
   int nsides = 0;            // 0: disk; 3..60: regular polygon of circumradius `radius`
   double angle = 0.0;        // orientation (vertex 0 at this angle)
+  std::array<double, 2> force{0.0, 0.0};  // constant applied force (N)
 };
 
 struct WallSpec {            // [[wall]]: a rigid segment with imposed velocity
@@ -45,6 +46,8 @@ struct Scene {
   double alert = 0.1;        // alert distance, in mean diameters
   bool rotation = true;      // integrate rotations
   double overlap_correction = 0.0;  // beta: overlaps separate at beta |gap|/dt (0: none)
+  double adhesion = 0.0;     // pull-off force f_a (N); 0: no cohesion
+  double debond = 0.01;      // debonding distance delta_a, in mean diameters
 
   // [solver]
   double tol = 1e-4;         // NLGS tolerance eps_f (relative)

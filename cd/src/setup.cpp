@@ -75,6 +75,8 @@ WorldParams world_params(const Scene& s) {
   p.d_ref = mean_diameter(s);
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
+  p.adhesion = s.adhesion;
+  p.debond = s.debond * p.d_ref;
   p.solver.tol = s.tol;
   p.solver.max_iter = s.max_iter;
   p.solver.rotation = s.rotation;
@@ -87,11 +89,11 @@ World build_world(const Scene& s) {
 
   for (const DiskSpec& d : s.disks) {
     const double rho = d.density > 0 ? d.density : s.density;
-    if (d.nsides > 0)
-      B.add_polygon({d.pos[0], d.pos[1]}, d.radius, d.nsides, d.angle, rho, {d.vel[0], d.vel[1]},
-                    d.omega);
-    else
-      B.add_disk({d.pos[0], d.pos[1]}, d.radius, rho, {d.vel[0], d.vel[1]}, d.omega);
+    const int i = d.nsides > 0 ? B.add_polygon({d.pos[0], d.pos[1]}, d.radius, d.nsides, d.angle,
+                                               rho, {d.vel[0], d.vel[1]}, d.omega)
+                               : B.add_disk({d.pos[0], d.pos[1]}, d.radius, rho,
+                                            {d.vel[0], d.vel[1]}, d.omega);
+    B.force[i] = Vec2(d.force[0], d.force[1]);
   }
   const int first_generated = static_cast<int>(B.size());
 

@@ -24,9 +24,20 @@ void World::configure() {
   // with the gap term u_n + g_m/dt >= 0, which closes gaps without overlap.
   alert_ = restitution_on_ ? 0.0 : prm_.alert;
   prm_.solver.friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
+  // Cohesive scenes only: contacts up to the debonding distance pull with
+  // f_a (no bond history: a pair within debond of each other is bonded).
+  adhesion_on_ = prm_.adhesion > 0.0;
+  prm_.solver.adhesion = adhesion_on_;
+  if (adhesion_on_) alert_ = std::max(alert_, prm_.debond);
+  prepared_ = false;
 }
 
 void World::step() {
+  if (!prepared_) {  // per-scene choices that depend on the bodies
+    forces_on_ = std::any_of(bodies.force.begin(), bodies.force.end(),
+                             [](const Vec2& f) { return f.squaredNorm() > 0.0; });
+    prepared_ = true;
+  }
   auto t0 = Clock::now();
   predict();
   detect_stage();
@@ -75,6 +86,10 @@ void World::build() {
     r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
     r.bt = 0.0;
   }
+  if (adhesion_on_) {
+    const double a = prm_.adhesion * dt;
+    for (std::size_t k = 0; k < nr; ++k) rows_[k].adh = info_[k].gap <= prm_.debond ? a : 0.0;
+  }
   if (restitution_on_) {
     // Law on u+ + e u-, with u- the relative velocity at the start of the
     // step (before external forces) in the midpoint frame. Only approaching
@@ -102,8 +117,10 @@ void World::external() {
   const Vec2 dv = prm_.dt * prm_.gravity;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (!bodies.is_dynamic(i)) continue;
-    bodies.vel[i].vx += dv.x();
-    bodies.vel[i].vy += dv.y();
+    Vec2 d = dv;
+    if (forces_on_) d += prm_.dt * bodies.vel[i].inv_m * bodies.force[i];
+    bodies.vel[i].vx += d.x();
+    bodies.vel[i].vy += d.y();
   }
 }
 
@@ -120,7 +137,7 @@ void World::solve() {
     rows_.swap(r);
     info_.swap(f);
   }
-  if (gravity_on_) external();
+  if (gravity_on_ || forces_on_) external();
   apply_impulses(rows_, bodies.vel, prm_.solver.rotation);
   last_.solve = nlgs_solve(rows_, col_, bodies.vel, prm_.solver);
 

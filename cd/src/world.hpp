@@ -29,6 +29,9 @@ struct WorldParams {
   // it gives persists, so it injects energy; its work p_n beta |g|/dt, an
   // upper bound of that energy, is reported in StepStats::correction_work.
   double overlap_correction = 0.0;
+  // Adhesion-shifted Signorini law (method.md section 2): pull-off force f_a
+  // on every contact whose midpoint gap is <= debond (absolute); 0: none.
+  double adhesion = 0.0, debond = 0.0;
   double d_ref = 1.0;     // length scale for overlaps (mean diameter)
   SolverParams solver;
 };
@@ -92,7 +95,8 @@ class World {
   void integrate();
 
   WorldParams prm_;
-  bool gravity_on_ = false, restitution_on_ = false;
+  bool gravity_on_ = false, restitution_on_ = false, adhesion_on_ = false;
+  bool forces_on_ = false, prepared_ = false;  // forces_on_: some body has an applied force
   double alert_ = 0.0;
   StepStats last_;
   std::vector<Vec2> xm_;
