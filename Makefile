@@ -13,15 +13,16 @@ DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libbenchmark-dev gnuplot-nox
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build run test bench clean help
+.PHONY: all deps build run test bench accuracy-cost clean help
 
 all: build
 
 help:
-	@echo "make run     build and run the default scene into $(OUT)/"
-	@echo "make test    build and run the test suite (ctest)"
-	@echo "make bench   build and run the benchmarks (results in outputs/bench/)"
-	@echo "make deps    install the missing Debian packages (idempotent)"
+	@echo "make run            build and run the default scene into $(OUT)/"
+	@echo "make test           build and run the test suite (ctest)"
+	@echo "make bench          build and run the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv)"
+	@echo "make accuracy-cost  eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s)"
+	@echo "make deps           install the missing Debian packages (idempotent)"
 
 # Idempotent: asks dpkg which packages are missing and installs only those.
 deps:
@@ -49,9 +50,15 @@ run: build
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 900
 
+# Timings are comparable only with the machine named: machine.csv (CPU, cores,
+# compiler, flags, load average) is written next to the results.
 bench: build
 	mkdir -p outputs/bench
-	$(BUILD)/cd/bench/cdbench --benchmark_out=outputs/bench/bench.json --benchmark_out_format=json
+	@awk -v n=$$(nproc) '$$1 > n / 2 { printf "make bench: load average %s on %d cores: times, above all the 2-thread ones, will be noisy\n", $$1, n }' /proc/loadavg
+	$(BUILD)/cd/bench/cdbench --benchmark_out=outputs/bench/bench.json --benchmark_out_format=json --csv_dir=outputs/bench
+
+accuracy-cost: build
+	$(BUILD)/cd/bench/accuracy_cost --out outputs/accuracy-cost $(if $(QUICK),--quick)
 
 clean:
 	rm -rf $(BUILD)
