@@ -7,6 +7,9 @@
 //                       contact updates per second per core
 //   nlgs_shuffled/N     the same problem with the bodies numbered at random:
 //                       what memory locality is worth
+//   nlgs_poly/S/N       nlgs/N on a settled pile of regular S-gons (S = 4, 6):
+//                       updates/s per core, and the cost per contact update
+//                       against disks at the same N (summary)
 //   step/N              one time step (detect, build, kSweeps sweeps,
 //                       integrate), 1 thread: ms/step against N, and its slope
 //   step_converged/N    one time step at the default eps_f: ms and sweeps a step
@@ -21,18 +24,25 @@
 // Scenes: N = 1e3 is a deposited, settled square pile (45 d deep); larger N
 // are side by side mirrored copies of it (a layer of the same depth), so
 // that preparing 1e5 disks takes seconds, and the work a sweep does per
-// contact is the same at every N. Preparation runs on one thread.
+// contact is the same at every N. Polygon piles: 1e3 polygons collapsed from
+// a loose lattice under gravity (cdbench::polygon_pile, a few seconds), 1e4
+// tiled from it. Preparation runs on one thread.
 //
 // Besides Google Benchmark's own output, --csv_dir=DIR writes
 //   runs.csv     one line per benchmark (time and counters)
 //   summary.csv  the ratios measured in this run (speedups, effect on/off,
 //                updates/s per core, ms/step slope against N)
 //   machine.csv  CPU model, cores, compiler, flags, load average
+//   plots.gp     gnuplot script (with plot_step.dat, plot_nlgs.dat), run if
+//                gnuplot is installed: step_ms_vs_N.png (log-log, slope-1
+//                guide) and nlgs_updates_disk_vs_polygon.png
 // and the summary is printed at the end.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -71,18 +81,21 @@ cd::WorldParams fixed_sweeps(cd::WorldParams p, int k) {
   return p;
 }
 
-// Prepared worlds, one per N, built on first use and copied by each run.
-const cd::World& prepared(int n) {
-  static std::map<int, std::unique_ptr<cd::World>> cache;
-  auto& slot = cache[n];
+// Prepared worlds, one per (N, sides), built on first use and copied by each
+// run. sides = 0: disks; 3..: regular polygons (cdbench::polygon_pile).
+const cd::World& prepared(int n, int sides = 0) {
+  static std::map<std::pair<int, int>, std::unique_ptr<cd::World>> cache;
+  auto& slot = cache[{n, sides}];
   if (!slot) {
     Threads one(1);
     const auto t0 = Clock::now();
-    if (n == kBase) {
+    if (n == kBase && sides > 0) {
+      slot = std::make_unique<cd::World>(cdbench::polygon_pile(kBase, sides));
+    } else if (n == kBase) {
       slot = std::make_unique<cd::World>(cdbench::pile_world(cdbench::pile_scene(kBase)));
       cdbench::settle(*slot);
     } else {
-      slot = std::make_unique<cd::World>(cdbench::tile(prepared(kBase), n / kBase));
+      slot = std::make_unique<cd::World>(cdbench::tile(prepared(kBase, sides), n / kBase));
       // The warm start is lost by tiling: rebuild a force network. Fixed
       // sweeps keep this affordable at 1e5 (converging it from zero would
       // take thousands of sweeps a step).
@@ -91,8 +104,11 @@ const cd::World& prepared(int n) {
       for (int k = 0; k < 3; ++k) slot->step();
       slot->set_params(p);
     }
-    std::cerr << "cdbench: prepared N = " << n << " (" << slot->last().contacts
-              << " contacts) in " << since(t0) << " s\n";
+    std::cerr << "cdbench: prepared N = " << n
+              << (sides ? " polygons of " + std::to_string(sides) + " sides" : std::string())
+              << " (" << slot->last().contacts << " contacts, max overlap "
+              << 100 * slot->last().max_overlap << " % d, kinetic energy "
+              << slot->kinetic_energy() << " J) in " << since(t0) << " s\n";
   }
   return *slot;
 }
@@ -104,13 +120,14 @@ struct Frozen {
   cd::Colouring col;
   std::vector<cd::BodyVel> vel;
   cd::SolverParams prm;
+  int contacts = 0;  // distinct body pairs (a polygon side-side contact has 2 rows)
 };
 
-const Frozen& frozen(int n) {
-  static std::map<int, std::unique_ptr<Frozen>> cache;
-  auto& slot = cache[n];
+const Frozen& frozen(int n, int sides = 0) {
+  static std::map<std::pair<int, int>, std::unique_ptr<Frozen>> cache;
+  auto& slot = cache[{n, sides}];
   if (!slot) {
-    const cd::World& w = prepared(n);
+    const cd::World& w = prepared(n, sides);
     slot = std::make_unique<Frozen>();
     const std::vector<cd::ContactRow>& r = w.rows();
     slot->col = cd::colour_rows(r, w.bodies);
@@ -120,6 +137,12 @@ const Frozen& frozen(int n) {
     slot->prm = w.params().solver;
     slot->prm.tol = 0.0;
     slot->prm.max_iter = kSweeps;
+    std::vector<std::pair<int, int>> pairs;
+    pairs.reserve(r.size());
+    for (const cd::ContactRow& row : r) pairs.emplace_back(row.b1, row.b2);
+    std::sort(pairs.begin(), pairs.end());
+    slot->contacts =
+        static_cast<int>(std::unique(pairs.begin(), pairs.end()) - pairs.begin());
   }
   return *slot;
 }
@@ -161,8 +184,7 @@ int runs_for(int n, int sweeps) {
   return static_cast<int>(std::clamp(kWork / (rows * sweeps), 3.0, 200.0));
 }
 
-void bm_nlgs(benchmark::State& state, int n, int threads, bool shuffled) {
-  const Frozen& f = shuffled ? frozen_shuffled(n) : frozen(n);
+void time_nlgs(benchmark::State& state, const Frozen& f, int n, int threads) {
   Threads scope(threads);
   std::vector<cd::ContactRow> rows;
   std::vector<cd::BodyVel> vel;
@@ -185,7 +207,23 @@ void bm_nlgs(benchmark::State& state, int n, int threads, bool shuffled) {
   state.counters["sweeps"] = sweeps / state.iterations();
   state.counters["updates_per_s_per_core"] = updates / t / threads;
   state.counters["ns_per_update"] = 1e9 * t / updates;
+  state.counters["contacts"] = f.contacts;
+  state.counters["ns_per_contact_sweep"] = 1e9 * t / (static_cast<double>(f.contacts) * sweeps);
 }
+
+void bm_nlgs(benchmark::State& state, int n, int threads, bool shuffled) {
+  time_nlgs(state, shuffled ? frozen_shuffled(n) : frozen(n), n, threads);
+}
+
+// nlgs_poly/<sides>/N: nlgs/N on a settled pile of regular polygons. The
+// solver only sees rows; a side-side contact is two rows on the same body
+// pair, so updates count rows (as for disks) and ns_per_contact_sweep counts
+// distinct body pairs.
+void bm_nlgs_poly(benchmark::State& state, int sides, int n) {
+  time_nlgs(state, frozen(n, sides), n, 1);
+}
+const int kPolySides[] = {4, 6};
+const int kPolySizes[] = {1000, 10000};
 
 // Steps a copy of a prepared world with the given parameters; one warm-up
 // step first (the row set changes with the parameters), then one step a run.
@@ -307,6 +345,25 @@ std::vector<Line> summarise(const Recorder& rec, const std::vector<int>& sizes) 
     out.push_back({"nlgs_updates_per_s_per_core/" + std::to_string(n),
                    counter("nlgs/" + std::to_string(n), "updates_per_s_per_core"), "1/s",
                    "contact updates a second, one thread"});
+  for (int sides : kPolySides)
+    for (int n : kPolySizes) {
+      const std::string p = "nlgs_poly/" + std::to_string(sides) + "/" + std::to_string(n);
+      const std::string d = "nlgs/" + std::to_string(n);
+      const std::string shape = std::to_string(sides) + "-gons";
+      out.push_back({"nlgs_poly_updates_per_s_per_core/" + std::to_string(sides) + "/" +
+                         std::to_string(n),
+                     counter(p, "updates_per_s_per_core"), "1/s",
+                     "contact (row) updates a second, one thread, " + shape});
+      out.push_back({"nlgs_poly_over_disk_ns_per_update/" + std::to_string(sides) + "/" +
+                         std::to_string(n),
+                     counter(p, "ns_per_update") / counter(d, "ns_per_update"), "",
+                     "cost per contact (row) update, " + shape + " / disks, same N"});
+      out.push_back({"nlgs_poly_over_disk_ns_per_contact/" + std::to_string(sides) + "/" +
+                         std::to_string(n),
+                     counter(p, "ns_per_contact_sweep") / counter(d, "ns_per_contact_sweep"), "",
+                     "sweep cost per contact (body pair; side-side = 2 rows), " + shape +
+                         " / disks, same N"});
+    }
   for (int n : {10000, 100000})
     out.push_back({"nlgs_shuffled_over_sorted/" + std::to_string(n),
                    ms("nlgs_shuffled/" + std::to_string(n)) / ms("nlgs/" + std::to_string(n)), "",
@@ -374,7 +431,8 @@ void write_csvs(const std::string& dir, const Recorder& rec, const std::vector<L
     const char* cols[] = {"n",         "threads",          "rows",
                           "colours",   "sweeps",           "cap_hits",
                           "detect_ms", "solve_ms",         "ns_per_row_sweep",
-                          "updates_per_s_per_core",        "ns_per_update"};
+                          "updates_per_s_per_core",        "ns_per_update",
+                          "contacts",  "ns_per_contact_sweep"};
     std::ofstream f(dir + "/runs.csv");
     f << "name,ms_per_run";
     for (const char* c : cols) f << "," << c;
@@ -389,6 +447,110 @@ void write_csvs(const std::string& dir, const Recorder& rec, const std::vector<L
       f << "\n";
     }
   }
+}
+
+// Plots from this run's results into dir: plot_step.dat and plot_nlgs.dat,
+// plots.gp, and with gnuplot (pngcairo) step_ms_vs_N.png and
+// nlgs_updates_disk_vs_polygon.png. Plots without data are left out; a
+// missing gnuplot only costs the PNGs.
+void write_plots(const std::string& dir, const Recorder& rec, const std::vector<int>& sizes) {
+  auto run = [&](const std::string& k) { return rec.get(k); };
+  auto upd = [&](const std::string& k) {
+    const auto* r = run(k);
+    return r && r->counters.count("updates_per_s_per_core") ? r->counters.at("updates_per_s_per_core")
+                                                             : double(NAN);
+  };
+  std::vector<std::pair<int, double>> step;
+  for (int n : sizes)
+    if (const auto* r = run("step/" + std::to_string(n)); r && std::isfinite(r->ms) && r->ms > 0)
+      step.emplace_back(n, r->ms);
+  {
+    std::ofstream f(dir + "/plot_step.dat");
+    f << "# N ms_per_step (step/N: " << kSweeps << " sweeps a step, one thread)\n";
+    for (const auto& [n, t] : step) f << n << " " << t << "\n";
+  }
+  std::vector<int> ns;  // N with a disk or polygon nlgs result
+  for (int n : {1000, 10000, 100000}) {
+    bool any = std::isfinite(upd("nlgs/" + std::to_string(n)));
+    for (int sides : kPolySides)
+      any = any || std::isfinite(
+                       upd("nlgs_poly/" + std::to_string(sides) + "/" + std::to_string(n)));
+    if (any) ns.push_back(n);
+  }
+  {
+    std::ofstream f(dir + "/plot_nlgs.dat");
+    f << "# N disks";
+    for (int sides : kPolySides) f << " " << sides << "-gons";
+    f << "   (contact row updates a second, one thread; ? = not run)\n";
+    auto put = [&](double v) {
+      if (std::isfinite(v)) f << " " << v;
+      else f << " ?";
+    };
+    for (int n : ns) {
+      f << n;
+      put(upd("nlgs/" + std::to_string(n)));
+      for (int sides : kPolySides)
+        put(upd("nlgs_poly/" + std::to_string(sides) + "/" + std::to_string(n)));
+      f << "\n";
+    }
+  }
+  std::ofstream g(dir + "/plots.gp");
+  g << "# cdbench plots (gnuplot " << "plots.gp, run in this directory)\n"
+    << "set terminal pngcairo size 800,560 enhanced font ',11'\n"
+    << "set datafile missing '?'\nset grid\n";
+  if (step.size() >= 1) {
+    // Slope-1 guide through the smallest N measured.
+    g << "set output 'step_ms_vs_N.png'\n"
+      << "set title 'Time per step against N (" << kSweeps << " NLGS sweeps a step, 1 thread)'\n"
+      << "set logscale xy\nset xlabel 'N (bodies)'\nset ylabel 'ms / step'\n"
+      << "set key top left\n"
+      << "guide(x) = " << step.front().second << " * x / " << step.front().first << ".0\n"
+      << "plot 'plot_step.dat' using 1:2 with linespoints pt 7 lw 2 title 'step/N', \\\n"
+      << "     guide(x) with lines dt 2 lc rgb 'gray40' title 'slope 1 (linear)'\n"
+      << "unset logscale\nunset output\n";
+  }
+  if (!ns.empty()) {
+    g << "set output 'nlgs_updates_disk_vs_polygon.png'\n"
+      << "set title 'NLGS throughput: contact row updates per second per core (" << kSweeps
+      << " sweeps, 1 thread)'\n"
+      << "set style data histograms\nset style histogram clustered gap 1\n"
+      << "set style fill solid 0.8 border -1\nset boxwidth 0.9\n"
+      << "set xlabel 'N (bodies)'\nset ylabel 'updates / s / core'\nset yrange [0:*]\n"
+      << "set key top right\n"
+      << "plot 'plot_nlgs.dat'";
+    // Only the shapes measured in this run (an empty column makes gnuplot warn).
+    auto measured = [&](const std::string& prefix) {
+      for (int n : ns)
+        if (std::isfinite(upd(prefix + std::to_string(n)))) return true;
+      return false;
+    };
+    bool first = true;
+    auto column = [&](int col, const std::string& title) {
+      g << (first ? "" : ", \\\n     ''") << " using " << col << ":xtic(1) title '" << title
+        << "'";
+      first = false;
+    };
+    if (measured("nlgs/")) column(2, "disks");
+    int col = 3;
+    for (int sides : kPolySides) {
+      if (measured("nlgs_poly/" + std::to_string(sides) + "/"))
+        column(col, std::to_string(sides) +
+                        (sides == 4 ? "-gons (squares)" : sides == 6 ? "-gons (hexagons)" : "-gons"));
+      ++col;
+    }
+    g << "\nunset output\n";
+  }
+  g.close();
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
+    std::cout << "cdbench: gnuplot not found: wrote " << dir
+              << "/plots.gp and its data, no PNG (run gnuplot plots.gp there)\n";
+    return;
+  }
+  const std::string cmd = "cd '" + dir + "' && gnuplot plots.gp";
+  if (std::system(cmd.c_str()) != 0)
+    std::cout << "cdbench: gnuplot failed on " << dir << "/plots.gp; continuing\n";
+  else
+    std::cout << "cdbench: wrote " << dir << "/plots.gp and its PNGs\n";
 }
 
 }  // namespace
@@ -419,6 +581,12 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("nlgs_shuffled/" + std::to_string(n)).c_str(), bm_nlgs, n, 1,
                                  true)
         ->UseManualTime()->Unit(kMillisecond)->Iterations(runs_for(n, kSweeps));
+  for (int sides : kPolySides)
+    for (int n : kPolySizes)
+      benchmark::RegisterBenchmark(
+          ("nlgs_poly/" + std::to_string(sides) + "/" + std::to_string(n)).c_str(), bm_nlgs_poly,
+          sides, n)
+          ->UseManualTime()->Unit(kMillisecond)->Iterations(runs_for(n, kSweeps));
   for (int n : sizes)
     benchmark::RegisterBenchmark(("step/" + std::to_string(n)).c_str(), bm_step, n, 1)
         ->UseRealTime()->Unit(kMillisecond)->Iterations(runs_for(n, kSweeps));
@@ -455,6 +623,7 @@ int main(int argc, char** argv) {
   if (!csv_dir.empty()) {
     write_csvs(csv_dir, rec, summary, cdbench::machine(load_start));
     std::cout << "cdbench: wrote " << csv_dir << "/{runs,summary,machine}.csv\n";
+    write_plots(csv_dir, rec, sizes);
   }
   benchmark::Shutdown();
   return 0;
