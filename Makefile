@@ -43,9 +43,9 @@ build: deps $(BUILD)/CMakeCache.txt
 run: build
 	$(BUILD)/cd/cdsim $(SCENE) --out $(OUT)
 	@echo ""
-	@echo "Outputs in $(OUT)/: series.csv (time series), scene.toml (resolved scene),"
-	@echo "particles.pvd and contacts.pvd (VTK collections)."
-	@echo "Open in ParaView:  paraview $(OUT)/particles.pvd"
+	@echo "Outputs in $(OUT)/: series.csv (time series, columns in README.md), scene.toml"
+	@echo "(resolved scene), shapes.pvd, particles.pvd, contacts.pvd, walls.pvd (VTK collections)."
+	@echo "Open in ParaView:  paraview $(OUT)/shapes.pvd   (grains as drawn; colour by velocity)"
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 900
