@@ -17,8 +17,6 @@
 //                       the speedup from 1 to 2 threads
 //   effect/<name>:<on|off>    one step, N = 1e4, 1 thread: what an effect
 //                       costs when on, and that it costs nothing when off
-// TODO(adhesion): effect/adhesion:on|off once a cohesive scene reaches the
-//   World (the law exists in law.hpp, but no scene sets WorldParams for it).
 // TODO(periodicity): effect/periodic:on|off once periodic boundaries exist.
 //
 // Scenes: N = 1e3 is a deposited, settled square pile (45 d deep); larger N
@@ -284,6 +282,14 @@ const Effect kEffects[] = {
      [](cd::WorldParams& p) { p.e_n = 0.5; }},
     {"gravity", [](cd::WorldParams& p) { p.gravity = cd::Vec2::Zero(); },
      [](cd::WorldParams& p) { p.gravity = cd::Vec2(0.0, -9.81); }},
+    // A vanishing pull-off force with a zero debonding distance: the same rows
+    // and nearly the same solution, so the difference is the cost of the
+    // cohesive sweep and of the adhesion bookkeeping alone.
+    {"adhesion", [](cd::WorldParams& p) { p.adhesion = 0.0; },
+     [](cd::WorldParams& p) {
+       p.adhesion = 1e-12;
+       p.debond = 0.0;
+     }},
 };
 constexpr int kEffectN = 10000;
 
