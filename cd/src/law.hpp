@@ -80,17 +80,6 @@ inline void solve_frictionless(double bn, const Block& W, double a, double& pn) 
   pn = std::max(-a, -bn / W.wnn);
 }
 
-template <class L>
-inline void solve_local(double bn, double bt, const Block& W, double mu, double a, double& pn,
-                        double& pt) {
-  if constexpr (L::friction) {
-    solve_coulomb(bn, bt, W, mu, a, pn, pt);
-  } else {
-    solve_frictionless(bn, W, a, pn);
-    pt = 0.0;
-  }
-}
-
 // Natural-map residual of the law at (u, p), in impulse units (rho = 1/W_nn):
 //   r_n = (p_n + a) - max(0, p_n + a - rho u_n)
 //   r_t = p_t - clamp(p_t - rho u_t, -mu (p_n + a), mu (p_n + a))

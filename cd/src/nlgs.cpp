@@ -62,17 +62,16 @@ struct RowBlock {
 };
 
 struct BlockStats {
-  double dp2max = 0, dp2sum = 0, psum = 0, rmax = 0, rsum = 0;
+  double dp2sum = 0, psum = 0, rmax = 0, rsum = 0;
 };
 
 template <class L, bool Rot>
 void run_block(const RowBlock& k, ContactRow* rows, BodyVel* vel, BlockStats& s) {
-  double dmax = 0, dsum = 0, psum = 0;
+  double dsum = 0, psum = 0;
   if (k.write1) {
     for (int i = k.begin; i < k.end; ++i) {
       double dp2, pabs;
       update_row<L, Rot, true>(rows[i], vel, dp2, pabs);
-      dmax = std::max(dmax, dp2);
       dsum += dp2;
       psum += pabs;
     }
@@ -80,12 +79,10 @@ void run_block(const RowBlock& k, ContactRow* rows, BodyVel* vel, BlockStats& s)
     for (int i = k.begin; i < k.end; ++i) {
       double dp2, pabs;
       update_row<L, Rot, false>(rows[i], vel, dp2, pabs);
-      dmax = std::max(dmax, dp2);
       dsum += dp2;
       psum += pabs;
     }
   }
-  s.dp2max = dmax;
   s.dp2sum = dsum;
   s.psum = psum;
 }
@@ -156,15 +153,13 @@ SolveStats nlgs_impl(std::vector<ContactRow>& rows, const Colouring& col,
 #pragma omp single
       {
         ++it;
-        double dmax = 0, dsum = 0, psum = 0;
+        double dsum = 0, psum = 0;
         for (int b = 0; b < nb; ++b) {
-          dmax = std::max(dmax, bs[b].dp2max);
           dsum += bs[b].dp2sum;
           psum += bs[b].psum;
         }
         st.p_mean = psum / n;
         const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
-        st.dp_max_rel = std::sqrt(dmax) / scale;
         st.dp_rel = std::sqrt(dsum / n) / scale;
         st.iterations = it;
         if (it >= prm.max_iter) done = true;

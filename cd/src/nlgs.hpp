@@ -33,7 +33,6 @@ struct SolveStats {
   int iterations = 0;
   bool cap_hit = false;
   double dp_rel = 0;         // last sweep's rms |dp| / mean |p| (the convergence test)
-  double dp_max_rel = 0;     // last sweep's max |dp| / mean |p|
   double residual_max = 0;   // law residual, max over contacts / mean |p|
   double residual_mean = 0;  // law residual, mean over contacts / mean |p|
   double p_mean = 0;         // mean |p| (impulse scale)
