@@ -116,14 +116,10 @@ TEST(Cohesion, ZeroAdhesionThroughTheCohesiveSweepIsBitIdentical) {
   ASSERT_GT(rows.size(), 100u);
   const cd::Colouring col = cd::colour_rows(rows, w.bodies);
   auto solve = [&](bool adhesion) {
-    auto r = rows;
-    auto v = w.bodies.vel;
-    cd::SolverParams sp;
+    cd::SolverParams sp = cdtest::tight_solver();
     sp.adhesion = adhesion;
-    sp.tol = 1e-8;
-    sp.max_iter = 500;
-    cd::nlgs_solve(r, col, v, sp);
-    return std::make_pair(r, v);
+    const auto c = cdtest::solve_copy(rows, col, w.bodies.vel, sp);
+    return std::make_pair(c.rows, c.vel);
   };
   const auto [r1, v1] = solve(true);
   const auto [r0, v0] = solve(false);

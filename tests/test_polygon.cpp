@@ -215,6 +215,15 @@ void fill_polygons(cd::World& w, int count, int n, double W, double rmin, double
   w.bodies.add_wall({W, 0}, {W, 1e3});
 }
 
+// The hard-case piles: dt = 2e-3 (1/160 of sqrt(d/g)), tol 1e-4, cap 1000.
+cd::WorldParams pile_params(double alert) {
+  auto p = params(2e-3, 9.81, 0.4);
+  p.solver.tol = 1e-4;
+  p.solver.max_iter = 1000;
+  p.alert = alert;
+  return p;
+}
+
 void expect_hard_case(const char* name, cd::World& w, int steps, double overlap_bound) {
   const double mgd = total_mass(w) * 9.81;
   const cdtest::Watch r = cdtest::run_watched(w, steps);
@@ -228,32 +237,20 @@ void expect_hard_case(const char* name, cd::World& w, int steps, double overlap_
 }  // namespace
 
 TEST(PolygonHardCases, DensePileOfTriangles) {
-  auto p = params(2e-3, 9.81, 0.4);
-  p.solver.tol = 1e-4;
-  p.solver.max_iter = 1000;
-  p.alert = 0.2;
-  cd::World w(p);
+  cd::World w(pile_params(0.2));
   fill_polygons(w, 60, 3, 8, 0.4, 0.6, 11);
   // Overlap: triangles land at ~sqrt(2 g h) ~ 12 d/s, 0.02 d per half step.
   expect_hard_case("pile of triangles", w, 1200, 5e-2);
 }
 
 TEST(PolygonHardCases, DensePileOfSixtyGons) {
-  auto p = params(2e-3, 9.81, 0.4);
-  p.solver.tol = 1e-4;
-  p.solver.max_iter = 1000;
-  p.alert = 0.2;
-  cd::World w(p);
+  cd::World w(pile_params(0.2));
   fill_polygons(w, 60, 60, 8, 0.4, 0.6, 12);
   expect_hard_case("pile of 60-gons", w, 1200, 5e-2);
 }
 
 TEST(PolygonHardCases, SquaresWithDisksTenTimesSmaller) {
-  auto p = params(2e-3, 9.81, 0.4);
-  p.solver.tol = 1e-4;
-  p.solver.max_iter = 1000;
-  p.alert = 0.1;
-  cd::World w(p);
+  cd::World w(pile_params(0.1));
   // squares of circumradius ~0.5 and clusters of 9 disks of radius 0.05
   fill_polygons(w, 48, 4, 8, 0.45, 0.55, 13, 4, 0.05);
   expect_hard_case("squares with small disks", w, 1200, 5e-2);

@@ -72,6 +72,27 @@ inline void fill_box(cd::World& w, int n, double W, double H, double dmin, doubl
   w.bodies.add_wall({W, 0}, {W, H});
 }
 
+// Solves a copy of the rows from the given body velocities with `sp` (tol
+// 1e-8, 500 sweeps unless set): for tests that compare two sweep variants on
+// the same problem.
+struct SolvedCopy {
+  std::vector<cd::ContactRow> rows;
+  std::vector<cd::BodyVel> vel;
+  int iterations;
+};
+inline SolvedCopy solve_copy(const std::vector<cd::ContactRow>& rows, const cd::Colouring& col,
+                             const std::vector<cd::BodyVel>& vel, cd::SolverParams sp) {
+  SolvedCopy out{rows, vel, 0};
+  out.iterations = cd::nlgs_solve(out.rows, col, out.vel, sp).iterations;
+  return out;
+}
+inline cd::SolverParams tight_solver() {
+  cd::SolverParams sp;
+  sp.tol = 1e-8;
+  sp.max_iter = 500;
+  return sp;
+}
+
 inline double total_mass(const cd::World& w) {
   double m = 0;
   for (std::size_t i = 0; i < w.bodies.size(); ++i)
