@@ -38,7 +38,8 @@ void compare(const Scene& x, const Scene& y, bool same) {
   const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, adhesion, debond, tol,
                max_iter, threads, n, d_mean, size_ratio, size_dist, density, seed, nsides, region,
                box_width, box_height, disks, walls, series_interval, snapshot_interval,
-               checkpoint_interval, quiet] = x;
+               checkpoint_interval, quiet, shear_mode, cell_width, cell_height, pressure,
+               inertial_number, cell_mass, isotropic, strain, dt_tp, start, cohesion_number] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
@@ -47,6 +48,9 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
   CHECK_FIELD(box_height); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
   CHECK_FIELD(checkpoint_interval); CHECK_FIELD(quiet);
+  CHECK_FIELD(shear_mode); CHECK_FIELD(cell_width); CHECK_FIELD(cell_height); CHECK_FIELD(pressure);
+  CHECK_FIELD(inertial_number); CHECK_FIELD(cell_mass); CHECK_FIELD(isotropic); CHECK_FIELD(strain);
+  CHECK_FIELD(dt_tp); CHECK_FIELD(start); CHECK_FIELD(cohesion_number);
   if (same) {
     ASSERT_EQ(disks.size(), y.disks.size());
     ASSERT_EQ(walls.size(), y.walls.size());
@@ -88,6 +92,17 @@ Scene nondefault() {
   s.snapshot_interval = 0.0;
   s.checkpoint_interval = 0.05;
   s.quiet = true;
+  s.shear_mode = "walls";
+  s.cell_width = 0.05;
+  s.cell_height = 0.02;
+  s.pressure = 100.0;
+  s.inertial_number = 0.01;
+  s.cell_mass = 2.0;
+  s.isotropic = true;
+  s.strain = 3.0;
+  s.dt_tp = 0.1;
+  s.start = "prep/checkpoint.bin";
+  s.cohesion_number = 5.0;
   s.disks = {{{0.05, 0.1}, {1.0, -2.0}, 1e-3, 3.0, 5.0, 4, 0.25, {0.5, -0.5}},
              {{0.02, 0.03}, {0.0, 0.5}, 2e-3, -1.0, -1.0, 60, -1.5, {-1.0, 2.0}}};
   s.walls = {{{0.0, 0.3}, {0.1, 0.25}, {0.0, -0.01}, 0.5}, {{-1.0, 0.0}, {-1.0, 1.0}, {0.2, 0.0}, -0.5}};
@@ -315,9 +330,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 30 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 41 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 30u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 41u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer >= 1 |"), std::string::npos) << md;

@@ -39,6 +39,7 @@ inline std::uint64_t state_hash(const cd::World& w) {
     mix(&b.angle[i], sizeof(double));
     mix(&b.vel[i], 3 * sizeof(double));
   }
+  mix(&w.cell, sizeof(w.cell));
   return h;
 }
 

@@ -21,7 +21,7 @@ static_assert(std::endian::native == std::endian::little,
               "checkpoints store raw little-endian values");
 
 constexpr std::string_view kMagic = "CDLABCKP";
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: the periodic cell
 
 // Every Bodies array, listed once: the writer and the reader both walk this
 // list, so a new Bodies member is one line here.
@@ -130,6 +130,7 @@ void save_checkpoint(const std::string& path, const World& w, std::uint64_t scen
   for_each_array(w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
   o.array("warm.keys", w.warm_start().keys);
   o.array("warm.p", w.warm_start().p);
+  o.array("cell", std::vector<CellState>{w.cell});
   o.put(fnv1a(o.buf));
   write_file_atomic(path, o.buf);  // binary-safe: the string is written as is
 }
@@ -168,6 +169,9 @@ std::uint64_t load_checkpoint(const std::string& path, World& w) {
   in.array("warm.keys", warm.keys);
   in.array("warm.p", warm.p);
   if (warm.keys.size() != warm.p.size()) in.fail("is corrupt (warm-start sizes differ)");
+  std::vector<CellState> cell;
+  in.array("cell", cell);
+  if (cell.size() != 1) in.fail("is corrupt (cell state)");
   if (!in.rest.empty()) in.fail("has unexpected data after the last array");
 
   w.bodies = std::move(b);
@@ -175,6 +179,7 @@ std::uint64_t load_checkpoint(const std::string& path, World& w) {
   w.time = time;
   w.times = times;
   w.set_warm_start(std::move(warm));
+  w.cell = cell[0];
   return key;
 }
 

@@ -64,6 +64,12 @@ Rule side_list() {
             return !r.empty() && std::all_of(r.begin(), r.end(), valid_sides);
           }};
 }
+Rule shear_mode() {
+  return {"\"none\", \"periodic\" or \"walls\"", [](const Val& v) {
+            const auto& m = std::get<std::string>(v);
+            return m == "none" || m == "periodic" || m == "walls";
+          }};
+}
 Rule disk_density() {
   return {"> 0, or -1 (particles.density)", [](const Val& v) { return num(v) > 0 || num(v) == -1; }};
 }
@@ -97,6 +103,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"contact", "rotation", &Scene::rotation, "", any(), "integrate particle rotations"},
       {"contact", "adhesion", &Scene::adhesion, "N", ge(0), "pull-off force f_a of the adhesion-shifted Signorini law, on contacts with gap <= debond; 0: no cohesion (no adhesion work at all)"},
       {"contact", "debond", &Scene::debond, "d_mean", ge(0), "debonding distance delta_a, in mean diameters: a bond breaks beyond it"},
+      {"contact", "cohesion_number", &Scene::cohesion_number, "", ge(0), "cohesion number eta: f_a = eta p d with the imposed shear.pressure p and the mean diameter d (instead of contact.adhesion); 0: use contact.adhesion"},
       {"contact", "overlap_correction", &Scene::overlap_correction, "", in(0, 1), "beta: an overlapping contact must separate at beta |gap|/dt; injects energy (bounded by the series column correction_work); 0: pure CD, overlaps never pushed apart"},
       {"solver", "tol", &Scene::tol, "", gt(0), "NLGS convergence tolerance (relative)"},
       {"solver", "max_iter", &Scene::max_iter, "", ge(1), "NLGS iteration cap per time step"},
@@ -115,6 +122,16 @@ const std::vector<Param<Scene>>& scene_params() {
       {"output", "snapshot_interval", &Scene::snapshot_interval, "s", ge(0), "time between VTK snapshots; 0: none"},
       {"output", "checkpoint_interval", &Scene::checkpoint_interval, "s", ge(0), "time between checkpoints (checkpoint.bin: rerunning the same command resumes), rounded up to whole series intervals; 0: none"},
       {"output", "quiet", &Scene::quiet, "", any(), "no progress output"},
+      {"shear", "mode", &Scene::shear_mode, "", shear_mode(), "boundary protocol: none; periodic (bi-periodic Lees-Edwards cell, height a dof at imposed pressure); walls (rough walls of glued grains, periodic in x, top wall at imposed velocity and pressure)"},
+      {"shear", "width", &Scene::cell_width, "m", ge(0), "cell width (period in x)"},
+      {"shear", "height", &Scene::cell_height, "m", ge(0), "initial cell height (periodic) or gap between the wall grains' centres (walls)"},
+      {"shear", "pressure", &Scene::pressure, "N/m", ge(0), "imposed normal stress sigma_yy (2D: force per length)"},
+      {"shear", "inertial_number", &Scene::inertial_number, "", ge(0), "imposed inertial number I: shear rate = I sqrt(p/rho)/d (walls: top wall speed = shear rate x initial gap); 0: no shear"},
+      {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width) degree of freedom, in units of the particles' total mass"},
+      {"shear", "isotropic", &Scene::isotropic, "", any(), "compaction: the width is a degree of freedom too, at sigma_xx = pressure (periodic, inertial_number = 0)"},
+      {"shear", "strain", &Scene::strain, "", ge(0), "run until this shear strain (overrides time.duration); 0: use time.duration"},
+      {"shear", "dt_tp", &Scene::dt_tp, "t_p", ge(0), "time step in units of t_p = d sqrt(rho/p) (overrides time.dt); 0: use time.dt"},
+      {"shear", "start", &Scene::start, "", any(), "checkpoint.bin of a preparation run (same particles) to start from, with the cell it reached; \"\": generate particles"},
   };
   return t;
 }

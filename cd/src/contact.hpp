@@ -39,6 +39,12 @@ struct ContactInfo {
   double gap;            // signed gap at the midpoint configuration (< 0: overlap)
   double px, py;         // contact point (midpoint configuration)
   ContactType type;
+  // Branch vector from the centre of body 1 to the centre of body 2, or of
+  // the periodic image of body 2 that is touched (midpoint configuration).
+  double lx = 0.0, ly = 0.0;
+  // That image, in cells: body 2 is seen shifted by ix widths and iy heights
+  // (iy = +-1 across a Lees-Edwards boundary also shifts x by the offset).
+  std::int8_t ix = 0, iy = 0;
 };
 
 inline std::uint64_t contact_key(std::int32_t b1, std::int32_t b2, int point) {

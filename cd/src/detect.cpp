@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <omp.h>
 
@@ -214,47 +215,86 @@ int segment_polygon(int w, int p, const Vec2& wa, const Vec2& wb, const Vec2& wc
 
 namespace {
 
-PolyView poly_view(const Bodies& b, const std::vector<Vec2>& x, const std::vector<double>& th,
-                   int i) {
-  return {x[i], b.radius[i], th[i], b.nsides[i]};
+// The image of body j a pair is computed with: j seen at x[j] + s.
+struct Image {
+  Vec2 s = Vec2::Zero();
+  std::int8_t ix = 0, iy = 0;
+  Image operator-() const { return {-s, static_cast<std::int8_t>(-ix), static_cast<std::int8_t>(-iy)}; }
+};
+
+PolyView poly_view(const Bodies& b, const Vec2& c, const std::vector<double>& th, int i) {
+  return {c, b.radius[i], th[i], b.nsides[i]};
 }
 
-// All contacts of the pair (i < j). Poly = false: the scene has only disks,
-// and the shape dispatch is compiled out.
+// All contacts of the pair (i < j), with j seen through image im. Poly =
+// false: the scene has only disks, and the shape dispatch is compiled out.
 template <bool Poly>
 void pair_contacts(const Bodies& b, const std::vector<Vec2>& x, const std::vector<double>& th,
-                   int i, int j, double alert, std::vector<ContactRow>& R,
+                   int i, int j, const Image& im, double alert, std::vector<ContactRow>& R,
                    std::vector<ContactInfo>& I) {
+  if (b.driven[i] && b.driven[j]) return;  // bodies glued to one wall, or to two
+  const std::size_t n0 = R.size();
+  const Vec2 xj = x[j] + im.s;
   ContactRow row;
   ContactInfo inf;
   if (!Poly || (b.nsides[i] == 0 && b.nsides[j] == 0)) {
-    if (disk_disk(i, j, x[i], x[j], b.radius[i], b.radius[j], alert, row, inf)) {
+    if (disk_disk(i, j, x[i], xj, b.radius[i], b.radius[j], alert, row, inf)) {
       R.push_back(row);
       I.push_back(inf);
     }
-    return;
-  }
-  if constexpr (Poly) {
+  } else if constexpr (Poly) {
     // Bounding circles first: cheap rejection before the polygon geometry.
     const double reach = b.radius[i] + b.radius[j] + alert;
-    if ((x[j] - x[i]).squaredNorm() > reach * reach) return;
+    if ((xj - x[i]).squaredNorm() > reach * reach) return;
     if (b.nsides[i] > 0 && b.nsides[j] > 0) {
-      polygon_polygon(i, j, poly_view(b, x, th, i), poly_view(b, x, th, j), alert, R, I);
+      polygon_polygon(i, j, poly_view(b, x[i], th, i), poly_view(b, xj, th, j), alert, R, I);
     } else {
-      const int p = b.nsides[i] > 0 ? i : j, k = p == i ? j : i;
-      if (polygon_disk(p, k, poly_view(b, x, th, p), x[k], b.radius[k], alert, row, inf)) {
+      const bool pi = b.nsides[i] > 0;
+      const int p = pi ? i : j, k = pi ? j : i;
+      if (polygon_disk(p, k, poly_view(b, pi ? x[i] : xj, th, p), pi ? xj : x[i], b.radius[k],
+                       alert, row, inf)) {
         R.push_back(row);
         I.push_back(inf);
       }
     }
   }
+  // Branch vectors and images, whichever body the narrow phase made body 1.
+  for (std::size_t k = n0; k < R.size(); ++k) {
+    const bool fwd = R[k].b1 == i;
+    const Image m = fwd ? im : -im;
+    const Vec2 l = x[R[k].b2] + m.s - x[R[k].b1];
+    I[k].lx = l.x();
+    I[k].ly = l.y();
+    I[k].ix = m.ix;
+    I[k].iy = m.iy;
+  }
 }
 
-template <bool Poly>
+// One axis of the grid: origin, cell size and count, periodic or not.
+struct Axis {
+  double lo = 0, h = 1;
+  int n = 1;
+  bool periodic = false;
+  double length = 0;  // period
+  int cell(double v) const { return std::clamp(static_cast<int>(std::floor((v - lo) / h)), 0, n - 1); }
+};
+
+template <bool Poly, bool Periodic>
 void grid_pairs(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<double>& th,
-                double alert, int ncx, int ncy, const std::vector<int>& cs,
-                const std::vector<int>& it, std::vector<ContactRow>& R,
-                std::vector<ContactInfo>& I) {
+                double alert, const Axis& ax, const Axis& ay, double offset,
+                const std::vector<int>& cs, const std::vector<int>& it,
+                std::vector<ContactRow>& R, std::vector<ContactInfo>& I) {
+  const int ncx = ax.n, ncy = ay.n;
+  // The pair (i, j) is computed from the lower index, with j's image.
+  auto visit_cell = [&](int i, int cn, const Image& im) {
+    for (int b = cs[cn]; b < cs[cn + 1]; ++b) {
+      const int j = it[b];
+      if (i < j)
+        pair_contacts<Poly>(bodies, x, th, i, j, im, alert, R, I);
+      else
+        pair_contacts<Poly>(bodies, x, th, j, i, -im, alert, R, I);
+    }
+  };
   // Half of the 3x3 stencil: the cell itself and E, NW, N, NE neighbours.
   static constexpr int off[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
 #pragma omp for schedule(static)
@@ -263,27 +303,67 @@ void grid_pairs(const Bodies& bodies, const std::vector<Vec2>& x, const std::vec
       const int c = cy * ncx + cx;
       for (int a = cs[c]; a < cs[c + 1]; ++a) {
         const int i = it[a];
-        for (int b = a + 1; b < cs[c + 1]; ++b) pair_contacts<Poly>(bodies, x, th, i, it[b], alert, R, I);
+        for (int b = a + 1; b < cs[c + 1]; ++b)
+          pair_contacts<Poly>(bodies, x, th, i, it[b], Image{}, alert, R, I);
         for (const auto& o : off) {
-          const int nx = cx + o[0], ny = cy + o[1];
-          if (nx < 0 || nx >= ncx || ny >= ncy) continue;
-          const int cn = ny * ncx + nx;
-          for (int b = cs[cn]; b < cs[cn + 1]; ++b) {
-            // frame from the lower to the higher index (polygons may flip it)
-            const int p = std::min(i, it[b]), q = std::max(i, it[b]);
-            pair_contacts<Poly>(bodies, x, th, p, q, alert, R, I);
+          int nx = cx + o[0], ny = cy + o[1];
+          Image im;
+          if constexpr (Periodic) {
+            if (ny == ncy) {
+              if (!ay.periodic) continue;
+              if (o[0] != 0) continue;  // the top row's neighbours above, all at once below
+              // Lees-Edwards: the bottom row seen above the top shifted by
+              // (offset, height). Images within reach of cell cx lie over
+              // [(cx - 1) h, (cx + 2) h): up to 4 cells of the bottom row.
+              const double xlo = (cx - 1) * ax.h - offset, xhi = (cx + 2) * ax.h - offset;
+              const int k0 = static_cast<int>(std::floor(xlo / ax.h));
+              const int k1 = static_cast<int>(std::ceil(xhi / ax.h)) - 1;
+              for (int kr = k0; kr <= k1; ++kr) {
+                const int k = ((kr % ncx) + ncx) % ncx;
+                const int m = (kr - k) / ncx;
+                visit_cell(i, k, {Vec2(m * ax.length + offset, ay.length),
+                                  static_cast<std::int8_t>(m), 1});
+              }
+              continue;
+            }
+            if (nx < 0 || nx >= ncx) {
+              if (!ax.periodic) continue;
+              const int m = nx < 0 ? -1 : 1;
+              nx -= m * ncx;
+              im = {Vec2(m * ax.length, 0.0), static_cast<std::int8_t>(m), 0};
+            }
+          } else {
+            if (nx < 0 || nx >= ncx || ny >= ncy) continue;
           }
+          visit_cell(i, ny * ncx + nx, im);
         }
       }
     }
   }
 }
 
+// Grid axis over [lo, hi] (open) or over the period [0, length).
+Axis make_axis(double lo, double hi, double h, bool periodic, double length) {
+  Axis a;
+  a.periodic = periodic;
+  if (periodic) {
+    a.length = length;
+    a.lo = 0.0;
+    a.n = std::max(1, static_cast<int>(std::floor(length / h)));
+    a.h = length / a.n;
+  } else {
+    a.lo = lo;
+    a.h = h;
+    a.n = static_cast<int>((hi - lo) / h) + 1;
+  }
+  return a;
+}
+
 }  // namespace
 
 void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<double>& th,
             double alert, CellGrid& grid, std::vector<ContactRow>& rows,
-            std::vector<ContactInfo>& info) {
+            std::vector<ContactInfo>& info, const PeriodicCell* cell) {
   rows.clear();
   info.clear();
   const int nb = static_cast<int>(bodies.size());
@@ -313,17 +393,21 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
 
   if (nd > 0) {
     double h = 2 * rmax + alert;
-    const Vec2 ext = hi - lo;
+    const bool px = cell && cell->x, py = cell && cell->y;
     // Bound the cell count by ~4 cells a particle, so that a runaway particle
-    // cannot blow up memory: the grid coarsens instead.
-    while ((std::floor(ext.x() / h) + 1) * (std::floor(ext.y() / h) + 1) > 4.0 * nd + 16) h *= 1.5;
-    const int ncx = static_cast<int>(ext.x() / h) + 1;
-    const int ncy = static_cast<int>(ext.y() / h) + 1;
-    auto cell_of = [&](int i) {
-      const int cx = std::min(ncx - 1, static_cast<int>((x[i].x() - lo.x()) / h));
-      const int cy = std::min(ncy - 1, static_cast<int>((x[i].y() - lo.y()) / h));
-      return cy * ncx + cx;
-    };
+    // cannot blow up memory: the grid coarsens instead. (A periodic axis
+    // has its own bounded length.)
+    auto count = [&](double e, bool p, double len) { return std::floor((p ? len : e) / h) + 1; };
+    while (count(hi.x() - lo.x(), px, cell ? cell->width : 0) *
+               count(hi.y() - lo.y(), py, cell ? cell->height : 0) > 4.0 * nd + 16)
+      h *= 1.5;
+    const Axis ax = make_axis(lo.x(), hi.x(), h, px, cell ? cell->width : 0);
+    const Axis ay = make_axis(lo.y(), hi.y(), h, py, cell ? cell->height : 0);
+    if ((px && ax.n < 4) || (py && ay.n < 3))
+      throw std::runtime_error(
+          "periodic cell too small: it must span at least 4 (x) and 3 (y) times 2 r_max + alert");
+    const int ncx = ax.n, ncy = ay.n;
+    auto cell_of = [&](int i) { return ay.cell(x[i].y()) * ncx + ax.cell(x[i].x()); };
     grid.cell_start.assign(static_cast<std::size_t>(ncx) * ncy + 1, 0);
     for (int i : parts) ++grid.cell_start[cell_of(i) + 1];
     for (std::size_t c = 0; c + 1 < grid.cell_start.size(); ++c)
@@ -333,6 +417,7 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
       std::vector<int> fill(grid.cell_start.begin(), grid.cell_start.end() - 1);
       for (int i : parts) grid.items[fill[cell_of(i)]++] = i;  // ascending index inside a cell
     }
+    const double offset = cell ? cell->offset : 0.0;
     // Small systems detect on one thread: waking a team costs more than the
     // work, and much more on a loaded machine.
 #pragma omp parallel if (nd >= kMinParallelDetect)
@@ -341,10 +426,19 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
       auto& I = grid.info_t[omp_get_thread_num()];
       R.clear();
       I.clear();
-      if (poly)
-        grid_pairs<true>(bodies, x, th, alert, ncx, ncy, grid.cell_start, grid.items, R, I);
-      else
-        grid_pairs<false>(bodies, x, th, alert, ncx, ncy, grid.cell_start, grid.items, R, I);
+      const auto& cs = grid.cell_start;
+      const auto& it = grid.items;
+      if (cell) {
+        if (poly)
+          grid_pairs<true, true>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
+        else
+          grid_pairs<false, true>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
+      } else {
+        if (poly)
+          grid_pairs<true, false>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
+        else
+          grid_pairs<false, false>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
+      }
     }
     for (int t = 0; t < nthreads; ++t) {
       rows.insert(rows.end(), grid.rows_t[t].begin(), grid.rows_t[t].end());
@@ -358,13 +452,19 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
   for (int w : walls) {
     const Vec2 e(std::cos(th[w]), std::sin(th[w]));
     const Vec2 a = x[w] - bodies.radius[w] * e, b = x[w] + bodies.radius[w] * e;
+    const std::size_t n0 = rows.size();
     for (int k : parts) {
+      if (bodies.driven[k]) continue;
       if (bodies.nsides[k] > 0) {
-        segment_polygon(w, k, a, b, x[w], poly_view(bodies, x, th, k), alert, rows, info);
+        segment_polygon(w, k, a, b, x[w], poly_view(bodies, x[k], th, k), alert, rows, info);
       } else if (segment_disk(w, k, a, b, x[w], x[k], bodies.radius[k], alert, row, inf)) {
         rows.push_back(row);
         info.push_back(inf);
       }
+    }
+    for (std::size_t k = n0; k < rows.size(); ++k) {
+      info[k].lx = x[rows[k].b2].x() - x[w].x();
+      info[k].ly = x[rows[k].b2].y() - x[w].y();
     }
   }
 }

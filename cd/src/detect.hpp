@@ -11,6 +11,17 @@
 
 namespace cd {
 
+// Periodic boundaries (method.md section 9): the cell [0, width) x [0,
+// height), periodic in x and/or y. Across the top boundary the images are
+// Lees-Edwards images: a body at (x, y) is seen at (x + offset, y + height)
+// (plus any multiple of the width). Periodic directions need at least 4
+// (x) and 3 (y) grid cells of 2 r_max + alert: detect throws otherwise.
+struct PeriodicCell {
+  bool x = false, y = false;
+  double width = 0.0, height = 0.0;
+  double offset = 0.0;  // in [0, width)
+};
+
 struct CellGrid {  // scratch kept between steps to avoid reallocation
   std::vector<int> cell_start, items;
   std::vector<std::vector<ContactRow>> rows_t;
@@ -19,10 +30,11 @@ struct CellGrid {  // scratch kept between steps to avoid reallocation
 
 // Candidate contacts with gap <= alert among the bodies at positions x and
 // angles th. Fills geometry only (b1, b2, frame, lever arms, gap, point);
-// the caller fills W blocks, offsets and impulses.
+// the caller fills W blocks, offsets and impulses. cell: periodic
+// boundaries, or nullptr for none (the scene's choice, made once).
 void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<double>& th,
             double alert, CellGrid& grid, std::vector<ContactRow>& rows,
-            std::vector<ContactInfo>& info);
+            std::vector<ContactInfo>& info, const PeriodicCell* cell = nullptr);
 
 // Narrow phase of one disk pair (i < j), frame from i to j. Returns false if
 // the gap exceeds alert.

@@ -109,10 +109,15 @@ void push_blocks(std::vector<RowBlock>& out, int begin, int end, bool write1) {
 
 template <class L, bool Rot>
 SolveStats nlgs_impl(std::vector<ContactRow>& rows, const Colouring& col,
-                     std::vector<BodyVel>& vel, const SolverParams& prm) {
+                     std::vector<BodyVel>& vel, const SolverParams& prm,
+                     std::vector<BoundaryDof>* dofs) {
   SolveStats st;
   const int n = static_cast<int>(rows.size());
-  if (n == 0) return st;
+  if (n == 0) {
+    if (dofs)
+      for (BoundaryDof& d : *dofs) d.v = d.v0;
+    return st;
+  }
 
   const int ncol = static_cast<int>(col.start.size()) - 1;
   std::vector<RowBlock> blocks;
@@ -162,15 +167,18 @@ SolveStats nlgs_impl(std::vector<ContactRow>& rows, const Colouring& col,
         const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
         st.dp_rel = std::sqrt(dsum / n) / scale;
         st.iterations = it;
+        st.dof_rel = 0.0;
+        if (dofs)
+          for (BoundaryDof& d : *dofs) st.dof_rel = std::max(st.dof_rel, update_dof(d, R));
         if (it >= prm.max_iter) done = true;
-        if (st.dp_rel < prm.tol) done = true;
+        if (st.dp_rel < prm.tol && st.dof_rel < prm.tol) done = true;
       }
       // implicit barrier: every thread sees the same 'done'
     }
   }
 
   law_residuals(rows, vel, prm, st);
-  st.cap_hit = st.dp_rel >= prm.tol;
+  st.cap_hit = st.dp_rel >= prm.tol || st.dof_rel >= prm.tol;
   return st;
 }
 
@@ -262,19 +270,38 @@ void law_residuals(const std::vector<ContactRow>& rows, const std::vector<BodyVe
   st.residual_mean = rsum / n / scale;
 }
 
+double update_dof(BoundaryDof& d, ContactRow* rows) {
+  double s = 0.0;
+  const std::size_t m = d.rows.size();
+  for (std::size_t k = 0; k < m; ++k) {
+    const ContactRow& r = rows[d.rows[k]];
+    s += d.an[k] * r.pn + d.at[k] * r.pt;
+  }
+  const double v = d.v0 + d.inv_mass * s;
+  const double dv = v - d.v;
+  for (std::size_t k = 0; k < m; ++k) {
+    ContactRow& r = rows[d.rows[k]];
+    r.bn += d.an[k] * dv;
+    r.bt += d.at[k] * dv;
+  }
+  d.v = v;
+  return std::abs(dv) / (d.inv_mass * d.scale);
+}
+
 SolveStats nlgs_solve(std::vector<ContactRow>& rows, const Colouring& col,
-                      std::vector<BodyVel>& vel, const SolverParams& prm) {
+                      std::vector<BodyVel>& vel, const SolverParams& prm,
+                      std::vector<BoundaryDof>* dofs) {
   // The law is resolved once here, never inside the sweep.
   const int key = (prm.friction ? 4 : 0) | (prm.adhesion ? 2 : 0) | (prm.rotation ? 1 : 0);
   switch (key) {
-    case 0: return nlgs_impl<Law<false, false>, false>(rows, col, vel, prm);
-    case 1: return nlgs_impl<Law<false, false>, true>(rows, col, vel, prm);
-    case 2: return nlgs_impl<Law<false, true>, false>(rows, col, vel, prm);
-    case 3: return nlgs_impl<Law<false, true>, true>(rows, col, vel, prm);
-    case 4: return nlgs_impl<Law<true, false>, false>(rows, col, vel, prm);
-    case 5: return nlgs_impl<Law<true, false>, true>(rows, col, vel, prm);
-    case 6: return nlgs_impl<Law<true, true>, false>(rows, col, vel, prm);
-    default: return nlgs_impl<Law<true, true>, true>(rows, col, vel, prm);
+    case 0: return nlgs_impl<Law<false, false>, false>(rows, col, vel, prm, dofs);
+    case 1: return nlgs_impl<Law<false, false>, true>(rows, col, vel, prm, dofs);
+    case 2: return nlgs_impl<Law<false, true>, false>(rows, col, vel, prm, dofs);
+    case 3: return nlgs_impl<Law<false, true>, true>(rows, col, vel, prm, dofs);
+    case 4: return nlgs_impl<Law<true, false>, false>(rows, col, vel, prm, dofs);
+    case 5: return nlgs_impl<Law<true, false>, true>(rows, col, vel, prm, dofs);
+    case 6: return nlgs_impl<Law<true, true>, false>(rows, col, vel, prm, dofs);
+    default: return nlgs_impl<Law<true, true>, true>(rows, col, vel, prm, dofs);
   }
 }
 

@@ -29,6 +29,20 @@ struct SolverParams {
   int min_parallel = 4096;
 };
 
+// A boundary degree of freedom solved with the contacts: a scalar velocity v
+// (a periodic cell's height rate, a wall's normal velocity) that enters the
+// relative velocity of some rows, u_n += an v and u_t += at v, and on which
+// their impulses act back (the transpose): v = v0 + inv_mass sum (an p_n +
+// at p_t), v0 holding the external impulse (imposed stress). Updated after
+// every sweep (Gauss-Seidel on one more body); the change of v goes into the
+// rows' offsets bn, bt, so the sweep itself does not know it exists.
+struct BoundaryDof {
+  double v0 = 0.0, v = 0.0, inv_mass = 0.0;
+  double scale = 1.0;  // impulse scale of the convergence test (|imposed impulse|)
+  std::vector<std::int32_t> rows;
+  std::vector<double> an, at;
+};
+
 struct SolveStats {
   int iterations = 0;
   bool cap_hit = false;
@@ -36,6 +50,7 @@ struct SolveStats {
   double residual_max = 0;   // law residual, max over contacts / mean |p|
   double residual_mean = 0;  // law residual, mean over contacts / mean |p|
   double p_mean = 0;         // mean |p| (impulse scale)
+  double dof_rel = 0;        // last sweep's largest |dv| / (inv_mass scale) of the boundary dofs
 };
 
 // Colouring: rows are permuted so that colour c is [start[c], start[c+1]);
@@ -56,8 +71,14 @@ void apply_impulses(const std::vector<ContactRow>& rows, std::vector<BodyVel>& v
 
 // Solves the rows in place (p and the body velocities), starting from the
 // impulses already held in the rows, which must already be applied to vel.
+// Boundary dofs, if any, are updated after each sweep and must converge too.
 SolveStats nlgs_solve(std::vector<ContactRow>& rows, const Colouring& col,
-                      std::vector<BodyVel>& vel, const SolverParams& prm);
+                      std::vector<BodyVel>& vel, const SolverParams& prm,
+                      std::vector<BoundaryDof>* dofs = nullptr);
+
+// One Gauss-Seidel update of a boundary dof from the rows' impulses; returns
+// |dv| / (inv_mass scale).
+double update_dof(BoundaryDof& d, ContactRow* rows);
 
 // Relative velocity (u_n, u_t) of a row from body velocities.
 inline void row_velocity(const ContactRow& r, const std::vector<BodyVel>& vel, bool rotation,

@@ -258,6 +258,7 @@ vtkSmartPointer<vtkPolyData> contacts(const World& w) {
   auto gap = make_array<vtkDoubleArray>("gap", 1, n);
   auto b1 = make_array<vtkIntArray>("b1", 1, n);
   auto b2 = make_array<vtkIntArray>("b2", 1, n);
+  auto branch = make_array<vtkDoubleArray>("branch", 3, n);
   for (vtkIdType k = 0; k < n; ++k) {
     const ContactRow& r = rows[k];
     const ContactInfo& c = infos[k];
@@ -266,7 +267,10 @@ vtkSmartPointer<vtkPolyData> contacts(const World& w) {
     auto end = [&](std::int32_t i) {
       return b.shape[i] == Shape::Segment ? Vec2(c.px, c.py) : b.pos[i];
     };
-    const Vec2 x1 = end(r.b1), x2 = end(r.b2);
+    // Across a periodic boundary the line goes to the image of body 2 that
+    // is touched (x1 + branch), not across the cell.
+    const Vec2 x1 = end(r.b1);
+    const Vec2 x2 = (c.ix || c.iy) ? Vec2(x1 + Vec2(c.lx, c.ly)) : end(r.b2);
     pts->SetPoint(2 * k, x1.x(), x1.y(), 0.0);
     pts->SetPoint(2 * k + 1, x2.x(), x2.y(), 0.0);
     const vtkIdType ids[2] = {2 * k, 2 * k + 1};
@@ -281,11 +285,12 @@ vtkSmartPointer<vtkPolyData> contacts(const World& w) {
     gap->SetValue(k, c.gap);
     b1->SetValue(k, r.b1);
     b2->SetValue(k, r.b2);
+    branch->SetTuple3(k, c.lx, c.ly, 0.0);
   }
   auto pd = vtkSmartPointer<vtkPolyData>::New();
   pd->SetPoints(pts);
   pd->SetLines(lines);
-  add_arrays(pd->GetCellData(), fn, ft, force, normal, status, type, gap, b1, b2);
+  add_arrays(pd->GetCellData(), fn, ft, force, normal, status, type, gap, b1, b2, branch);
   return pd;
 }
 

@@ -42,8 +42,10 @@ class Series {
 // VTK snapshots through VTK's XML writers (binary, zlib-compressed):
 //   particles_NNNNN.vtp  points, one per particle: id, radius, velocity, omega, angle,
 //                        mass, nsides (0 for disks)
-//   contacts_NNNNN.vtp   lines from centre to centre: fn, ft, force vector,
-//                        normal, status (0 open, 1 stick, 2 slide), type, gap
+//   contacts_NNNNN.vtp   lines from centre to centre (to the touched periodic
+//                        image across a boundary): fn, ft, force vector, normal,
+//                        status (0 open, 1 stick, 2 slide), type, gap, b1, b2,
+//                        branch (centre of b1 to the touched image of b2)
 //   walls_NNNNN.vtp      wall segments as lines
 //   shapes_NNNNN.vtp     true outlines: one polygon cell per particle (disks
 //                        as 36-gons): id, nsides, velocity, omega

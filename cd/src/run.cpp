@@ -6,11 +6,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 
 #include <fmt/format.h>
 
 #include "checkpoint.hpp"
 #include "output.hpp"
+#include "setup.hpp"
 
 namespace cd {
 
@@ -57,6 +59,75 @@ struct Interval {
   }
 };
 
+// Coordination of the force-bearing network: physical contacts (the points
+// of a side-side contact count once) with p_n + adhesion > 0 between a
+// dynamic body and any body; rattlers (dynamic bodies with fewer than 2 such
+// contacts, removed until none is left) are excluded from both counts.
+// Returns z and the fraction of dynamic bodies that are not rattlers.
+std::pair<double, double> coordination(const World& w) {
+  const Bodies& b = w.bodies;
+  const auto& rows = w.rows();
+  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+  for (const ContactRow& r : rows)
+    if (r.pn + r.adh > 0.0) pairs.emplace_back(std::min(r.b1, r.b2), std::max(r.b1, r.b2));
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  std::vector<int> deg(b.size(), 0);
+  for (const auto& [i, j] : pairs) {
+    ++deg[i];
+    ++deg[j];
+  }
+  std::vector<std::uint8_t> out(b.size(), 0);
+  for (std::size_t i = 0; i < b.size(); ++i) out[i] = !b.is_dynamic(i);
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      if (out[i] || deg[i] >= 2) continue;
+      out[i] = 2;  // rattler
+      changed = true;
+      for (const auto& [p, q] : pairs)
+        if (p == static_cast<std::int32_t>(i) || q == static_cast<std::int32_t>(i)) {
+          const std::int32_t o = p == static_cast<std::int32_t>(i) ? q : p;
+          if (out[o] != 2) --deg[o];
+        }
+    }
+  }
+  std::size_t n = 0, nd = 0;
+  long ends = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (!b.is_dynamic(i)) continue;
+    ++nd;
+    if (out[i]) continue;
+    ++n;
+    ends += deg[i];
+  }
+  return {n ? double(ends) / n : 0.0, nd ? double(n) / nd : 0.0};
+}
+
+// Area of the particles in the cell: dynamic bodies, and half of each
+// wall grain (its centre is on the cell's edge).
+double solid_area(const Bodies& b) {
+  double a = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.shape[i] == Shape::Segment) continue;
+    const double n = b.nsides[i], R = b.radius[i];
+    const double area = n > 0 ? 0.5 * n * R * R * std::sin(2 * std::numbers::pi / n)
+                              : std::numbers::pi * R * R;
+    a += b.is_dynamic(i) ? area : 0.5 * area;
+  }
+  return a;
+}
+
+// Protocol columns: stress averaged over the steps of the interval.
+struct ShearInterval {
+  int steps = 0;
+  Eigen::Matrix2d sigma = Eigen::Matrix2d::Zero();
+  void add(const World& w) {
+    ++steps;
+    sigma += w.contact_stress();
+  }
+};
+
 }  // namespace
 
 RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
@@ -65,7 +136,10 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   const std::string ckpt = (dir / "checkpoint.bin").string();
   const std::string series_path = (dir / "series.csv").string();
   const double dt = w.params().dt;
-  const std::int64_t nsteps = std::llround(s.duration / dt);
+  const std::int64_t nsteps = std::llround(run_duration(s) / dt);
+  const bool shear = s.shear_mode != "none";
+  const double d_mean = mean_diameter(s);
+  const double area = shear ? solid_area(w.bodies) : 0.0;
   const std::int64_t every_row = std::max<std::int64_t>(1, std::llround(s.series_interval / dt));
   const std::int64_t every_snap =
       s.snapshot_interval > 0 ? std::max<std::int64_t>(1, std::llround(s.snapshot_interval / dt))
@@ -108,6 +182,8 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
 
   RunSummary sum;
   Interval iv;
+  ShearInterval sh;
+  double v_prev = w.cell.width * w.cell.height, t_prev = w.time;
   iv.t0 = w.times;  // restored on resume
   const auto start = Clock::now();
   auto last_print = start;
@@ -124,6 +200,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     w.step();
     const StepStats& st = w.last();
     iv.add(st);
+    if (shear) sh.add(w);
     iter_total += st.solve.iterations;
     sum.max_iterations = std::max(sum.max_iterations, st.solve.iterations);
     sum.cap_hits += st.solve.cap_hit;
@@ -133,7 +210,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     if (k % every_row == 0 || k == nsteps) {
       timed_output([&] {
         const StageTimes& t = w.times;
-        series.row({{"step", double(k)},
+        std::vector<std::pair<std::string, double>> cols = {{"step", double(k)},
                     {"time", w.time},
                     {"contacts", double(st.contacts)},
                     {"active", double(st.active)},
@@ -149,7 +226,42 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
                     {"t_detect", t.detect - iv.t0.detect},
                     {"t_solve", t.solve - iv.t0.solve},
                     {"t_integrate", t.integrate - iv.t0.integrate},
-                    {"t_output", t.output - iv.t0.output}});
+                    {"t_output", t.output - iv.t0.output}};
+        if (shear) {
+          // Contact stress (mean over the interval's steps), compression
+          // positive; p = (s1 + s2)/2, q = (s1 - s2)/2 from the symmetric part.
+          const Eigen::Matrix2d S = sh.sigma / sh.steps;
+          const double sxx = S(0, 0), syy = S(1, 1), sxy = 0.5 * (S(0, 1) + S(1, 0));
+          const double p = 0.5 * (sxx + syy);
+          const double q = std::sqrt(0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy);
+          const double V = w.cell.width * w.cell.height;
+          const double gd = w.shear_rate();
+          const auto [z, nonrattler] = coordination(w);
+          cols.insert(cols.end(), {{"strain", w.cell.strain},
+                      {"shear_rate", gd},
+                      {"sxx", sxx},
+                      {"sxy", S(0, 1)},
+                      {"syx", S(1, 0)},
+                      {"syy", syy},
+                      {"p", p},
+                      {"q", q},
+                      {"q_over_p", p > 0 ? q / p : 0.0},
+                      // tau / sigma_n, positive in the imposed sense (the
+                      // top moves +x, so sigma_xy < 0 compression-positive)
+                      {"shear_stress_ratio", syy > 0 ? -sxy / syy : 0.0},
+                      {"inertial_number", syy > 0 ? gd * d_mean * std::sqrt(s.density / syy) : 0.0},
+                      {"packing_fraction", area / V},
+                      {"z", z},
+                      {"non_rattler", nonrattler},
+                      {"cell_width", w.cell.width},
+                      {"cell_height", w.cell.height},
+                      {"volume_strain_rate",
+                       w.time > t_prev ? std::log(V / v_prev) / (w.time - t_prev) : 0.0}});
+          v_prev = V;
+          t_prev = w.time;
+          sh = ShearInterval{};
+        }
+        series.row(cols);
         series.flush();
       });
       iv = Interval{};

@@ -80,6 +80,20 @@ struct Scene {
   double checkpoint_interval = 0.0;  // time between checkpoints (s); 0: none
   bool quiet = false;
 
+  // [shear]: boundary protocols (method.md section 9)
+  std::string shear_mode = "none";  // "none" | "periodic" (Lees-Edwards) | "walls"
+  double cell_width = 0.0;          // cell width (m)
+  double cell_height = 0.0;         // initial cell height / wall gap (m)
+  double pressure = 0.0;            // imposed normal stress (N/m)
+  double inertial_number = 0.0;     // imposed I: gamma-dot = I sqrt(p/rho) / d
+  double cell_mass = 0.1;           // mass of the height (width) dof, in total particle mass
+  bool isotropic = false;           // compaction: the width is a dof too (periodic, I = 0)
+  double strain = 0.0;              // > 0: run until this shear strain (overrides duration)
+  double dt_tp = 0.0;               // > 0: dt = dt_tp x t_p, t_p = d sqrt(rho/p)
+  std::string start;                // checkpoint.bin of a preparation run to start from
+  // [contact] cohesion_number: eta > 0 gives f_a = eta p d
+  double cohesion_number = 0.0;
+
   double mu_w() const { return mu_wall < 0 ? mu : mu_wall; }
 };
 

@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "checkpoint.hpp"
+
 namespace cd {
 
 namespace {
@@ -64,9 +66,57 @@ double mean_diameter(const Scene& s) {
   return n > 0 ? sum / n : s.d_mean;
 }
 
+double pressure_time(const Scene& s) {
+  return s.pressure > 0 ? mean_diameter(s) * std::sqrt(s.density / s.pressure) : 0.0;
+}
+
+double shear_rate(const Scene& s) {
+  const double tp = pressure_time(s);
+  return tp > 0 ? s.inertial_number / tp : 0.0;
+}
+
+double time_step(const Scene& s) { return s.dt_tp > 0 ? s.dt_tp * pressure_time(s) : s.dt; }
+
+double run_duration(const Scene& s) {
+  return s.strain > 0 && shear_rate(s) > 0 ? s.strain / shear_rate(s) : s.duration;
+}
+
+namespace {
+
+// What the parser's per-key rules cannot see: keys that only make sense
+// together.
+void check_shear(const Scene& s) {
+  auto fail = [](const std::string& m) { throw SceneError(m); };
+  const bool shear = s.shear_mode != "none";
+  if (s.cohesion_number > 0) {
+    if (s.pressure <= 0) fail("contact.cohesion_number > 0 needs shear.pressure > 0 (f_a = eta p d)");
+    if (s.adhesion > 0) fail("give contact.adhesion or contact.cohesion_number, not both");
+  }
+  if (s.dt_tp > 0 && s.pressure <= 0) fail("shear.dt_tp > 0 needs shear.pressure > 0 (t_p = d sqrt(rho/p))");
+  if (!shear) {
+    if (s.inertial_number > 0 || s.isotropic || !s.start.empty() || s.strain > 0)
+      fail("shear.inertial_number, shear.isotropic, shear.strain and shear.start need shear.mode "
+           "\"periodic\" or \"walls\"");
+    return;
+  }
+  if (s.cell_width <= 0 || s.cell_height <= 0)
+    fail(fmt::format("shear.mode = \"{}\" needs shear.width > 0 and shear.height > 0", s.shear_mode));
+  if (s.gravity[0] != 0 || s.gravity[1] != 0)
+    fail("shear protocols run without gravity: set [gravity] g = [0.0, 0.0]");
+  if (s.box_width > 0 || !s.walls.empty()) fail("shear protocols take no [box] and no [[wall]]");
+  if (s.inertial_number > 0 && s.pressure <= 0)
+    fail("shear.inertial_number > 0 needs shear.pressure > 0 (shear rate = I sqrt(p/rho)/d)");
+  if (s.isotropic && (s.shear_mode != "periodic" || s.inertial_number > 0))
+    fail("shear.isotropic (compaction) needs shear.mode = \"periodic\" and shear.inertial_number = 0");
+  if (s.strain > 0 && s.inertial_number <= 0) fail("shear.strain > 0 needs shear.inertial_number > 0");
+}
+
+}  // namespace
+
 WorldParams world_params(const Scene& s) {
+  check_shear(s);
   WorldParams p;
-  p.dt = s.dt;
+  p.dt = time_step(s);
   p.gravity = Vec2(s.gravity[0], s.gravity[1]);
   p.mu = s.mu;
   p.mu_wall = s.mu_w();
@@ -75,8 +125,20 @@ WorldParams world_params(const Scene& s) {
   p.d_ref = mean_diameter(s);
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
-  p.adhesion = s.adhesion;
+  p.adhesion = s.cohesion_number > 0 ? s.cohesion_number * s.pressure * p.d_ref : s.adhesion;
   p.debond = s.debond * p.d_ref;
+  if (s.shear_mode != "none") {
+    CellParams& c = p.cell;
+    c.mode = s.shear_mode == "periodic" ? CellParams::Mode::LeesEdwards : CellParams::Mode::Walls;
+    c.width = s.cell_width;
+    c.pressure = s.pressure;
+    c.isotropic = s.isotropic;
+    if (c.mode == CellParams::Mode::LeesEdwards)
+      c.shear_rate = shear_rate(s);
+    else
+      c.wall_velocity = shear_rate(s) * s.cell_height;
+    // c.mass: set by build_world, which knows the particles' mass
+  }
   p.solver.tol = s.tol;
   p.solver.max_iter = s.max_iter;
   p.solver.rotation = s.rotation;
@@ -84,8 +146,49 @@ WorldParams world_params(const Scene& s) {
 }
 
 World build_world(const Scene& s) {
-  World w(world_params(s));
+  WorldParams wp = world_params(s);
+  World w(wp);
   Bodies& B = w.bodies;
+  const bool shear = s.shear_mode != "none", walls = s.shear_mode == "walls";
+  if (shear) {
+    w.cell.width = s.cell_width;
+    w.cell.height = s.cell_height;
+  }
+  if (!s.start.empty()) {
+    // The particles and the cell a preparation run reached; time, strain
+    // and the cell's rates start from zero, and the shear starts from the
+    // linear velocity profile (so that there is no start-up transient of
+    // momentum diffusion across the cell).
+    World prep(wp);
+    try {
+      load_checkpoint(s.start, prep);
+    } catch (const CheckpointError& e) {
+      throw SceneError(fmt::format("shear.start: {}", e.what()));
+    }
+    B = prep.bodies;
+    w.cell = prep.cell;
+    if (w.cell.width <= 0 || w.cell.height <= 0)
+      throw SceneError(fmt::format("shear.start: '{}' holds no periodic cell (not a periodic "
+                                   "preparation run)", s.start));
+    if (!s.disks.empty() || s.n > 0)
+      throw SceneError("shear.start gives the particles: set particles.n = 0 and no [[disk]]");
+    w.cell.offset = w.cell.hdot = w.cell.wdot = w.cell.strain = 0.0;
+    w.set_warm_start(prep.warm_start());
+    const double gd = wp.cell.shear_rate;
+    double dsum = 0;
+    int nd = 0;
+    for (std::size_t i = 0; i < B.size(); ++i)
+      if (B.is_dynamic(i)) {
+        B.vel[i].vx += gd * (B.pos[i].y() - 0.5 * w.cell.height);
+        dsum += 2 * B.radius[i];
+        ++nd;
+      }
+    // d sets the shear rate, t_p and f_a: it must be the sample's.
+    if (nd == 0 || std::abs(dsum / nd - wp.d_ref) > 0.1 * wp.d_ref)
+      throw SceneError(fmt::format("shear.start: the sample's mean diameter is {:.4g} m, "
+                                   "particles.d_mean is {:.4g} m; set particles.d_mean to the "
+                                   "preparation's", nd ? dsum / nd : 0.0, wp.d_ref));
+  }
 
   for (const DiskSpec& d : s.disks) {
     const double rho = d.density > 0 ? d.density : s.density;
@@ -101,6 +204,11 @@ World build_world(const Scene& s) {
     // Loose placement on a jittered square lattice of pitch 1.02 d_max: no
     // overlap by construction, filled row by row from the bottom.
     std::vector<double> region = s.region;
+    if (region.empty() && shear) {
+      // The cell; between the walls' grains, a grain's clearance away.
+      const double m = walls ? 1.0 * s.d_mean * 1.01 : 0.0;
+      region = {0.0, m, s.cell_width, s.cell_height - m};
+    }
     if (region.empty()) {
       if (s.box_width <= 0)
         throw SceneError("particles.n > 0 needs particles.region or a [box] to place them in");
@@ -136,6 +244,32 @@ World build_world(const Scene& s) {
     }
   }
 
+  if (walls) {
+    // Rough walls: a row of touching grains of the mean diameter glued to
+    // each wall (driven bodies); the top row moves together (World::top_wall).
+    const int m = std::max(1, static_cast<int>(std::floor(s.cell_width / s.d_mean)));
+    const double pitch = s.cell_width / m, r = 0.5 * std::min(pitch, s.d_mean);
+    const Vec2 vtop(wp.cell.wall_velocity, 0.0);
+    for (int k = 0; k < m; ++k) {
+      const int b = B.add_disk({(k + 0.5) * pitch, 0.0}, r, s.density);
+      B.driven[b] = 1;
+      B.vel[b] = {0, 0, 0, 0, 0};
+    }
+    for (int k = 0; k < m; ++k) {
+      const int t = B.add_disk({(k + 0.5) * pitch, s.cell_height}, r, s.density, vtop);
+      B.driven[t] = 1;
+      B.vel[t] = {vtop.x(), 0, 0, 0, 0};
+      w.top_wall.push_back(t);
+    }
+  }
+  if (shear) {
+    double mass = 0;
+    for (std::size_t i = 0; i < B.size(); ++i)
+      if (B.is_dynamic(i)) mass += B.mass[i];
+    wp.cell.mass = s.cell_mass * mass;
+    w.set_params(wp);
+  }
+
   if (s.box_width > 0) {
     const double W = s.box_width, H = s.box_height;
     B.add_wall({0, 0}, {W, 0});
@@ -146,13 +280,20 @@ World build_world(const Scene& s) {
   for (const WallSpec& ws : s.walls)
     B.add_wall({ws.a[0], ws.a[1]}, {ws.b[0], ws.b[1]}, {ws.vel[0], ws.vel[1]}, ws.omega);
 
+  // A started state comes from a simulation, with its solver-sized overlaps.
+  if (!s.start.empty()) return w;
   // No overlap at t = 0: run the detector with zero alert on the initial
   // configuration. Round-off sized overlaps (1e-9 d) are tolerated so that
   // disks placed exactly touching are accepted.
   std::vector<ContactRow> rows;
   std::vector<ContactInfo> info;
   CellGrid grid;
-  detect(B, B.pos, B.angle, 0.0, grid, rows, info);
+  PeriodicCell cell{shear, shear && !walls, w.cell.width, w.cell.height, 0.0};
+  try {
+    detect(B, B.pos, B.angle, 0.0, grid, rows, info, shear ? &cell : nullptr);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(fmt::format("shear.width, shear.height: {}", e.what()));
+  }
   const double tol = 1e-9 * w.params().d_ref;
   for (std::size_t k = 0; k < rows.size(); ++k) {
     if (info[k].gap >= -tol) continue;

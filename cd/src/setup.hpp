@@ -18,6 +18,14 @@ double mean_diameter(const Scene& s);
 
 WorldParams world_params(const Scene& s);
 
+// Shear protocols: the imposed shear rate gamma-dot = I sqrt(p/rho)/d, the
+// pressure time t_p = d sqrt(rho/p); 0 when the scene imposes no pressure.
+double shear_rate(const Scene& s);
+double pressure_time(const Scene& s);
+// Time step and simulated time after the [shear] overrides (dt_tp, strain).
+double time_step(const Scene& s);
+double run_duration(const Scene& s);
+
 // Builds the world; throws SceneError naming the bodies at fault.
 World build_world(const Scene& s);
 

@@ -29,6 +29,10 @@ void World::configure() {
   adhesion_on_ = prm_.adhesion > 0.0;
   prm_.solver.adhesion = adhesion_on_;
   if (adhesion_on_) alert_ = std::max(alert_, prm_.debond);
+  periodic_ = prm_.cell.mode == CellParams::Mode::LeesEdwards;
+  walls_ = prm_.cell.mode == CellParams::Mode::Walls;
+  pc_.x = periodic_ || walls_;
+  pc_.y = periodic_;
   prepared_ = false;
 }
 
@@ -36,6 +40,8 @@ void World::step() {
   if (!prepared_) {  // per-scene choices that depend on the bodies
     forces_on_ = std::any_of(bodies.force.begin(), bodies.force.end(),
                              [](const Vec2& f) { return f.squaredNorm() > 0.0; });
+    on_top_.assign(walls_ ? bodies.size() : 0, 0);
+    for (const std::int32_t i : top_wall) on_top_[i] = 1;
     prepared_ = true;
   }
   auto t0 = Clock::now();
@@ -65,9 +71,23 @@ void World::predict() {
     xm_[i] = bodies.pos[i] + h * Vec2(v.vx, v.vy);
     thm_[i] = bodies.angle[i] + h * v.w;
   }
+  if (periodic_ || walls_) {
+    cm_ = cell;
+    cm_.height += h * cell.hdot;
+    cm_.width += h * cell.wdot;
+    if (periodic_) {
+      cm_.offset = std::fmod(cell.offset + h * prm_.cell.shear_rate * cell.height, cm_.width);
+      if (cm_.offset < 0) cm_.offset += cm_.width;
+    }
+    pc_.width = cm_.width;
+    pc_.height = cm_.height;
+    pc_.offset = cm_.offset;
+  }
 }
 
-void World::detect_stage() { detect(bodies, xm_, thm_, alert_, grid_, rows_, info_); }
+void World::detect_stage() {
+  detect(bodies, xm_, thm_, alert_, grid_, rows_, info_, (periodic_ || walls_) ? &pc_ : nullptr);
+}
 
 void World::build() {
   const double dt = prm_.dt;
@@ -86,6 +106,19 @@ void World::build() {
     r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
     r.bt = 0.0;
   }
+  if (periodic_) {
+    // Lees-Edwards: the image of body 2 across the top moves at (gamma-dot
+    // H, dH/dt) relative to body 2, across a side at (dW/dt, 0).
+    const double vs = prm_.cell.shear_rate * cm_.height;
+    for (std::size_t k = 0; k < nr; ++k) {
+      const ContactInfo& f = info_[k];
+      if (f.ix == 0 && f.iy == 0) continue;
+      ContactRow& r = rows_[k];
+      const double vx = f.iy * vs + f.ix * cell.wdot, vy = f.iy * cell.hdot;
+      r.bn += r.nx * vx + r.ny * vy;
+      r.bt += -r.ny * vx + r.nx * vy;
+    }
+  }
   if (adhesion_on_) {
     const double a = prm_.adhesion * dt;
     for (std::size_t k = 0; k < nr; ++k) rows_[k].adh = info_[k].gap <= prm_.debond ? a : 0.0;
@@ -93,11 +126,18 @@ void World::build() {
   if (restitution_on_) {
     // Law on u+ + e u-, with u- the relative velocity at the start of the
     // step (before external forces) in the midpoint frame. Only approaching
-    // normal velocities are restituted.
+    // normal velocities are restituted. (bn, bt so far hold only the gap
+    // term and the periodic images' velocity: that velocity is part of u-.)
+    const double vs = prm_.cell.shear_rate * cm_.height;
     for (std::size_t k = 0; k < nr; ++k) {
       ContactRow& r = rows_[k];
       double un, ut;
       row_velocity(r, V, rot, un, ut);
+      if (periodic_ && (info_[k].ix != 0 || info_[k].iy != 0)) {
+        const double vx = info_[k].iy * vs + info_[k].ix * cell.wdot, vy = info_[k].iy * cell.hdot;
+        un += r.nx * vx + r.ny * vy;
+        ut += -r.ny * vx + r.nx * vy;
+      }
       r.bn += prm_.e_n * std::min(un, 0.0);
       r.bt += prm_.e_t * ut;
     }
@@ -139,7 +179,17 @@ void World::solve() {
   }
   if (gravity_on_ || forces_on_) external();
   apply_impulses(rows_, bodies.vel, prm_.solver.rotation);
-  last_.solve = nlgs_solve(rows_, col_, bodies.vel, prm_.solver);
+  if (periodic_ || walls_) set_cell_dofs();
+  last_.solve = nlgs_solve(rows_, col_, bodies.vel, prm_.solver, dofs_.empty() ? nullptr : &dofs_);
+  if (!dofs_.empty()) {
+    if (periodic_) {
+      cell.hdot = dofs_[0].v;
+      if (dofs_.size() > 1) cell.wdot = dofs_[1].v;
+    } else {
+      cell.hdot = dofs_[0].v;
+      for (const std::int32_t i : top_wall) bodies.vel[i].vy = cell.hdot;
+    }
+  }
 
   // Keep the impulses for the next step's warm start.
   const std::size_t nr = rows_.size();
@@ -187,6 +237,104 @@ void World::integrate() {
     bodies.pos[i] = xm_[i] + h * Vec2(v.vx, v.vy);
     if (rot || !bodies.is_dynamic(i)) bodies.angle[i] = thm_[i] + h * v.w;
   }
+  if (periodic_ || walls_) {
+    const double gd = shear_rate();
+    cell.height = cm_.height + h * cell.hdot;
+    cell.width = cm_.width + h * cell.wdot;
+    cell.strain += prm_.dt * gd;
+    if (periodic_) {
+      cell.offset = std::fmod(cell.offset + prm_.dt * prm_.cell.shear_rate * cm_.height, cell.width);
+      if (cell.offset < 0) cell.offset += cell.width;
+    }
+    wrap_into_cell();
+  }
+}
+
+void World::set_cell_dofs() {
+  // One dof per controlled length: its velocity at the start of the step
+  // (already in the rows' offsets, or in the top bodies' velocities), and
+  // v0 with the imposed stress's impulse; the offsets get the difference.
+  const double dt = prm_.dt, P = prm_.cell.pressure, M = prm_.cell.mass;
+  dofs_.clear();
+  if (P <= 0.0 || M <= 0.0) return;
+  auto make = [&](double v_start, double load) {
+    BoundaryDof d;
+    d.inv_mass = 1.0 / M;
+    d.v0 = v_start - dt * load / M;
+    d.v = d.v0;
+    d.scale = dt * load;
+    return d;
+  };
+  const std::size_t nr = rows_.size();
+  auto couple = [&](BoundaryDof& d, std::size_t k, double an, double at, double v_start) {
+    d.rows.push_back(static_cast<std::int32_t>(k));
+    d.an.push_back(an);
+    d.at.push_back(at);
+    rows_[k].bn += an * (d.v0 - v_start);
+    rows_[k].bt += at * (d.v0 - v_start);
+  };
+  if (periodic_) {
+    dofs_.push_back(make(cell.hdot, P * cm_.width));
+    if (prm_.cell.isotropic) dofs_.push_back(make(cell.wdot, P * cm_.height));
+    for (std::size_t k = 0; k < nr; ++k) {
+      const ContactInfo& f = info_[k];
+      const ContactRow& r = rows_[k];
+      if (f.iy != 0) couple(dofs_[0], k, f.iy * r.ny, f.iy * r.nx, cell.hdot);
+      if (f.ix != 0 && prm_.cell.isotropic) couple(dofs_[1], k, f.ix * r.nx, -f.ix * r.ny, cell.wdot);
+    }
+  } else {
+    dofs_.push_back(make(cell.hdot, P * cm_.width));
+    for (std::size_t k = 0; k < nr; ++k) {
+      const ContactRow& r = rows_[k];
+      const double s = on_top_[r.b2] ? 1.0 : on_top_[r.b1] ? -1.0 : 0.0;
+      if (s != 0.0) couple(dofs_[0], k, s * r.ny, s * r.nx, cell.hdot);
+    }
+  }
+}
+
+void World::wrap_into_cell() {
+  const double W = cell.width, H = cell.height;
+  const double vs = prm_.cell.shear_rate * H;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies.shape[i] == Shape::Segment) continue;
+    Vec2& x = bodies.pos[i];
+    if (periodic_) {
+      // A body leaving through the top comes back through the bottom as
+      // its own Lees-Edwards image: shifted back by the offset, and slower
+      // by the images' velocity.
+      BodyVel& v = bodies.vel[i];
+      while (x.y() >= H) {
+        x.y() -= H;
+        x.x() -= cell.offset;
+        v.vx -= vs;
+        v.vy -= cell.hdot;
+      }
+      while (x.y() < 0.0) {
+        x.y() += H;
+        x.x() += cell.offset;
+        v.vx += vs;
+        v.vy += cell.hdot;
+      }
+    }
+    x.x() -= W * std::floor(x.x() / W);
+  }
+}
+
+double World::shear_rate() const {
+  if (periodic_) return prm_.cell.shear_rate;
+  if (walls_) return cell.height > 0 ? prm_.cell.wall_velocity / cell.height : 0.0;
+  return 0.0;
+}
+
+Eigen::Matrix2d World::contact_stress(double volume) const {
+  Eigen::Matrix2d s = Eigen::Matrix2d::Zero();
+  for (std::size_t k = 0; k < rows_.size(); ++k) {
+    const ContactRow& r = rows_[k];
+    const Vec2 p(r.nx * r.pn - r.ny * r.pt, r.ny * r.pn + r.nx * r.pt);
+    s += p * Vec2(info_[k].lx, info_[k].ly).transpose();
+  }
+  const double V = volume > 0.0 ? volume : cell_volume();
+  return s / ((V > 0.0 ? V : 1.0) * prm_.dt);  // no volume: stress times V
 }
 
 double World::kinetic_energy() const {

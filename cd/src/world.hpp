@@ -18,6 +18,27 @@
 
 namespace cd {
 
+// Boundary protocols (method.md section 9), chosen once per scene.
+//   LeesEdwards  bi-periodic cell [0, width) x [0, height); the images above
+//                slide at shear_rate x height; with pressure > 0 the height
+//                is a degree of freedom of mass `mass` loaded by -pressure x
+//                width, solved with the contacts (BoundaryDof). isotropic:
+//                the width too, at sigma_xx = pressure (compaction; no shear).
+//   Walls        periodic in x over `width`; the bodies listed in
+//                World::top_wall move together, at imposed horizontal
+//                velocity wall_velocity and a vertical velocity that is a
+//                degree of freedom loaded by -pressure x width.
+struct CellParams {
+  enum class Mode { None, LeesEdwards, Walls };
+  Mode mode = Mode::None;
+  double width = 0.0;
+  double shear_rate = 0.0;     // gamma-dot (LeesEdwards)
+  double wall_velocity = 0.0;  // top wall's horizontal velocity (Walls)
+  double pressure = 0.0;       // imposed normal stress (N/m); 0: height fixed
+  double mass = 0.0;           // mass of the height (and width) dof (kg)
+  bool isotropic = false;
+};
+
 struct WorldParams {
   double dt = 1e-4;
   Vec2 gravity{0.0, 0.0};
@@ -33,7 +54,16 @@ struct WorldParams {
   // on every contact whose midpoint gap is <= debond (absolute); 0: none.
   double adhesion = 0.0, debond = 0.0;
   double d_ref = 1.0;     // length scale for overlaps (mean diameter)
+  CellParams cell;
   SolverParams solver;
+};
+
+// State of the periodic cell or of the wall gap; part of the checkpoint.
+struct CellState {
+  double width = 0.0, height = 0.0;  // Walls: height = top wall's travel from its start + gap0
+  double offset = 0.0;               // Lees-Edwards offset of the images above, in [0, width)
+  double hdot = 0.0, wdot = 0.0;     // rates of height and width
+  double strain = 0.0;               // integral of the shear rate
 };
 
 struct StageTimes {  // wall-clock seconds, accumulated
@@ -70,6 +100,20 @@ class World {
   const std::vector<ContactRow>& rows() const { return rows_; }
   const std::vector<ContactInfo>& infos() const { return info_; }
 
+  // Periodic cell (LeesEdwards) or gap between the walls (Walls).
+  CellState cell;
+  // Walls mode: the bodies glued to the top wall (driven, moved together).
+  std::vector<std::int32_t> top_wall;
+
+  // Contact stress of the last step (method.md section 10): sigma_ij =
+  // (1/V) sum_c f_i l_j, f the force on body 2, l the branch vector from
+  // body 1; compression positive. V: `volume` if given, else the cell area at
+  // the midpoint (LeesEdwards, Walls); neither: the sum itself (stress times V).
+  Eigen::Matrix2d contact_stress(double volume = 0.0) const;
+  double cell_volume() const { return cm_.width * cm_.height; }  // midpoint cell area
+  // Imposed shear rate of the protocol (Walls: wall velocity over the gap).
+  double shear_rate() const;
+
   double kinetic_energy() const;
   double potential_energy() const;  // -m g.r summed over dynamic bodies
 
@@ -95,7 +139,14 @@ class World {
   void integrate();
 
   WorldParams prm_;
+  void wrap_into_cell();
+  void set_cell_dofs();
   bool gravity_on_ = false, restitution_on_ = false, adhesion_on_ = false;
+  bool periodic_ = false, walls_ = false;
+  CellState cm_;           // cell at the midpoint configuration
+  PeriodicCell pc_;        // its periodic view for detection
+  std::vector<BoundaryDof> dofs_;
+  std::vector<std::uint8_t> on_top_;  // Walls: body is glued to the top wall
   bool forces_on_ = false, prepared_ = false;  // forces_on_: some body has an applied force
   double alert_ = 0.0;
   StepStats last_;
