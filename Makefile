@@ -13,7 +13,7 @@ DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libbenchmark-dev gnuplot-nox
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build run test bench accuracy-cost clean help
+.PHONY: all deps build run test bench accuracy-cost clean help analyze-inertial analyze-cohesive analyze-angularity
 
 all: build
 
@@ -23,6 +23,8 @@ help:
 	@echo "make bench          build and run the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv)"
 	@echo "make accuracy-cost  eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s)"
 	@echo "make deps           install the missing Debian packages (idempotent)"
+	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity"
+	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
 
 # Idempotent: asks dpkg which packages are missing and installs only those.
 deps:
@@ -59,6 +61,25 @@ bench: build
 
 accuracy-cost: build
 	$(BUILD)/cd/bench/accuracy_cost --out outputs/accuracy-cost $(if $(QUICK),--quick)
+
+# Campaign analyses: the report of outputs/campaigns/<name> (made by the
+# campaign-* targets) into outputs/analysis/<name>/, plus the campaign's fits.
+CDA := $(BUILD)/analysis/cdanalysis
+CAMPAIGNS := outputs/campaigns
+ANALYSIS := outputs/analysis
+
+analyze-inertial: build
+	$(CDA) report $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial
+	$(CDA) fit mu-i $(CAMPAIGNS)/inertial --toml $(ANALYSIS)/inertial/mu_i.toml
+	$(CDA) fit dilatancy $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/dilatancy --toml $(ANALYSIS)/inertial/dilatancy.toml
+
+# The eta = 0 reference runs (eta_0_I_*) must be in the cohesive campaign.
+analyze-cohesive: build
+	$(CDA) report $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive
+	$(CDA) fit cohesion $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive/cohesion --toml $(ANALYSIS)/cohesive/cohesion.toml
+
+analyze-angularity: build
+	$(CDA) report $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity
 
 clean:
 	rm -rf $(BUILD)

@@ -1,7 +1,8 @@
 // cdanalysis: steady-state statistics, fabric, fits and reports of cdsim
 // runs. Every failure that is the input's fault prints one line naming the
 // file or quantity at fault and exits with status 1; usage errors exit with
-// CLI11's own non-zero codes.
+// CLI11's own non-zero codes; compare-fits exits with 2 when a parameter
+// FAILs (so a script can tell a regression from an unreadable file).
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
@@ -10,6 +11,9 @@
 #include <fstream>
 #include <optional>
 
+#include "analysis/src/cohesion.hpp"
+#include "analysis/src/compare.hpp"
+#include "analysis/src/dilatancy.hpp"
 #include "analysis/src/fabric_bounds.hpp"
 #include "analysis/src/fit.hpp"
 #include "analysis/src/report.hpp"
@@ -57,6 +61,17 @@ void write_toml(const std::string& path, const std::vector<FitResult>& f, const 
   fmt::print("wrote {}\n", path);
 }
 
+// Run folders from the arguments: a folder holding series.csv is a run, any
+// other folder a campaign whose subfolders are runs (report.hpp).
+std::vector<std::string> expand_runs(const std::vector<std::string>& args) {
+  std::vector<std::string> runs;
+  for (const auto& a : args) {
+    const auto r = campaign_runs(a);
+    runs.insert(runs.end(), r.begin(), r.end());
+  }
+  return runs;
+}
+
 std::vector<double> col_or_empty(const Table& t, const std::string& name) {
   return t.has(name) ? t.column(name) : std::vector<double>{};
 }
@@ -92,16 +107,60 @@ int main(int argc, char** argv) {
   std::vector<std::string> runs;
   std::string table, toml_out;
   auto* mu_i = fit->add_subcommand("mu-i", "mu(I) = mu1 + (mu2 - mu1)/(1 + I0/I) over steady runs");
-  mu_i->add_option("runs", runs, "run folders (each: steady mean of q_over_p and inertial_number)");
+  mu_i->add_option("runs", runs, "run or campaign folders (each run: steady mean of q_over_p and "
+                                 "inertial_number)");
   mu_i->add_option("--table", table, "CSV with columns I, mu and optionally mu_err, instead of runs");
   mu_i->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
-  auto* coh = fit->add_subcommand("cohesion", "c/p = k0 eta/(1 - beta ln(1 - I/(1 + alpha eta)^(1/2)))");
-  coh->add_option("--table", table, "CSV with columns eta, I, c_over_p and optionally c_over_p_err")->required();
+  auto* coh = fit->add_subcommand(
+      "cohesion",
+      "c/p = k0 eta/(1 - beta ln(1 - I/(1 + alpha eta)^(1/2))) over steady runs: eta from scene.toml "
+      "([contact] cohesion_number), I the measured inertial_number, c/p = (q/p - sin phi)/cos phi with "
+      "sin phi(I) from the eta = 0 runs among those given");
+  std::string reference = "auto";
+  coh->add_option("runs", runs, "run or campaign folders, eta = 0 reference runs included");
+  coh->add_option("--table", table, "CSV with columns eta, I, c_over_p and optionally c_over_p_err, instead of runs");
+  coh->add_option("--reference", reference,
+                  "sin phi(I) of the eta = 0 runs: mu-i (fit, 4+ runs), interp (linear in ln I), auto "
+                  "(mu-i with 4+ runs, else interp)")
+      ->check(CLI::IsMember({"auto", "mu-i", "interp"}))
+      ->capture_default_str();
+  coh->add_option("--out", out, "folder for c/p data, model curves and the plot (png, svg)");
   coh->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
+  auto* dil = fit->add_subcommand(
+      "dilatancy",
+      "sin phi = sin phi_c + sin psi over the rows of shear runs (transient and steady), sin phi = q/p, "
+      "sin psi = volume_strain_rate/sqrt(volume_strain_rate^2 + shear_rate^2); also the free slope b");
+  std::size_t blocks_per_bin = 4;
+  std::string strain_range;
+  dil->add_option("runs", runs, "run or campaign folders (series.csv with q_over_p, volume_strain_rate, "
+                                "shear_rate)")->required();
+  dil->add_option("--blocks-per-bin", blocks_per_bin,
+                  "blocks of ceil(4 tau) rows averaged into one point (consecutive in strain)")
+      ->check(CLI::Range(2, 1000000))
+      ->capture_default_str();
+  dil->add_option("--strain", strain_range, "use the rows with a <= strain <= b only (a:b; default all)");
+  dil->add_option("--out", out, "folder for the binned points, the fit curve and the plot (png, svg)");
+  dil->add_option("--toml", toml_out, "write the fit parameters (fixed and free slope) to this TOML file");
   auto* bounds = fit->add_subcommand("fabric-bounds", "envelope z_min, z_max of (z, a_c) points");
   double k_bound = 1.0;
   bounds->add_option("--table", table, "CSV with columns z, a_c (optionally z_err, a_c_err)")->required();
   bounds->add_option("--k", k_bound, "bound prefactor (1 from method.md's definition)")->capture_default_str();
+
+  // compare-fits
+  auto* cmp = app.add_subcommand(
+      "compare-fits",
+      "compare the parameters of two fit TOML files (as written by --toml or report). A parameter FAILs "
+      "when |new - ref| > TOL_SIGMA sqrt(err_ref^2 + err_new^2) AND |new - ref| > TOL_REL |ref|; a model "
+      "or parameter of REFERENCE missing from NEW, a non-finite value, or a fit no longer converged FAILs "
+      "too. Exit status: 0 all OK, 2 some FAIL, 1 a file unreadable.");
+  std::string ref_toml, new_toml;
+  double tol_sigma = 3, tol_rel = 0;
+  cmp->add_option("reference", ref_toml, "reference fit TOML")->required();
+  cmp->add_option("new", new_toml, "new fit TOML")->required();
+  cmp->add_option("--tol-sigma", tol_sigma, "combined standard uncertainties allowed")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmp->add_option("--tol-rel", tol_rel, "relative change allowed (0: the sigma test alone)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
 
   // report
   auto* report = app.add_subcommand("report", "tables, fits, plots and index.html for a campaign");
@@ -163,7 +222,7 @@ int main(int argc, char** argv) {
         err = col_or_empty(t, "mu_err");
       } else {
         if (runs.empty()) throw AnalysisError("fit mu-i: give run folders or --table");
-        for (const auto& r : runs) {
+        for (const auto& r : expand_runs(runs)) {
           const auto series = read_series(r);
           const auto x = default_x_column(series);
           const auto s = run_steady(r, series, "q_over_p", x, std::nullopt);
@@ -179,11 +238,85 @@ int main(int argc, char** argv) {
       print_fit(r, mu_of_I());
       write_toml(toml_out, {r}, {mu_of_I()});
     } else if (coh->parsed()) {
-      const auto t = Table::read_csv(table);
-      const auto r = fit_cohesion(t.column("eta"), t.column("I"), t.column("c_over_p"),
-                                  col_or_empty(t, "c_over_p_err"));
-      print_fit(r, cohesion());
-      write_toml(toml_out, {r}, {cohesion()});
+      if (!table.empty()) {
+        if (!runs.empty()) throw AnalysisError("fit cohesion: give run folders or --table, not both");
+        const auto t = Table::read_csv(table);
+        const auto r = fit_cohesion(t.column("eta"), t.column("I"), t.column("c_over_p"),
+                                    col_or_empty(t, "c_over_p_err"));
+        print_fit(r, cohesion());
+        write_toml(toml_out, {r}, {cohesion()});
+      } else {
+        if (runs.empty()) throw AnalysisError("fit cohesion: give run folders or --table");
+        std::vector<SteadyPoint> ref_pts, coh_pts;
+        for (const auto& r : expand_runs(runs)) {
+          const auto p = steady_point(r);
+          (p.eta == 0 ? ref_pts : coh_pts).push_back(p);
+        }
+        if (coh_pts.empty()) throw AnalysisError("fit cohesion: no run with eta > 0 among the given runs");
+        const auto mode = reference == "mu-i"     ? SinPhiReference::Mode::MuI
+                          : reference == "interp" ? SinPhiReference::Mode::Interp
+                                                  : SinPhiReference::Mode::Auto;
+        const SinPhiReference ref(ref_pts, mode);
+        fmt::print("reference: {} eta = 0 runs, sin phi(I) by {}\n", ref_pts.size(),
+                   ref.uses_fit() ? "the mu(I) fit" : "interpolation in ln I");
+        for (const auto& p : ref.points())
+          fmt::print("  {}: I = {:.4g} +- {:.2g}, sin phi = {:.4f} +- {:.4f}\n", p.run, p.I, p.I_err, p.mu, p.mu_err);
+        if (ref.uses_fit()) print_fit(ref.fit(), mu_of_I());
+        std::vector<CohesionPoint> pts;
+        std::vector<double> eta, I, c, ce;
+        for (const auto& p : coh_pts) {
+          const auto cp = cohesion_point(p, ref);
+          fmt::print("{}: eta = {:g}, I = {:.4g} +- {:.2g} (imposed {:.4g}), q/p = {:.4f} +- {:.4f}, "
+                     "sin phi = {:.4f} +- {:.4f}{}, c/p = {:.4f} +- {:.4f}\n",
+                     p.run, p.eta, p.I, p.I_err, p.I_imposed, p.mu, p.mu_err, cp.ref.sin_phi, cp.ref.err,
+                     cp.ref.extrapolated ? " (extrapolated)" : "", cp.c_over_p, cp.c_over_p_err);
+          pts.push_back(cp);
+          eta.push_back(p.eta);
+          I.push_back(p.I);
+          c.push_back(cp.c_over_p);
+          ce.push_back(cp.c_over_p_err);
+        }
+        const auto r = fit_cohesion(eta, I, c, ce);
+        print_fit(r, cohesion());
+        std::vector<FitResult> fits = {r};
+        std::vector<Model> models = {cohesion()};
+        if (ref.uses_fit()) {
+          fits.push_back(ref.fit());
+          models.push_back(mu_of_I());
+        }
+        write_toml(toml_out, fits, models);
+        if (!out.empty() && !plot_cohesion(out, pts, r))
+          fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
+      }
+    } else if (dil->parsed()) {
+      DilatancyOptions opt;
+      opt.blocks_per_bin = blocks_per_bin;
+      if (!strain_range.empty()) opt.strain = parse_range(strain_range);
+      std::vector<RunDilatancy> rd;
+      for (const auto& r : expand_runs(runs)) {
+        rd.push_back(run_dilatancy(r, read_series(r), opt));
+        const auto& d = rd.back();
+        fmt::print("{}: {} rows ({} skipped), tau {:.3g} rows, blocks of {} rows, {} bins, reliability of "
+                   "sin psi {:.3f}\n",
+                   r, d.rows, d.skipped, d.tau, d.block_rows, d.bins.size(), d.reliability);
+      }
+      const auto f = fit_dilatancy_runs(std::move(rd));
+      print_fit(f.fixed, dilatancy());
+      print_fit(f.free, dilatancy_free());
+      const double b = f.free["b"], be = f.free.err("b");
+      fmt::print("slope check: b = {:.4f} +- {:.4f}, (b - 1)/err = {:.2f}{}\n", b, be, (b - 1) / be,
+                 std::abs(b - 1) > 3 * be ? "  (b differs from the model's 1 by more than 3 sigma; a free "
+                                            "slope is biased towards 0 by the reliability of sin psi)"
+                                          : "");
+      write_toml(toml_out, {f.fixed, f.free}, {dilatancy(), dilatancy_free()});
+      if (!out.empty() && !plot_dilatancy(out, f))
+        fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
+    } else if (cmp->parsed()) {
+      const auto a = read_fit_toml(ref_toml);
+      const auto b = read_fit_toml(new_toml);
+      const auto c = compare_fits(a, b, tol_sigma, tol_rel);
+      fmt::print("reference {}\nnew       {}\n{}", ref_toml, new_toml, format_comparison(c, tol_sigma, tol_rel));
+      if (!c.ok()) return 2;
     } else if (bounds->parsed()) {
       const auto t = Table::read_csv(table);
       const auto b = fabric_bounds(t.column("z"), t.column("a_c"), col_or_empty(t, "z_err"),

@@ -1,0 +1,158 @@
+#include "cohesion.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+
+#include "report.hpp"
+#include "run.hpp"
+#include "scene_info.hpp"
+
+namespace fs = std::filesystem;
+
+namespace cda {
+
+SteadyPoint steady_point(const std::string& run_dir) {
+  SteadyPoint p;
+  p.run = run_dir;
+  const auto scene = read_scene_info(run_dir);
+  p.eta = require(scene, scene.cohesion_number, "[contact] cohesion_number");
+  if (p.eta < 0) throw AnalysisError(fmt::format("'{}': cohesion_number {} is negative", scene.file, p.eta));
+  p.I_imposed = scene.inertial_number.value_or(std::numeric_limits<double>::quiet_NaN());
+  const auto series = read_series(run_dir);
+  const auto x = default_x_column(series);
+  const auto s = run_steady(run_dir, series, "q_over_p", x, std::nullopt);
+  const auto si = stats_over(series, "inertial_number", x, s.stats.window);
+  p.mu = s.stats.mean;
+  p.mu_err = s.stats.error();
+  p.I = si.mean;
+  p.I_err = si.error();
+  return p;
+}
+
+SinPhiReference::SinPhiReference(std::vector<SteadyPoint> pts, Mode mode) {
+  if (pts.empty())
+    throw AnalysisError("fit cohesion: no eta = 0 run among the given runs; sin phi(I) of the cohesionless "
+                        "material is the reference for c/p = (q/p - sin phi)/cos phi: add the eta = 0 runs "
+                        "([contact] cohesion_number = 0) to the run list");
+  for (const auto& p : pts)
+    if (!(p.I > 0)) throw AnalysisError(fmt::format("'{}': measured inertial number {} is not positive", p.run, p.I));
+  std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.I < b.I; });
+  if (mode != Mode::Interp && pts.size() >= 4) {
+    std::vector<double> I, mu, e;
+    for (const auto& p : pts) {
+      I.push_back(p.I);
+      mu.push_back(p.mu);
+      e.push_back(p.mu_err);
+    }
+    fit_ = fit_mu_I(I, mu, e);
+    use_fit_ = fit_.converged || mode == Mode::MuI;
+  } else if (mode == Mode::MuI) {
+    throw AnalysisError(fmt::format("fit cohesion: --reference mu-i needs 4 eta = 0 runs, {} given", pts.size()));
+  }
+  // Runs at the same I (within 1e-9 relative) are merged by the weighted
+  // mean, so the interpolation never divides by a zero ln I step.
+  for (const auto& p : pts) {
+    if (!points_.empty() && std::abs(std::log(p.I / points_.back().I)) < 1e-9) {
+      auto& q = points_.back();
+      const double wa = 1 / (q.mu_err * q.mu_err), wb = 1 / (p.mu_err * p.mu_err);
+      q.mu = (wa * q.mu + wb * p.mu) / (wa + wb);
+      q.mu_err = 1 / std::sqrt(wa + wb);
+      continue;
+    }
+    points_.push_back(p);
+  }
+}
+
+std::pair<double, double> SinPhiReference::raw(double I) const {
+  if (use_fit_) {
+    const Model m = mu_of_I();
+    return {predict(m, fit_, &I), predict_error(m, fit_, &I)};
+  }
+  if (points_.size() == 1) return {points_[0].mu, points_[0].mu_err};
+  // Bracketing pair, or the end pair for extrapolation.
+  std::size_t k = 1;
+  while (k + 1 < points_.size() && points_[k].I < I) ++k;
+  const auto& a = points_[k - 1];
+  const auto& b = points_[k];
+  const double w = std::log(I / a.I) / std::log(b.I / a.I);
+  return {(1 - w) * a.mu + w * b.mu, std::hypot((1 - w) * a.mu_err, w * b.mu_err)};
+}
+
+SinPhiReference::Value SinPhiReference::at(double I, double I_err) const {
+  if (!(I > 0)) throw AnalysisError(fmt::format("sin phi reference: inertial number {} is not positive", I));
+  Value v;
+  const auto [s, e] = raw(I);
+  // The error of I through the slope of sin phi(I) (central difference in ln I).
+  const double h = 1e-3;
+  const double slope = (raw(I * std::exp(h)).first - raw(I * std::exp(-h)).first) / (2 * h * I);
+  v.sin_phi = s;
+  v.err = std::hypot(e, slope * I_err);
+  v.extrapolated = I < points_.front().I * (1 - 1e-9) || I > points_.back().I * (1 + 1e-9);
+  return v;
+}
+
+CohesionPoint cohesion_point(const SteadyPoint& p, const SinPhiReference& ref) {
+  CohesionPoint c;
+  c.run = p;
+  c.ref = ref.at(p.I, p.I_err);
+  const double s = c.ref.sin_phi, m = p.mu;
+  if (!(std::abs(s) < 1))
+    throw AnalysisError(fmt::format("'{}': reference sin phi = {} at I = {} is outside (-1, 1)", p.run, s, p.I));
+  const double cphi = std::sqrt(1 - s * s);
+  c.c_over_p = (m - s) / cphi;
+  const double dm = 1 / cphi, ds = (m * s - 1) / (cphi * cphi * cphi);
+  c.c_over_p_err = std::hypot(dm * p.mu_err, ds * c.ref.err);
+  return c;
+}
+
+bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts, const FitResult& r) {
+  fs::create_directories(dir);
+  Table data({"eta", "I", "I_err", "q_over_p", "q_over_p_err", "sin_phi", "sin_phi_err", "c_over_p",
+              "c_over_p_err", "extrapolated"});
+  std::set<double> etas;
+  double lo = 1, hi = 0;
+  for (const auto& c : pts) {
+    data.add_row({c.run.eta, c.run.I, c.run.I_err, c.run.mu, c.run.mu_err, c.ref.sin_phi, c.ref.err, c.c_over_p,
+                  c.c_over_p_err, c.ref.extrapolated ? 1.0 : 0.0});
+    etas.insert(c.run.eta);
+    lo = std::min(lo, c.run.I);
+    hi = std::max(hi, c.run.I);
+  }
+  data.write_csv((fs::path(dir) / "cohesion_data.csv").string());
+  lo /= 2;
+  hi = std::min(hi * 2, 0.99);
+  // One curve per eta, each in its own block (blank line between) for `index`.
+  std::string curves = "# I,c_over_p per eta block\n";
+  const Model m = cohesion();
+  std::string plot = "plot ";
+  int k = 0;
+  for (double eta : etas) {
+    if (k) curves += "\n\n";
+    for (int i = 0; i <= 100; ++i) {
+      const double x[2] = {eta, lo * std::pow(hi / lo, i / 100.0)};
+      curves += fmt::format("{},{}\n", x[1], predict(m, r, x));
+    }
+    plot += fmt::format("{}'cohesion_fit.csv' index {} using 1:2 with lines lc {} title 'model, η = {:g}', \\\n"
+                        "     'cohesion_data.csv' every ::1 using ($1=={:.17g}?$2:1/0):8:3:9 with xyerrorbars "
+                        "pt 7 lc {} notitle",
+                        k ? ", \\\n     " : "", k, k + 1, eta, eta, k + 1);
+    ++k;
+  }
+  {
+    std::ofstream out(fs::path(dir) / "cohesion_fit.csv");
+    out << curves;
+  }
+  const std::string body = fmt::format(
+      "set datafile separator ','\nset logscale x\nset xlabel 'I (measured)'\nset ylabel 'c/p'\n"
+      "set key outside right\nset grid\nset title 'k_0 = {:.4g}, β = {:.3g}, α = {:.3g}'\n{}\n",
+      r["k0"], r["beta"], r["alpha"], plot);
+  return plot_both(dir, "cohesion", body, 900, 500);
+}
+
+}  // namespace cda

@@ -1,0 +1,28 @@
+// The few scene parameters the analysis needs, read from a run's resolved
+// scene.toml (written by cdsim next to series.csv). Read through toml11, the
+// simulator's own parser, so the two never disagree on the syntax.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "error.hpp"
+
+namespace cda {
+
+struct SceneInfo {
+  std::string file;
+  std::optional<double> cohesion_number;   // [contact] cohesion_number (eta; 0: cohesionless)
+  std::optional<double> inertial_number;   // [shear] inertial_number (imposed I)
+  std::optional<double> pressure;          // [shear] pressure
+};
+
+// Throws AnalysisError naming the folder when scene.toml is missing, or the
+// file when it does not parse or a key has a non-numeric value. Absent keys
+// are left empty: the caller says which ones it needs (require()).
+SceneInfo read_scene_info(const std::string& run_dir);
+
+// The value of an optional field, or an AnalysisError naming the file and
+// the key ("[contact] cohesion_number").
+double require(const SceneInfo& s, const std::optional<double>& v, const std::string& key);
+
+}  // namespace cda
