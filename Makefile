@@ -13,7 +13,7 @@ DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libbenchmark-dev gnuplot-nox
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build run test bench accuracy-cost clean help analyze-inertial analyze-cohesive analyze-angularity
+.PHONY: all deps build run test bench accuracy-cost tensile clean help analyze-inertial analyze-cohesive analyze-angularity
 
 all: build
 
@@ -22,6 +22,7 @@ help:
 	@echo "make test           build and run the test suite (ctest)"
 	@echo "make bench          build and run the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv)"
 	@echo "make accuracy-cost  eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s)"
+	@echo "make tensile        tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
 	@echo "make deps           install the missing Debian packages (idempotent)"
 	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity"
 	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
@@ -61,6 +62,10 @@ bench: build
 
 accuracy-cost: build
 	$(BUILD)/cd/bench/accuracy_cost --out outputs/accuracy-cost $(if $(QUICK),--quick)
+
+# Cohesion against the time step (README, "Cohesion and the time step").
+tensile: build
+	$(BUILD)/cd/bench/tensile --out outputs/tensile $(if $(QUICK),--quick)
 
 # Campaign analyses: the report of outputs/campaigns/<name> (made by the
 # campaign-* targets) into outputs/analysis/<name>/, plus the campaign's fits.
