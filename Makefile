@@ -5,6 +5,7 @@ SHELL := /bin/bash
 BUILD ?= build
 JOBS  ?= $(shell nproc)
 SCENE ?= configs/default.toml
+CAMPAIGNS ?= outputs/campaigns
 OUT   ?= outputs/default
 
 # Debian 12 packages the build needs (docs in README, facts in shared/docs/deps.md).
@@ -24,6 +25,8 @@ help:
 	@echo "make accuracy-cost  eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s)"
 	@echo "make tensile        tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
 	@echo "make deps           install the missing Debian packages (idempotent)"
+	@echo "make campaign-inertial|campaign-cohesive|campaign-angularity [N=200 STRAIN=2 P=100 ...]"
+	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
 	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity"
 	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
 
@@ -67,10 +70,82 @@ accuracy-cost: build
 tensile: build
 	$(BUILD)/cd/bench/tensile --out outputs/tensile $(if $(QUICK),--quick)
 
+# ---- Campaigns (README, "Shear protocols and campaigns") -------------------
+# Each run is a make target whose product is its folder (marked complete by
+# a .done file written after cdsim succeeds), so `make -j` runs campaigns in
+# parallel, finished runs are skipped, and a killed run resumes from its
+# checkpoint when made again. Every shear run starts from a compacted sample
+# (prep/...) made once per size and shape. Changing N or STRAIN does not
+# invalidate finished runs: use another CAMPAIGNS folder (or remove it).
+N        ?= 200
+STRAIN   ?= 2
+P        ?= 100
+INERTIAL_I ?= 0.001 0.003 0.01 0.03 0.1 0.3
+COHESIVE_ETA ?= 0 1 10 100
+COHESIVE_I ?= 0.01 0.1
+ANGULAR_NS ?= 0 3 4 5 6 8 10 20 60
+ANGULAR_I ?= 0.01
+CDSIM := $(BUILD)/cd/cdsim
+# Loose square cell for N grains (lattice pitch 1.47 mm for d_mean = 1 mm,
+# size ratio 2), and the time step in t_p = d sqrt(rho/p): at most 0.05 t_p,
+# and at most 0.005 d of relative sliding per step (dt <= 0.005 t_p / I).
+cell_side = $(shell awk 'BEGIN { printf "%.6g", 1.5e-3 * int(sqrt($(N)) + 1) }')
+dt_tp = $(shell awk 'BEGIN { x = 0.005 / $(1); printf "%.4g", x < 0.05 ? x : 0.05 }')
+# 100 series rows per unit strain: 0.01 / shear rate = 0.01 t_p / I.
+series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt(2.6 / $(P)) / $(1) }')
+# A contact snapshot every 0.2 strain (fabric, cdanalysis fabric / report).
+snapshot_dt = $(shell awk 'BEGIN { printf "%.6g", 0.2e-3 * sqrt(2.6 / $(P)) / $(1) }')
+CAMPAIGN_SET = --set output.quiet=true --set output.checkpoint_interval=0.05
+
+inertial_runs   := $(foreach i,$(INERTIAL_I),$(CAMPAIGNS)/inertial/I_$(i))
+cohesive_runs   := $(foreach e,$(COHESIVE_ETA),$(foreach i,$(COHESIVE_I),$(CAMPAIGNS)/cohesive/eta_$(e)_I_$(i)))
+angularity_runs := $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/angularity/ns_$(n))
+
+.PHONY: campaign-inertial campaign-cohesive campaign-angularity campaign-list
+campaign-inertial: $(addsuffix /.done,$(inertial_runs))
+campaign-cohesive: $(addsuffix /.done,$(cohesive_runs))
+campaign-angularity: $(addsuffix /.done,$(angularity_runs))
+# The run folders of a campaign, one per line, and the sample a run starts
+# from (configs/cluster/job-array.sh).
+.PHONY: campaign-prep-of
+campaign-list:
+	@for r in $($(CAMPAIGN)_runs); do echo $$r; done
+campaign-prep-of:
+	@case "$(RUN)" in */angularity/ns_*) echo $(CAMPAIGNS)/prep/$(notdir $(RUN))/.done ;; \
+	  *) echo $(CAMPAIGNS)/prep/ns_0/.done ;; esac
+
+# Products, never intermediates: make must not delete a sample when done.
+.PRECIOUS: $(CAMPAIGNS)/prep/ns_%/.done
+
+# Compacted samples: disks (ns_0) or n-gons, N grains, isotropic at P.
+$(CAMPAIGNS)/prep/ns_%/.done: | build
+	$(CDSIM) configs/shear-prep.toml --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_interval=1 \
+	  --set output.snapshot_interval=0 \
+	  --set particles.n=$(N) --set particles.nsides=[$*] --set shear.pressure=$(P) \
+	  --set shear.width=$(cell_side) --set shear.height=$(cell_side)
+	touch $@
+
+shear_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) \
+	  --set shear.start='"$(CAMPAIGNS)/prep/ns_$(2)/checkpoint.bin"' --set shear.pressure=$(P) \
+	  --set shear.inertial_number=$(1) --set shear.strain=$(STRAIN) --set shear.dt_tp=$(call dt_tp,$(1)) \
+	  --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=$(call snapshot_dt,$(1))
+
+$(CAMPAIGNS)/inertial/I_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
+	$(call shear_run,$*,0)
+	touch $@
+
+# eta_<eta>_I_<I>: f_a = eta p d; eta = 0 are the reference runs of the fit.
+$(CAMPAIGNS)/cohesive/eta_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
+	$(call shear_run,$(lastword $(subst _I_, ,$*)),0) --set contact.cohesion_number=$(firstword $(subst _I_, ,$*))
+	touch $@
+
+$(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done
+	$(call shear_run,$(ANGULAR_I),$*)
+	touch $@
+
 # Campaign analyses: the report of outputs/campaigns/<name> (made by the
 # campaign-* targets) into outputs/analysis/<name>/, plus the campaign's fits.
 CDA := $(BUILD)/analysis/cdanalysis
-CAMPAIGNS := outputs/campaigns
 ANALYSIS := outputs/analysis
 
 analyze-inertial: build
