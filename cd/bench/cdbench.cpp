@@ -17,7 +17,10 @@
 //                       the speedup from 1 to 2 threads
 //   effect/<name>:<on|off>    one step, N = 1e4, 1 thread: what an effect
 //                       costs when on, and that it costs nothing when off
-// TODO(periodicity): effect/periodic:on|off once periodic boundaries exist.
+//                       (periodicity: the pile made periodic in x over its
+//                       box width plus one diameter; the side walls stay, so
+//                       the same rows, and the difference is the periodic
+//                       cell list, images and wrapping)
 //
 // Scenes: N = 1e3 is a deposited, settled square pile (45 d deep); larger N
 // are side by side mirrored copies of it (a layer of the same depth), so
@@ -290,12 +293,24 @@ const Effect kEffects[] = {
        p.adhesion = 1e-12;
        p.debond = 0.0;
      }},
+    // Width 0: set to the pile's box width + d by bm_effect.
+    {"periodicity", [](cd::WorldParams& p) { p.cell = {}; },
+     [](cd::WorldParams& p) {
+       p.cell = {};
+       p.cell.mode = cd::CellParams::Mode::Walls;
+     }},
 };
 constexpr int kEffectN = 10000;
 
 void bm_effect(benchmark::State& state, const Effect& e, bool on) {
-  cd::WorldParams p = fixed_sweeps(prepared(kEffectN).params(), kSweeps);
+  const cd::World& w = prepared(kEffectN);
+  cd::WorldParams p = fixed_sweeps(w.params(), kSweeps);
   (on ? e.on : e.off)(p);
+  if (p.cell.mode != cd::CellParams::Mode::None) {
+    double xmax = 0;
+    for (const cd::Vec2& x : w.bodies.pos) xmax = std::max(xmax, x.x());
+    p.cell.width = xmax + p.d_ref;
+  }
   run_steps(state, kEffectN, 1, p, true);
 }
 

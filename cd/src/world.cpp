@@ -33,6 +33,7 @@ void World::configure() {
   walls_ = prm_.cell.mode == CellParams::Mode::Walls;
   pc_.x = periodic_ || walls_;
   pc_.y = periodic_;
+  if ((periodic_ || walls_) && cell.width <= 0.0) cell.width = prm_.cell.width;
   prepared_ = false;
 }
 
