@@ -226,11 +226,11 @@ int main(int argc, char** argv) {
           const auto series = read_series(r);
           const auto x = default_x_column(series);
           const auto s = run_steady(r, series, "q_over_p", x, std::nullopt);
-          const auto si = stats_over(series, "inertial_number", x, s.stats.window);
+          const auto si = measured_inertial_number(series, x, s.stats.window);
           I.push_back(si.mean);
           mu.push_back(s.stats.mean);
           err.push_back(s.stats.error());
-          fmt::print("{}: I = {:.4g} +- {:.2g}, mu = {:.4f} +- {:.4f}\n", r, si.mean, si.error(),
+          fmt::print("{}: I = {:.4g} +- {:.2g}, mu = {:.4f} +- {:.4f}\n", r, si.mean, si.err,
                      s.stats.mean, s.stats.error());
         }
       }

@@ -27,11 +27,11 @@ SteadyPoint steady_point(const std::string& run_dir) {
   const auto series = read_series(run_dir);
   const auto x = default_x_column(series);
   const auto s = run_steady(run_dir, series, "q_over_p", x, std::nullopt);
-  const auto si = stats_over(series, "inertial_number", x, s.stats.window);
+  const auto si = measured_inertial_number(series, x, s.stats.window);
   p.mu = s.stats.mean;
   p.mu_err = s.stats.error();
   p.I = si.mean;
-  p.I_err = si.error();
+  p.I_err = si.err;
   return p;
 }
 

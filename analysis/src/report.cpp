@@ -199,7 +199,11 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         std::vector<double> row = {static_cast<double>(k)};
         double tau = rs.stats.acf.tau, neff = rs.stats.acf.n_eff;
         for (const auto& q : quantities) {
-          if (series.has(q)) {
+          if (q == "inertial_number" && series.has(q)) {
+            const auto st = measured_inertial_number(series, xc, w);  // from <sigma_yy>
+            row.push_back(st.mean);
+            row.push_back(st.err);
+          } else if (series.has(q)) {
             const auto st = stats_over(series, q, xc, w);
             row.push_back(st.mean);
             row.push_back(st.error());

@@ -1,5 +1,7 @@
 #include "run.hpp"
 
+#include <cmath>
+
 #include <fmt/core.h>
 
 #include <cstdlib>
@@ -49,6 +51,27 @@ SteadyStats stats_over(const Table& series, const std::string& column, const std
                        const Window& w) {
   return steady_stats(series.column(x_column), series.column(column), w,
                       fmt::format("'{}' column '{}'", series.source(), column));
+}
+
+Estimate measured_inertial_number(const Table& series, const std::string& x_column, const Window& w) {
+  if (!series.has("syy")) {
+    const SteadyStats si = stats_over(series, "inertial_number", x_column, w);
+    return {si.mean, si.error()};
+  }
+  const SteadyStats ss = stats_over(series, "syy", x_column, w);
+  // I sqrt(sigma_yy) = gamma-dot d sqrt(rho): the same on every row.
+  const auto& I = series.column("inertial_number");
+  const auto& syy = series.column("syy");
+  double k = 0;
+  for (std::size_t r = w.begin; r < w.end; ++r)
+    if (syy[r] > 0) {
+      k = I[r] * std::sqrt(syy[r]);
+      break;
+    }
+  if (k <= 0 || ss.mean <= 0)
+    throw AnalysisError(fmt::format("'{}': no positive syy in the steady window", series.source()));
+  const double i = k / std::sqrt(ss.mean);
+  return {i, 0.5 * i * ss.error() / ss.mean};
 }
 
 RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume) {
