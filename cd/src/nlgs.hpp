@@ -50,7 +50,7 @@ struct SolveStats {
   double residual_max = 0;   // law residual, max over contacts / mean |p|
   double residual_mean = 0;  // law residual, mean over contacts / mean |p|
   double p_mean = 0;         // mean |p| (impulse scale)
-  double dof_rel = 0;        // last sweep's largest |dv| / (inv_mass scale) of the boundary dofs
+  double dof_rel = 0;        // last sweep's largest dof residual / (inv_mass scale) (update_dof)
 };
 
 // Colouring: rows are permuted so that colour c is [start[c], start[c+1]);
@@ -76,8 +76,9 @@ SolveStats nlgs_solve(std::vector<ContactRow>& rows, const Colouring& col,
                       std::vector<BodyVel>& vel, const SolverParams& prm,
                       std::vector<BoundaryDof>* dofs = nullptr);
 
-// One Gauss-Seidel update of a boundary dof from the rows' impulses; returns
-// |dv| / (inv_mass scale).
+// One update of a boundary dof from the rows' impulses, damped by the active
+// rows' response (nlgs.cpp); returns the residual of its equation before the
+// update, |v0 + inv_mass sum(an p_n + at p_t) - v| / (inv_mass scale).
 double update_dof(BoundaryDof& d, ContactRow* rows);
 
 // Relative velocity (u_n, u_t) of a row from body velocities.
