@@ -126,7 +126,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"shear", "width", &Scene::cell_width, "m", ge(0), "cell width (period in x)"},
       {"shear", "height", &Scene::cell_height, "m", ge(0), "initial cell height (periodic) or gap between the wall grains' centres (walls)"},
       {"shear", "pressure", &Scene::pressure, "N/m", ge(0), "imposed normal stress sigma_yy (2D: force per length)"},
-      {"shear", "inertial_number", &Scene::inertial_number, "", ge(0), "imposed inertial number I: shear rate = I sqrt(p/rho)/d (walls: top wall speed = shear rate x initial gap); 0: no shear"},
+      {"shear", "inertial_number", &Scene::inertial_number, "", ge(0), "imposed inertial number I: shear rate = I sqrt(p/rho)/d (walls: top wall speed = shear rate x current gap); 0: no shear"},
       {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width) degree of freedom, in units of the particles' total mass"},
       {"shear", "isotropic", &Scene::isotropic, "", any(), "compaction: the width is a degree of freedom too, at sigma_xx = pressure (periodic, inertial_number = 0)"},
       {"shear", "strain", &Scene::strain, "", ge(0), "run until this shear strain (overrides time.duration); 0: use time.duration"},

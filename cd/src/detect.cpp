@@ -392,17 +392,25 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
   grid.info_t.resize(nthreads);
 
   if (nd > 0) {
-    double h = 2 * rmax + alert;
+    const double h = 2 * rmax + alert;
     const bool px = cell && cell->x, py = cell && cell->y;
+    const double wx = cell ? cell->width : 0, wy = cell ? cell->height : 0;
     // Bound the cell count by ~4 cells a particle, so that a runaway particle
-    // cannot blow up memory: the grid coarsens instead. (A periodic axis
-    // has its own bounded length.)
-    auto count = [&](double e, bool p, double len) { return std::floor((p ? len : e) / h) + 1; };
-    while (count(hi.x() - lo.x(), px, cell ? cell->width : 0) *
-               count(hi.y() - lo.y(), py, cell ? cell->height : 0) > 4.0 * nd + 16)
-      h *= 1.5;
-    const Axis ax = make_axis(lo.x(), hi.x(), h, px, cell ? cell->width : 0);
-    const Axis ay = make_axis(lo.y(), hi.y(), h, py, cell ? cell->height : 0);
+    // cannot blow up memory: the grid coarsens instead. A periodic axis has
+    // its own bounded length and never coarsens below the 4 x 3 cells its
+    // images need (a dilute sample in a large cell is no runaway): the other
+    // axis coarsens alone.
+    double hx = h, hy = h;
+    auto count = [](double e, bool p, double len, double hh) { return std::floor((p ? len : e) / hh) + 1; };
+    while (count(hi.x() - lo.x(), px, wx, hx) * count(hi.y() - lo.y(), py, wy, hy) > 4.0 * nd + 16) {
+      const bool cx = !px || std::floor(wx / (1.5 * hx)) >= 4;
+      const bool cy = !py || std::floor(wy / (1.5 * hy)) >= 3;
+      if (!cx && !cy) break;
+      if (cx) hx *= 1.5;
+      if (cy) hy *= 1.5;
+    }
+    const Axis ax = make_axis(lo.x(), hi.x(), hx, px, wx);
+    const Axis ay = make_axis(lo.y(), hi.y(), hy, py, wy);
     if ((px && ax.n < 4) || (py && ay.n < 3))
       throw std::runtime_error(
           "periodic cell too small: it must span at least 4 (x) and 3 (y) times 2 r_max + alert");

@@ -133,10 +133,7 @@ WorldParams world_params(const Scene& s) {
     c.width = s.cell_width;
     c.pressure = s.pressure;
     c.isotropic = s.isotropic;
-    if (c.mode == CellParams::Mode::LeesEdwards)
-      c.shear_rate = shear_rate(s);
-    else
-      c.wall_velocity = shear_rate(s) * s.cell_height;
+    c.shear_rate = shear_rate(s);
     // c.mass: set by build_world, which knows the particles' mass
   }
   p.solver.tol = s.tol;
@@ -249,7 +246,7 @@ World build_world(const Scene& s) {
     // each wall (driven bodies); the top row moves together (World::top_wall).
     const int m = std::max(1, static_cast<int>(std::floor(s.cell_width / s.d_mean)));
     const double pitch = s.cell_width / m, r = 0.5 * std::min(pitch, s.d_mean);
-    const Vec2 vtop(wp.cell.wall_velocity, 0.0);
+    const Vec2 vtop(wp.cell.shear_rate * s.cell_height, 0.0);
     for (int k = 0; k < m; ++k) {
       const int b = B.add_disk({(k + 0.5) * pitch, 0.0}, r, s.density);
       B.driven[b] = 1;

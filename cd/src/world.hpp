@@ -25,15 +25,14 @@ namespace cd {
 //                width, solved with the contacts (BoundaryDof). isotropic:
 //                the width too, at sigma_xx = pressure (compaction; no shear).
 //   Walls        periodic in x over `width`; the bodies listed in
-//                World::top_wall move together, at imposed horizontal
-//                velocity wall_velocity and a vertical velocity that is a
-//                degree of freedom loaded by -pressure x width.
+//                World::top_wall move together, at the horizontal velocity
+//                shear_rate x (current gap) and a vertical velocity that is
+//                a degree of freedom loaded by -pressure x width.
 struct CellParams {
   enum class Mode { None, LeesEdwards, Walls };
   Mode mode = Mode::None;
   double width = 0.0;
-  double shear_rate = 0.0;     // gamma-dot (LeesEdwards)
-  double wall_velocity = 0.0;  // top wall's horizontal velocity (Walls)
+  double shear_rate = 0.0;     // gamma-dot
   double pressure = 0.0;       // imposed normal stress (N/m); 0: height fixed
   double mass = 0.0;           // mass of the height (and width) dof (kg)
   bool isotropic = false;
@@ -111,7 +110,7 @@ class World {
   // the midpoint (LeesEdwards, Walls); neither: the sum itself (stress times V).
   Eigen::Matrix2d contact_stress(double volume = 0.0) const;
   double cell_volume() const { return cm_.width * cm_.height; }  // midpoint cell area
-  // Imposed shear rate of the protocol (Walls: wall velocity over the gap).
+  // Imposed shear rate of the protocol (0 without one).
   double shear_rate() const;
 
   double kinetic_energy() const;
