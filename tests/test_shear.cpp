@@ -684,6 +684,11 @@ TEST(BadInput, ShearScenesNameTheKeyAtFault) {
        {"shear.mode"}},
       {"dt_tp without pressure", no_g + disks + ok_shear + "dt_tp = 0.05\n",
        {"shear.dt_tp", "shear.pressure"}},
+      {"cohesion number without pressure", no_g + disks + "[contact]\ncohesion_number = 10.0\n" + ok_shear,
+       {"contact.cohesion_number", "shear.pressure"}},
+      {"cohesion number and adhesion",
+       no_g + disks + "[contact]\ncohesion_number = 10.0\nadhesion = 1.0\n" + ok_shear + "pressure = 100.0\n",
+       {"contact.adhesion", "contact.cohesion_number"}},
   };
   for (const Case& c : cases) {
     const std::string msg = scene_error(c.text);
@@ -691,6 +696,22 @@ TEST(BadInput, ShearScenesNameTheKeyAtFault) {
       EXPECT_NE(msg.find(k), std::string::npos) << c.what << ": " << msg;
     std::printf("[ bad input ] %s: %s\n", c.what, msg.c_str());
   }
+}
+
+// eta = f_a / (p d): the scene's cohesion number sets the pull-off force from
+// the imposed pressure and the mean diameter, and the time step from t_p.
+TEST(Scenes, CohesionNumberAndTimeStepFollowThePressure) {
+  const std::string text =
+      "[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 20\nd_mean = 2e-3\ndensity = 4.0\n"
+      "[contact]\ncohesion_number = 10.0\n[shear]\nmode = \"periodic\"\nwidth = 0.04\n"
+      "height = 0.04\npressure = 250.0\ninertial_number = 0.1\ndt_tp = 0.02\nstrain = 2.0\n";
+  const cd::Scene s = cd::parse_scene(text, "eta.toml");
+  const cd::World w = cd::build_world(s);
+  const double d = 2e-3, p = 250.0, rho = 4.0, tp = d * std::sqrt(rho / p);
+  EXPECT_DOUBLE_EQ(w.params().adhesion, 10.0 * p * d);
+  EXPECT_DOUBLE_EQ(w.params().dt, 0.02 * tp);
+  EXPECT_DOUBLE_EQ(w.params().cell.shear_rate, 0.1 / tp);
+  EXPECT_DOUBLE_EQ(cd::run_duration(s), 2.0 / (0.1 / tp));
 }
 
 }  // namespace
