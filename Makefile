@@ -14,7 +14,7 @@ DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libbenchmark-dev gnuplot-nox
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build run test bench accuracy-cost tensile clean help analyze-inertial analyze-cohesive analyze-angularity
+.PHONY: all deps build run test bench regress accuracy-cost tensile clean help analyze-inertial analyze-cohesive analyze-angularity
 
 all: build
 
@@ -27,6 +27,7 @@ help:
 	@echo "make deps           install the missing Debian packages (idempotent)"
 	@echo "make campaign-inertial|campaign-cohesive|campaign-angularity [N=200 STRAIN=2 P=100 ...]"
 	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
+	@echo "make regress        re-run the reference campaign, refit mu(I), compare with tests/data/regress/"
 	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity"
 	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
 
@@ -160,6 +161,23 @@ analyze-cohesive: build
 
 analyze-angularity: build
 	$(CDA) report $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity
+
+# Regression of fitted curves: re-runs the small reference campaign of
+# tests/data/regress/ from scratch (same sizes and seed, ~1 min on 2 cores),
+# fits mu(I) and compares with the stored fit: a parameter fails when it
+# moved by more than 3 combined standard uncertainties (cdanalysis
+# compare-fits). The simulator is deterministic, so an unchanged code gives
+# the same numbers; a change of the physics or numerics shows up here.
+REGRESS_DIR ?= outputs/regress
+REGRESS_I := 0.01 0.02 0.05 0.1 0.2 0.3 0.6 1.0
+.PHONY: regress regress-campaign
+regress: regress-campaign
+	$(CDA) fit mu-i $(REGRESS_DIR)/inertial --window 1:3 --toml $(REGRESS_DIR)/mu_i.toml
+	$(CDA) compare-fits tests/data/regress/mu_i.toml $(REGRESS_DIR)/mu_i.toml --tol-sigma 3
+regress-campaign: build
+	rm -rf $(REGRESS_DIR)
+	$(MAKE) --no-print-directory -j $(JOBS) campaign-inertial CAMPAIGNS=$(REGRESS_DIR) N=100 STRAIN=3 P=100 \
+	  INERTIAL_I="$(REGRESS_I)"
 
 clean:
 	rm -rf $(BUILD)

@@ -111,6 +111,9 @@ int main(int argc, char** argv) {
                                  "inertial_number)");
   mu_i->add_option("--table", table, "CSV with columns I, mu and optionally mu_err, instead of runs");
   mu_i->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
+  mu_i->add_option("--out", out, "folder for the plot mu_I.png/svg (points, fit, 1-sigma band)");
+  mu_i->add_option("--window", window, "steady window a:b of each run's abscissa (strain) "
+                                       "(default: detected per run)");
   auto* coh = fit->add_subcommand(
       "cohesion",
       "c/p = k0 eta/(1 - beta ln(1 - I/(1 + alpha eta)^(1/2))) over steady runs: eta from scene.toml "
@@ -222,10 +225,12 @@ int main(int argc, char** argv) {
         err = col_or_empty(t, "mu_err");
       } else {
         if (runs.empty()) throw AnalysisError("fit mu-i: give run folders or --table");
+        std::optional<std::pair<double, double>> range;
+        if (!window.empty()) range = parse_range(window);
         for (const auto& r : expand_runs(runs)) {
           const auto series = read_series(r);
           const auto x = default_x_column(series);
-          const auto s = run_steady(r, series, "q_over_p", x, std::nullopt);
+          const auto s = run_steady(r, series, "q_over_p", x, range);
           const auto si = measured_inertial_number(series, x, s.stats.window);
           I.push_back(si.mean);
           mu.push_back(s.stats.mean);
@@ -237,6 +242,13 @@ int main(int argc, char** argv) {
       const auto r = fit_mu_I(I, mu, err);
       print_fit(r, mu_of_I());
       write_toml(toml_out, {r}, {mu_of_I()});
+      if (!out.empty()) {
+        if (err.empty()) err.assign(I.size(), 0.0);
+        if (!plot_mu_I(out, I, mu, err, r))
+          fmt::print("cdanalysis: gnuplot did not run: {}/mu_I.gp written, no PNG\n", out);
+        else
+          fmt::print("wrote {}/mu_I.png and mu_I.svg\n", out);
+      }
     } else if (coh->parsed()) {
       if (!table.empty()) {
         if (!runs.empty()) throw AnalysisError("fit cohesion: give run folders or --table, not both");

@@ -102,6 +102,32 @@ bool plot_series(const std::string& dir, const std::string& stem, const Table& s
   return plot_both(dir, stem, body);
 }
 
+bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
+               std::span<const double> mu_err, const FitResult& r) {
+  const Model model = mu_of_I();
+  std::filesystem::create_directories(dir);
+  Table pts({"I", "mu", "mu_err"});
+  for (std::size_t i = 0; i < I.size(); ++i) pts.add_row({I[i], mu[i], mu_err[i]});
+  pts.write_csv((fs::path(dir) / "mu_I_data.csv").string());
+  Table curve({"I", "mu", "lo", "hi"});
+  const double lo = *std::min_element(I.begin(), I.end()) / 2, hi = *std::max_element(I.begin(), I.end()) * 2;
+  for (int k = 0; k <= 200; ++k) {
+    const double x = lo * std::pow(hi / lo, k / 200.0);
+    const double m = predict(model, r, &x), e = predict_error(model, r, &x);
+    curve.add_row({x, m, m - e, m + e});
+  }
+  curve.write_csv((fs::path(dir) / "mu_I_fit.csv").string());
+  const std::string body = fmt::format(
+      "set datafile separator ','\nset logscale x\nset xlabel 'I'\nset ylabel 'μ* = q/p'\n"
+      "set key top left\nset grid\n"
+      "plot 'mu_I_fit.csv' every ::1 using 1:3:4 with filledcurves fc rgb '#cce5ff' title '1σ band', \\\n"
+      "     'mu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' "
+      "title 'μ_1 = {:.3f}, μ_2 = {:.3f}, I_0 = {:.3g}', \\\n"
+      "     'mu_I_data.csv' every ::1 using 1:2:3 with yerrorbars pt 7 lc rgb 'black' title 'runs'\n",
+      r["mu1"], r["mu2"], r["I0"]);
+  return plot_both(dir, "mu_I", body);
+}
+
 bool plot_polar(const std::string& dir, const std::string& stem, const RunFabric& f) {
   const auto& p = f.profile;
   const auto& a = f.fft;
@@ -266,26 +292,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       const auto r = fit_mu_I(I, mu, mu_err);
       fits.push_back(r);
       models.push_back(mu_of_I());
-      Table pts({"I", "mu", "mu_err"});
-      for (std::size_t i = 0; i < I.size(); ++i) pts.add_row({I[i], mu[i], mu_err[i]});
-      pts.write_csv((fs::path(out_dir) / "mu_I_data.csv").string());
-      Table curve({"I", "mu", "lo", "hi"});
-      const double lo = *std::min_element(I.begin(), I.end()) / 2, hi = *std::max_element(I.begin(), I.end()) * 2;
-      for (int k = 0; k <= 200; ++k) {
-        const double x = lo * std::pow(hi / lo, k / 200.0);
-        const double m = predict(models.back(), r, &x), e = predict_error(models.back(), r, &x);
-        curve.add_row({x, m, m - e, m + e});
-      }
-      curve.write_csv((fs::path(out_dir) / "mu_I_fit.csv").string());
-      const std::string body = fmt::format(
-          "set datafile separator ','\nset logscale x\nset xlabel 'I'\nset ylabel 'μ* = q/p'\n"
-          "set key top left\nset grid\n"
-          "plot 'mu_I_fit.csv' every ::1 using 1:3:4 with filledcurves fc rgb '#cce5ff' title '1σ band', \\\n"
-          "     'mu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' "
-          "title 'μ_1 = {:.3f}, μ_2 = {:.3f}, I_0 = {:.3g}', \\\n"
-          "     'mu_I_data.csv' every ::1 using 1:2:3 with yerrorbars pt 7 lc rgb 'black' title 'runs'\n",
-          r["mu1"], r["mu2"], r["I0"]);
-      sum.plots_ok = plot_both(out_dir, "mu_I", body) && sum.plots_ok;
+      sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r) && sum.plots_ok;
       html_fit = fmt::format("<h2>μ(I)</h2><img src='mu_I.png' width=600><p>{}: chi2/dof = {:.2f}</p>\n",
                              html_escape(mu_of_I().formula), r.chi2_dof);
     } catch (const AnalysisError& e) {

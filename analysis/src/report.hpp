@@ -1,6 +1,7 @@
 // Campaign report: a folder of tables (CSV), fit parameters (TOML), plots
 // (gnuplot, pngcairo and svg) and an index.html that links them.
 #pragma once
+#include <span>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,10 @@ bool plot_series(const std::string& dir, const std::string& stem, const Table& s
 // Polar diagrams of P(theta), <fn>(theta), <ft>(theta) with their Fourier
 // (second-harmonic) fits; 3 plots named <stem>_P, <stem>_fn, <stem>_ft.
 bool plot_polar(const std::string& dir, const std::string& stem, const RunFabric& f);
+// mu(I) points with error bars, the fit and its 1-sigma band: dir/mu_I.{png,svg}
+// (with mu_I_data.csv, mu_I_fit.csv).
+bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
+               std::span<const double> mu_err, const FitResult& r);
 
 // Runs of a campaign folder: its subfolders holding series.csv, sorted; the
 // folder itself if it holds series.csv. Throws AnalysisError naming the
