@@ -176,7 +176,7 @@ TEST(AnalysisRegress, ReferenceCampaignReproducesStoredFit) {
 
 // The simulator's reference campaign (tests/data/regress/, written by its
 // regenerate.sh from the same runs as `make regress`): 100 disks, mu_p = 0.4,
-// p = 100 N/m, strain 3, I = 0.01 to 1. Re-analysing the committed series must
+// p = 100 N/m, strain 3, I = 0.01 to 0.4. Re-analysing the committed series must
 // reproduce the stored fit; and the stored fit must be the physics of 2D
 // frictional disks, not just the code's own output: the quasi-static
 // friction mu1 = q/p at I -> 0 of disks with mu_p = 0.4 is 0.25-0.30 in

@@ -58,14 +58,23 @@ Estimate measured_inertial_number(const Table& series, const std::string& x_colu
     const SteadyStats si = stats_over(series, "inertial_number", x_column, w);
     return {si.mean, si.error()};
   }
-  const SteadyStats ss = stats_over(series, "syy", x_column, w);
+  // The normal stress the simulator's I uses: contact syy plus the kinetic
+  // kyy when the series has it (cdsim writes both).
+  Table t = series;
+  const auto& syy = series.column("syy");
+  std::vector<double> total(syy.begin(), syy.end());
+  if (series.has("kyy")) {
+    const auto& kyy = series.column("kyy");
+    for (std::size_t r = 0; r < total.size(); ++r) total[r] += kyy[r];
+  }
+  t.add_column("sigma_yy_total", total);
+  const SteadyStats ss = stats_over(t, "sigma_yy_total", x_column, w);
   // I sqrt(sigma_yy) = gamma-dot d sqrt(rho): the same on every row.
   const auto& I = series.column("inertial_number");
-  const auto& syy = series.column("syy");
   double k = 0;
   for (std::size_t r = w.begin; r < w.end; ++r)
-    if (syy[r] > 0) {
-      k = I[r] * std::sqrt(syy[r]);
+    if (total[r] > 0) {
+      k = I[r] * std::sqrt(total[r]);
       break;
     }
   if (k <= 0 || ss.mean <= 0)

@@ -40,7 +40,8 @@ SteadyStats stats_over(const Table& series, const std::string& column, const std
                        const Window& w);
 
 // The measured inertial number over a steady window, I = gamma-dot d
-// sqrt(rho / <sigma_yy>): from the mean normal stress, not the mean of the
+// sqrt(rho / <sigma_yy>), sigma_yy = syy + kyy (contact and kinetic, when
+// the series has kyy): from the mean normal stress, not the mean of the
 // per-row inertial_number column, which is biased upwards by sigma_yy's
 // fluctuations (Jensen: <sigma^-1/2> > <sigma>^-1/2; +40 % at I = 0.3 with
 // rows every 2 steps). Falls back to the column's mean when the series has

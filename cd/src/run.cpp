@@ -237,6 +237,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
           const double V = w.cell.width * w.cell.height;
           const double gd = w.shear_rate();
           const auto [z, nonrattler] = coordination(w);
+          const Eigen::Matrix2d K = w.kinetic_stress();  // at the row's step
           cols.insert(cols.end(), {{"strain", w.cell.strain},
                       {"shear_rate", gd},
                       {"sxx", sxx},
@@ -249,14 +250,20 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
                       // tau / sigma_n, positive in the imposed sense (the
                       // top moves +x, so sigma_xy < 0 compression-positive)
                       {"shear_stress_ratio", syy > 0 ? -sxy / syy : 0.0},
-                      {"inertial_number", syy > 0 ? gd * d_mean * std::sqrt(s.density / syy) : 0.0},
+                      // with the whole normal stress, the one the control imposes
+                      {"inertial_number", syy + K(1, 1) > 0
+                                              ? gd * d_mean * std::sqrt(s.density / (syy + K(1, 1)))
+                                              : 0.0},
                       {"packing_fraction", area / V},
                       {"z", z},
                       {"non_rattler", nonrattler},
                       {"cell_width", w.cell.width},
                       {"cell_height", w.cell.height},
                       {"volume_strain_rate",
-                       w.time > t_prev ? std::log(V / v_prev) / (w.time - t_prev) : 0.0}});
+                       w.time > t_prev ? std::log(V / v_prev) / (w.time - t_prev) : 0.0},
+                      {"kxx", K(0, 0)},
+                      {"kxy", K(0, 1)},
+                      {"kyy", K(1, 1)}});
           v_prev = V;
           t_prev = w.time;
           sh = ShearInterval{};

@@ -110,6 +110,10 @@ class World {
   // the midpoint (LeesEdwards, Walls); neither: the sum itself (stress times V).
   Eigen::Matrix2d contact_stress(double volume = 0.0) const;
   double cell_volume() const { return cm_.width * cm_.height; }  // midpoint cell area
+  // Kinetic stress (1/V) sum m v' v'^T over dynamic bodies, v' the velocity
+  // less the mean shear flow (gamma-dot y, 0) and the mean of the rest;
+  // V the cell area. Zero without a cell.
+  Eigen::Matrix2d kinetic_stress() const;
   // Imposed shear rate of the protocol (0 without one).
   double shear_rate() const;
 
