@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -22,6 +23,14 @@ inline CmdResult run_command(const std::string& cmd) {
   while (std::fgets(buf.data(), buf.size(), p.get())) out += buf.data();
   const int status = pclose(p.release());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+// An empty folder BUILD/<test>/<name> for a test's files (emptied first).
+inline std::filesystem::path scratch_dir(const std::string& test, const std::string& name) {
+  const std::filesystem::path p = std::filesystem::path(CDLAB_BINARY_DIR) / test / name;
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p;
 }
 
 }  // namespace cdtest

@@ -16,18 +16,14 @@
 #include "analysis/src/report.hpp"
 #include "analysis/src/run.hpp"
 #include "analysis/src/snapshot.hpp"
+#include "cli_util.hpp"
 
 namespace fs = std::filesystem;
 using namespace cda;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path p = fs::path(CDLAB_BINARY_DIR) / "test_analysis_io" / name;
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
+fs::path scratch(const std::string& name) { return cdtest::scratch_dir("test_analysis_io", name); }
 
 void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 

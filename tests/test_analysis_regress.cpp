@@ -20,12 +20,7 @@ using namespace cda;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path p = fs::path(CDLAB_BINARY_DIR) / "test_analysis_regress" / name;
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
+fs::path scratch(const std::string& name) { return cdtest::scratch_dir("test_analysis_regress", name); }
 
 const fs::path exe = fs::path(CDLAB_BINARY_DIR) / "analysis" / "cdanalysis";
 

@@ -21,12 +21,7 @@ using namespace cda;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path p = fs::path(CDLAB_BINARY_DIR) / "test_analysis_runs" / name;
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
+fs::path scratch(const std::string& name) { return cdtest::scratch_dir("test_analysis_runs", name); }
 
 std::string message(const std::function<void()>& f) {
   try {
