@@ -71,6 +71,11 @@ void World::predict() {
   const double h = 0.5 * prm_.dt;
   xm_.resize(n);
   thm_.resize(n);
+  // Per-body and per-row loops with no reduction run in parallel above
+  // the solver's threshold: each element is written once, so the result is
+  // the same for any thread count.
+  const bool par = static_cast<int>(n) >= prm_.solver.min_parallel / 2;
+#pragma omp parallel for schedule(static) if (par)
   for (std::size_t i = 0; i < n; ++i) {
     const BodyVel& v = bodies.vel[i];
     xm_[i] = bodies.pos[i] + h * Vec2(v.vx, v.vy);
@@ -99,6 +104,8 @@ void World::build() {
   const bool rot = prm_.solver.rotation;
   const auto& V = bodies.vel;
   const std::size_t nr = rows_.size();
+  const bool par = static_cast<int>(nr) >= prm_.solver.min_parallel;
+#pragma omp parallel for schedule(static) if (par)
   for (std::size_t k = 0; k < nr; ++k) {
     ContactRow& r = rows_[k];
     set_block(r, V[r.b1], V[r.b2], rot);
@@ -148,6 +155,7 @@ void World::build() {
     }
   }
   // Warm start from the previous step's impulses, matched by contact key.
+#pragma omp parallel for schedule(static) if (par)
   for (std::size_t k = 0; k < nr; ++k) {
     const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
     if (it != warm_.keys.end() && *it == info_[k].key) {
@@ -175,6 +183,7 @@ void World::solve() {
   {
     std::vector<ContactRow> r(rows_.size());
     std::vector<ContactInfo> f(info_.size());
+#pragma omp parallel for schedule(static) if (static_cast<int>(rows_.size()) >= prm_.solver.min_parallel)
     for (std::size_t k = 0; k < rows_.size(); ++k) {
       r[k] = rows_[col_.perm[k]];
       f[k] = info_[col_.perm[k]];
@@ -237,7 +246,9 @@ void World::solve() {
 void World::integrate() {
   const double h = 0.5 * prm_.dt;
   const bool rot = prm_.solver.rotation;
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
+  const std::size_t n = bodies.size();
+#pragma omp parallel for schedule(static) if (static_cast<int>(n) >= prm_.solver.min_parallel / 2)
+  for (std::size_t i = 0; i < n; ++i) {
     const BodyVel& v = bodies.vel[i];
     bodies.pos[i] = xm_[i] + h * Vec2(v.vx, v.vy);
     if (rot || !bodies.is_dynamic(i)) bodies.angle[i] = thm_[i] + h * v.w;
