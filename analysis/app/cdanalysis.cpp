@@ -305,13 +305,23 @@ int main(int argc, char** argv) {
       opt.blocks_per_bin = blocks_per_bin;
       if (!strain_range.empty()) opt.strain = parse_range(strain_range);
       std::vector<RunDilatancy> rd;
-      for (const auto& r : expand_runs(runs)) {
-        rd.push_back(run_dilatancy(r, read_series(r), opt));
+      const auto all = expand_runs(runs);
+      for (const auto& r : all) {
+        // A run too short for its bins is skipped with the reason (the
+        // transient data of the other runs still make a fit); none usable: error.
+        try {
+          rd.push_back(run_dilatancy(r, read_series(r), opt));
+        } catch (const AnalysisError& e) {
+          if (all.size() == 1) throw;
+          fmt::print("{}: skipped: {}\n", r, e.what());
+          continue;
+        }
         const auto& d = rd.back();
         fmt::print("{}: {} rows ({} skipped), tau {:.3g} rows, blocks of {} rows, {} bins, reliability of "
                    "sin psi {:.3f}\n",
                    r, d.rows, d.skipped, d.tau, d.block_rows, d.bins.size(), d.reliability);
       }
+      if (rd.empty()) throw AnalysisError("fit dilatancy: no usable run (each was skipped, see above)");
       const auto f = fit_dilatancy_runs(std::move(rd));
       print_fit(f.fixed, dilatancy());
       print_fit(f.free, dilatancy_free());
