@@ -121,14 +121,12 @@ void World::build() {
   if (periodic_) {
     // Lees-Edwards: the image of body 2 across the top moves at (gamma-dot
     // H, dH/dt) relative to body 2, across a side at (dW/dt, 0).
-    const double vs = prm_.cell.shear_rate * cm_.height;
     for (std::size_t k = 0; k < nr; ++k) {
-      const ContactInfo& f = info_[k];
-      if (f.ix == 0 && f.iy == 0) continue;
+      if (info_[k].ix == 0 && info_[k].iy == 0) continue;
       ContactRow& r = rows_[k];
-      const double vx = f.iy * vs + f.ix * cell.wdot, vy = f.iy * cell.hdot;
-      r.bn += r.nx * vx + r.ny * vy;
-      r.bt += -r.ny * vx + r.nx * vy;
+      const Vec2 v = image_velocity(info_[k]);
+      r.bn += r.nx * v.x() + r.ny * v.y();
+      r.bt += -r.ny * v.x() + r.nx * v.y();
     }
   }
   if (adhesion_on_) {
@@ -140,15 +138,14 @@ void World::build() {
     // step (before external forces) in the midpoint frame. Only approaching
     // normal velocities are restituted. (bn, bt so far hold only the gap
     // term and the periodic images' velocity: that velocity is part of u-.)
-    const double vs = prm_.cell.shear_rate * cm_.height;
     for (std::size_t k = 0; k < nr; ++k) {
       ContactRow& r = rows_[k];
       double un, ut;
       row_velocity(r, V, rot, un, ut);
       if (periodic_ && (info_[k].ix != 0 || info_[k].iy != 0)) {
-        const double vx = info_[k].iy * vs + info_[k].ix * cell.wdot, vy = info_[k].iy * cell.hdot;
-        un += r.nx * vx + r.ny * vy;
-        ut += -r.ny * vx + r.nx * vy;
+        const Vec2 v = image_velocity(info_[k]);
+        un += r.nx * v.x() + r.ny * v.y();
+        ut += -r.ny * v.x() + r.nx * v.y();
       }
       r.bn += prm_.e_n * std::min(un, 0.0);
       r.bt += prm_.e_t * ut;
@@ -264,6 +261,10 @@ void World::integrate() {
     }
     wrap_into_cell();
   }
+}
+
+Vec2 World::image_velocity(const ContactInfo& f) const {
+  return {f.iy * prm_.cell.shear_rate * cm_.height + f.ix * cell.wdot, f.iy * cell.hdot};
 }
 
 void World::set_cell_dofs() {

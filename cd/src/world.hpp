@@ -143,6 +143,10 @@ class World {
 
   WorldParams prm_;
   void wrap_into_cell();
+  // Lees-Edwards: velocity of the image of body 2 that a contact touches,
+  // relative to body 2 itself ((gamma-dot H, dH/dt) per cell up, (dW/dt, 0)
+  // per cell right), at the step's start.
+  Vec2 image_velocity(const ContactInfo& f) const;
   void set_cell_dofs();
   bool gravity_on_ = false, restitution_on_ = false, adhesion_on_ = false;
   bool periodic_ = false, walls_ = false;
