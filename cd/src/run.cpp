@@ -72,24 +72,42 @@ std::pair<double, double> coordination(const World& w) {
     if (r.pn + r.adh > 0.0) pairs.emplace_back(std::min(r.b1, r.b2), std::max(r.b1, r.b2));
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  std::vector<int> deg(b.size(), 0);
+  // Adjacency (CSR) and a work list: each body is removed once and each
+  // pair visited twice, O(N + C) (the 2-core of the network is unique, so
+  // the order of removal does not change it).
+  const std::size_t nb = b.size();
+  std::vector<int> deg(nb, 0), start(nb + 1, 0), adj(2 * pairs.size());
   for (const auto& [i, j] : pairs) {
     ++deg[i];
     ++deg[j];
   }
-  std::vector<std::uint8_t> out(b.size(), 0);
-  for (std::size_t i = 0; i < b.size(); ++i) out[i] = !b.is_dynamic(i);
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (std::size_t i = 0; i < b.size(); ++i) {
-      if (out[i] || deg[i] >= 2) continue;
-      out[i] = 2;  // rattler
-      changed = true;
-      for (const auto& [p, q] : pairs)
-        if (p == static_cast<std::int32_t>(i) || q == static_cast<std::int32_t>(i)) {
-          const std::int32_t o = p == static_cast<std::int32_t>(i) ? q : p;
-          if (out[o] != 2) --deg[o];
-        }
+  for (std::size_t i = 0; i < nb; ++i) start[i + 1] = start[i] + deg[i];
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (const auto& [i, j] : pairs) {
+      adj[fill[i]++] = j;
+      adj[fill[j]++] = i;
+    }
+  }
+  std::vector<std::uint8_t> out(nb, 0);  // 1: not dynamic, 2: rattler
+  std::vector<int> todo;
+  for (std::size_t i = 0; i < nb; ++i) {
+    out[i] = !b.is_dynamic(i);
+    if (!out[i] && deg[i] < 2) {
+      out[i] = 2;
+      todo.push_back(static_cast<int>(i));
+    }
+  }
+  while (!todo.empty()) {
+    const int i = todo.back();
+    todo.pop_back();
+    for (int k = start[i]; k < start[i + 1]; ++k) {
+      const int o = adj[k];
+      if (out[o]) continue;
+      if (--deg[o] < 2) {
+        out[o] = 2;
+        todo.push_back(o);
+      }
     }
   }
   std::size_t n = 0, nd = 0;
