@@ -15,6 +15,7 @@
 // (tests/test_local_solver.cpp checks this against the assembled H^T M^-1 H).
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace cd {
@@ -50,6 +51,21 @@ struct ContactInfo {
 inline std::uint64_t contact_key(std::int32_t b1, std::int32_t b2, int point) {
   return (static_cast<std::uint64_t>(b1) << 34) | (static_cast<std::uint64_t>(b2) << 4) |
          static_cast<std::uint64_t>(point);
+}
+
+// The same contact seen from its other body: body 1 and 2 swapped, n and t
+// reversed, lever arms re-expressed in the reversed frame (c1' = c2, so
+// c1n' = c2.(-n) = -c2n). Impulses must still be zero (detection only).
+inline void reverse_contact(ContactRow& r, ContactInfo& f) {
+  std::swap(r.b1, r.b2);
+  r.nx = -r.nx;
+  r.ny = -r.ny;
+  const double c1n = r.c1n, c1t = r.c1t;
+  r.c1n = -r.c2n;
+  r.c1t = -r.c2t;
+  r.c2n = -c1n;
+  r.c2t = -c1t;
+  f.key = contact_key(r.b1, r.b2, static_cast<int>(f.key & 0xF));
 }
 
 // Status of a solved contact, for output: 0 open, 1 stick, 2 slide.

@@ -258,6 +258,12 @@ void pair_contacts(const Bodies& b, const std::vector<Vec2>& x, const std::vecto
       }
     }
   }
+  // A driven body (wall, glued grain) is always body 1: the wall friction
+  // (World::build) and the colouring's split of wall rows (nlgs.cpp) look at
+  // body 1 only. (It was not so for glued grains, which have higher indices
+  // than the free grains and came out as body 2: mu_wall was ignored.)
+  for (std::size_t k = n0; k < R.size(); ++k)
+    if (b.driven[R[k].b2]) reverse_contact(R[k], I[k]);
   // Branch vectors and images, whichever body the narrow phase made body 1.
   for (std::size_t k = n0; k < R.size(); ++k) {
     const bool fwd = R[k].b1 == i;
