@@ -85,7 +85,7 @@ TEST_P(BondedSlide, SlidesOnlyAboveMuTimesNormalPlusAdhesion) {
   // with a = (F - mu (m g + f_a)) / m (the Coulomb cone is shifted by f_a).
   const double ratio = GetParam(), g = 9.81, mu = 0.3, dt = 1e-3;
   auto p = cohesive(dt, g, mu, 0.0, 0.05);
-  p.solver.rotation = false;
+  p.rotation = false;
   cd::World probe(p);
   const double m = probe.bodies.mass[probe.bodies.add_disk({0, 0}, 0.5, 1.0)];
   p.adhesion = 2.0 * m * g;
@@ -116,9 +116,8 @@ TEST(Cohesion, ZeroAdhesionThroughTheCohesiveSweepIsBitIdentical) {
   ASSERT_GT(rows.size(), 100u);
   const cd::Colouring col = cd::colour_rows(rows, w.bodies);
   auto solve = [&](bool adhesion) {
-    cd::SolverParams sp = cdtest::tight_solver();
-    sp.adhesion = adhesion;
-    const auto c = cdtest::solve_copy(rows, col, w.bodies.vel, sp);
+    const cd::LocalLaw law = adhesion ? cd::LocalLaw{cd::CohesiveCoulomb{}} : cd::Coulomb{};
+    const auto c = cdtest::solve_copy(rows, col, w.bodies.vel, cdtest::tight_solver(), law);
     return std::make_pair(c.rows, c.vel);
   };
   const auto [r1, v1] = solve(true);

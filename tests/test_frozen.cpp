@@ -118,7 +118,7 @@ TEST(Assemble, SimulatorBuildStageBlocks) {
       w.bodies.add_disk(cd::Vec2(-4 + 0.99 * i + 0.5 * (j % 2), 0.499 + 0.86 * j), 0.5, 1.0);
   w.step();
   ASSERT_GT(w.rows().size(), 20u);
-  const cd::Problem p = cd::assemble_problem(w.bodies, w.rows(), prm.solver.rotation);
+  const cd::Problem p = cd::assemble_problem(w.bodies, w.rows(), prm.rotation);
   for (int k = 0; k < p.nc; ++k) {
     const cd::ContactRow& r = w.rows()[k];
     EXPECT_NEAR(p.W.coeff(2 * k, 2 * k), r.wnn, 1e-13 * r.wnn) << "row " << k;
@@ -153,8 +153,10 @@ TEST(Assemble, MatrixNlgsMatchesSimulatorNlgs) {
       cd::SolverParams sp;
       sp.tol = 1e-13;
       sp.max_iter = 100000;
-      sp.rotation = rot;
-      cd::nlgs_solve(rows, col, s.bodies.vel, sp);
+      cd::ContactProblem cp{rows, col, s.bodies.vel, {}, cd::Coulomb{}, rot};
+      cd::nlgs_solve(cp, sp);
+      rows = cp.rows;
+      s.bodies.vel = cp.vel;
 
       const double scale = r.cwiseAbs().maxCoeff();
       const VectorXd u = p.W * r + p.q;
@@ -176,27 +178,31 @@ struct Frozen {
   int nc;
   long nnz;
   double mu;
-  double tol;      // tightest NLGS tolerance reached (see Replay)
-  int max_sweeps;  // about 2x the sweeps it needs
+  double tol;       // the production test: rms |dr| / mean |r| over a sweep
+  double residual;  // bound on the law residual (max / mean |r|) it leaves
+  int max_sweeps;   // about 1.5-2x the sweeps it needs
 };
 
-// Slider-crank: 2 contacts, W singular (the two contacts' tangential rows are
-// equal) and GS crawls: ~250 sweeps at 1e-6. Granular flow, 667 contacts: q is
-// round-off (|q| < 1e-18), so the impulses are ~1e-22; relative to their mean
-// NLGS still converges in 39 sweeps at 1e-6. Granular flow, 2020 contacts:
-// the max law residual stalls at ~2.3e-5 (mean 3e-8) however many sweeps,
-// while r at a few contacts keeps creeping; 1e-4 is reached in ~930 sweeps.
-// W there is singular (about 10 eigenvalues within 1e-7 of the largest,
-// some slightly negative from Siconos' 6-digit print) and the same problem
-// with mu <= 0.3 converges to 1e-8 in ~1000 sweeps, with mu >= 0.4 it
-// stalls. The creep is along a near-null direction d of W (|W d|/|d| = 3e-3
-// against |W r|/|r| = 1e2; 7 contacts): with friction this large GS drifts
-// along the indeterminate part of the impulses instead of settling.
+// Measured with the production sweep (colour order, symmetric sweeps), one
+// thread. Slider-crank: 2 contacts, W singular (the two contacts' tangential
+// rows are equal) and GS crawls: 453 sweeps to 1e-6, law residual 1.4e-6.
+// Granular flow, 667 contacts: q is round-off (|q| < 1e-18), so the
+// impulses are ~1e-22; relative to their mean NLGS still converges, 81
+// sweeps to 1e-8, residual 1.6e-7. Granular flow, 2020 contacts: 2283
+// sweeps to 1e-6 and the max law residual stalls at ~3e-5 (mean 1e-7)
+// however many sweeps, while r at a few contacts keeps creeping; at 1e-8
+// the cap is hit. W there is singular (about 10 eigenvalues within 1e-7 of
+// the largest, some slightly negative from Siconos' 6-digit print) and the
+// same problem with mu <= 0.3 converges; with mu >= 0.4 it stalls. The
+// creep is along a near-null direction d of W (|W d|/|d| = 3e-3 against
+// |W r|/|r| = 1e2; 7 contacts): with friction this large GS drifts along
+// the indeterminate part of the impulses instead of settling. The residual
+// bounds are 2-3x the measured values.
 const Frozen kFrozen[] = {
-    {"FC2D_SliderCrankLagrangian00000.dat", 2, 16, 0.01, 1e-6, 600},
-    {"FC2D_SliderCrankLagrangian00001.dat", 2, 16, 0.01, 1e-6, 600},
-    {"fc2d_granularflowonwall_00667_00000.dat", 667, 3822, 0.5, 1e-6, 200},
-    {"fc2d_granularflowonwall_02020_00213.dat", 2020, 20616, 0.5, 1e-4, 2000},
+    {"FC2D_SliderCrankLagrangian00000.dat", 2, 16, 0.01, 1e-6, 3e-6, 900},
+    {"FC2D_SliderCrankLagrangian00001.dat", 2, 16, 0.01, 1e-6, 3e-6, 900},
+    {"fc2d_granularflowonwall_00667_00000.dat", 667, 3822, 0.5, 1e-8, 5e-7, 200},
+    {"fc2d_granularflowonwall_02020_00213.dat", 2020, 20616, 0.5, 1e-6, 1e-4, 4000},
 };
 
 TEST(Frozen, ReadsEveryFile) {
@@ -225,7 +231,7 @@ TEST(Frozen, ReadsEveryFile) {
   EXPECT_EQ(s.q[1], -8.407368208001527065675873e+00);
 }
 
-TEST(Frozen, NlgsReachesTheLawResidual) {
+TEST(Frozen, ProductionNlgsReachesTheLawResidual) {
   // Total well under a second (most of it the 2020-contact file).
   for (const Frozen& f : kFrozen) {
     const cd::Problem p = cd::read_problem(kData + f.file);
@@ -234,9 +240,11 @@ TEST(Frozen, NlgsReachesTheLawResidual) {
     opt.max_sweeps = f.max_sweeps;
     VectorXd r;
     const cd::NlgsStats st = cd::solve_nlgs(p, r, opt);
+    std::printf("[ frozen ] %s: %d sweeps, rms |dr|/|r| %.2e, residual max %.2e, Siconos %.2e\n",
+                f.file, st.sweeps, st.dr_rel, st.residual.max, st.siconos_error);
     EXPECT_TRUE(st.converged) << f.file << ": " << st.sweeps << " sweeps, residual "
                               << st.residual.max;
-    EXPECT_LT(cd::problem_residual(p, r).max, f.tol) << f.file;
+    EXPECT_LT(cd::problem_residual(p, r).max, f.residual) << f.file;
     EXPECT_GT(r.cwiseAbs().maxCoeff(), 0.0) << f.file;  // not the trivial r = 0
   }
 }

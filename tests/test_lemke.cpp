@@ -160,8 +160,10 @@ cd::NlgsOptions tight(double tol) {
 TEST(Lemke, RandomProblemsSatisfyTheLaw) {
   // Lemke is exact up to the round-off of the final LU solve (seen: at most
   // 5e-15 of the mean impulse); 1e-12 leaves room for worse conditioning.
-  // NLGS is asked for 1e-9 and must reach it on both criteria (seen: 2 to
-  // 200 sweeps).
+  // NLGS (the production sweep, problem.hpp) stops on the sweep's rms change
+  // < tol; its law residual is then within ~20 tol on these problems (seen
+  // at tol 1e-9: 1.1e-9 to 1.7e-8), so it is asked for 1e-11 and the law
+  // must hold to 1e-9.
   std::mt19937 g(42);
   for (int nc : {5, 12, 30})
     for (double mu : {0.0, 0.3, 0.7})
@@ -171,7 +173,7 @@ TEST(Lemke, RandomProblemsSatisfyTheLaw) {
         ASSERT_EQ(L.status, LemkeStatus::Solved) << "nc " << nc << " mu " << mu;
         EXPECT_LT(cd::problem_residual(p, L.r).max, 1e-12) << "nc " << nc << " mu " << mu;
         VectorXd r;
-        const cd::NlgsStats st = cd::solve_nlgs(p, r, tight(1e-9));
+        const cd::NlgsStats st = cd::solve_nlgs(p, r, tight(1e-11));
         EXPECT_TRUE(st.converged) << "nc " << nc << " mu " << mu;
         EXPECT_LT(cd::problem_residual(p, r).max, 1e-9);
         // Some contacts must be closed, or the test checks nothing.
@@ -198,7 +200,7 @@ TEST(Lemke, RandomSpdMatrix) {
     ASSERT_EQ(L.status, LemkeStatus::Solved);
     EXPECT_LT(cd::problem_residual(p, L.r).max, 1e-12);
     VectorXd r;
-    EXPECT_TRUE(cd::solve_nlgs(p, r, tight(1e-9)).converged);
+    EXPECT_TRUE(cd::solve_nlgs(p, r, tight(1e-11)).converged);
     EXPECT_LT(cd::problem_residual(p, r).max, 1e-9);
   }
 }

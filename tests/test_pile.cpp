@@ -51,9 +51,8 @@ TEST(Determinism, ZeroFrictionThroughCoulombPathEqualsFrictionlessPath) {
   const cd::Colouring col = cd::colour_rows(rows, w.bodies);
   ASSERT_GT(rows.size(), 100u);
   auto solve = [&](bool friction) {
-    cd::SolverParams sp = cdtest::tight_solver();
-    sp.friction = friction;
-    const auto c = cdtest::solve_copy(rows, col, w.bodies.vel, sp);
+    const cd::LocalLaw law = friction ? cd::LocalLaw{cd::Coulomb{}} : cd::Frictionless{};
+    const auto c = cdtest::solve_copy(rows, col, w.bodies.vel, cdtest::tight_solver(), law);
     return std::make_tuple(c.rows, c.vel, c.iterations);
   };
   const auto [r1, v1, it1] = solve(true);

@@ -82,10 +82,11 @@ struct SolvedCopy {
   int iterations;
 };
 inline SolvedCopy solve_copy(const std::vector<cd::ContactRow>& rows, const cd::Colouring& col,
-                             const std::vector<cd::BodyVel>& vel, cd::SolverParams sp) {
-  SolvedCopy out{rows, vel, 0};
-  out.iterations = cd::nlgs_solve(out.rows, col, out.vel, sp).iterations;
-  return out;
+                             const std::vector<cd::BodyVel>& vel, cd::SolverParams sp,
+                             cd::LocalLaw law = cd::Coulomb{}, bool rotation = true) {
+  cd::ContactProblem p{rows, col, vel, {}, law, rotation};
+  const int it = cd::nlgs_solve(p, sp).iterations;
+  return {std::move(p.rows), std::move(p.vel), it};
 }
 inline cd::SolverParams tight_solver() {
   cd::SolverParams sp;

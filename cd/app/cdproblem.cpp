@@ -1,14 +1,24 @@
-// cdproblem: replays a frozen contact problem (.dat, Siconos text format).
+// cdproblem: replays a frozen contact problem with the production solver.
 //   cdproblem solve FILE.dat [--tol 1e-6] [--max-sweeps N] [--check-every K] [--lemke]
-// Prints the problem size, the NLGS residual every K sweeps and the time; with
-// --lemke, the reference LCP solve instead. A malformed file is one message
-// naming the file, line and what was wrong, and exit code 2 (as cdsim).
+//   cdproblem solve FILE.cdp [--tol T] [--max-sweeps N] [--out IMPULSES.txt]
+// FILE.dat: Siconos' text format (W, q, mu), solved by the simulator's sweep
+// through the blocks of W (problem.hpp); prints the problem size, the sweep's
+// change and the law residual every K sweeps, Siconos' error and the time;
+// with --lemke, the reference LCP solve instead.
+// FILE.cdp: a step dumped by `cdsim --dump-problem` (contact_problem.hpp),
+// solved exactly as the step was (same rows, colouring, law, dofs and,
+// unless overridden, tolerance and cap): the same impulses to the bit.
+// A malformed file is one message naming the file, line and what was wrong,
+// and exit code 2 (as cdsim).
+#include <chrono>
+#include <fstream>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "lemke.hpp"
+#include "nlgs.hpp"
 #include "problem.hpp"
 
 namespace {
@@ -46,31 +56,68 @@ int solve(const std::string& path, const cd::NlgsOptions& opt, bool lemke) {
     fmt::print("{:>8} {:>12.3e} {:>14.3e} {:>14.3e}\n", c.sweep, c.dr_rel, c.residual_max,
                c.residual_mean);
   fmt::print(
-      "nlgs: {} after {} sweeps, residual max {:.3e} mean {:.3e} (mean |r| {:.3e}), "
-      "time {:.3g} s ({:.3g} ms/sweep)\n",
-      st.converged ? "converged" : "NOT converged (sweep cap)", st.sweeps, st.residual.max,
-      st.residual.mean, st.residual.r_mean, st.time, st.sweeps ? 1e3 * st.time / st.sweeps : 0.0);
+      "nlgs: {} after {} sweeps (rms |dr|/|r| {:.3e}), residual max {:.3e} mean {:.3e} "
+      "(mean |r| {:.3e}), Siconos error {:.3e}, time {:.3g} s ({:.3g} ms/sweep)\n",
+      st.converged ? "converged" : "NOT converged (sweep cap)", st.sweeps, st.dr_rel,
+      st.residual.max, st.residual.mean, st.residual.r_mean, st.siconos_error, st.time,
+      st.sweeps ? 1e3 * st.time / st.sweeps : 0.0);
   return st.converged ? 0 : 1;
+}
+
+// A dumped step: the production solve of its rows, with the step's own
+// tolerance and cap unless given. Writes the impulses (row order, hex
+// floats: exact) to `out` if given.
+int solve_step(const std::string& path, double tol, int max_sweeps, const std::string& out) {
+  cd::SolverParams prm;
+  cd::ContactProblem p = cd::read_contact_problem(path, prm);
+  if (tol > 0) prm.tol = tol;
+  if (max_sweeps > 0) prm.max_iter = max_sweeps;
+  fmt::print("{}: {} rows, {} bodies, {} colours, {} boundary dofs, law {}, rotation {}\n", path,
+             p.rows.size(), p.vel.size(), p.colouring.split.size(), p.dofs.size(),
+             cd::law_name(p.law), p.rotation ? "on" : "off");
+  const auto t0 = std::chrono::steady_clock::now();
+  const cd::SolveStats st = cd::nlgs_solve(p, prm);
+  const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  fmt::print(
+      "nlgs: {} after {} sweeps (rms |dp|/|p| {:.3e}, tol {:.3g}), residual max {:.3e} mean "
+      "{:.3e} (mean |p| {:.3e}), time {:.3g} s\n",
+      st.cap_hit ? "NOT converged (sweep cap)" : "converged", st.iterations, st.dp_rel, prm.tol,
+      st.residual_max, st.residual_mean, st.p_mean, t);
+  if (!out.empty()) {
+    std::string text;
+    for (const cd::ContactRow& r : p.rows) text += fmt::format("{:a} {:a}\n", r.pn, r.pt);
+    std::ofstream f(out);
+    if (!(f << text) || !f.flush())
+      throw std::runtime_error(fmt::format("{}: cannot write the impulses", out));
+  }
+  return st.cap_hit ? 1 : 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"cdproblem: solve frozen 2D frictional contact problems (.dat)"};
+  CLI::App app{"cdproblem: solve frozen 2D frictional contact problems (.dat, .cdp)"};
   app.require_subcommand(1);
   CLI::App* cmd = app.add_subcommand("solve", "solve one problem file with NLGS (or Lemke)");
   std::string path;
   cd::NlgsOptions opt;
   bool lemke = false;
-  cmd->add_option("file", path, "problem file (.dat)")->required();
-  cmd->add_option("--tol", opt.tol, "tolerance on max|dr|/mean|r| and on the law residual")
+  cmd->add_option("file", path, "problem file (.dat: Siconos matrix form; .cdp: a step dumped by cdsim)")->required();
+  cmd->add_option("--tol", opt.tol, "tolerance on the sweep's rms |dr|/mean|r| (the production test)")
       ->capture_default_str();
   cmd->add_option("--max-sweeps", opt.max_sweeps, "sweep cap")->capture_default_str();
   cmd->add_option("--check-every", opt.check_every, "residual checkpoint every K sweeps")
       ->capture_default_str();
   cmd->add_flag("--lemke", lemke, "solve as an LCP with Lemke's method (small problems)");
+  std::string out;
+  cmd->add_option("--out", out, "(.cdp) write the impulses, one row a line, as hex floats");
   CLI11_PARSE(app, argc, argv);
   try {
+    if (path.size() > 4 && path.substr(path.size() - 4) == ".cdp") {
+      if (lemke) throw std::runtime_error("--lemke takes a .dat problem (matrix form)");
+      const bool tol_given = cmd->count("--tol") > 0, cap_given = cmd->count("--max-sweeps") > 0;
+      return solve_step(path, tol_given ? opt.tol : 0.0, cap_given ? opt.max_sweeps : 0, out);
+    }
     return solve(path, opt, lemke);
   } catch (const std::exception& e) {
     std::cerr << "cdproblem: error: " << e.what() << "\n";

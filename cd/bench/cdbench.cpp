@@ -121,6 +121,8 @@ struct Frozen {
   cd::Colouring col;
   std::vector<cd::BodyVel> vel;
   cd::SolverParams prm;
+  cd::LocalLaw law;
+  bool rotation = true;
   int contacts = 0;  // distinct body pairs (a polygon side-side contact has 2 rows)
 };
 
@@ -136,6 +138,8 @@ const Frozen& frozen(int n, int sides = 0) {
     for (std::size_t k = 0; k < r.size(); ++k) slot->rows[k] = r[slot->col.perm[k]];
     slot->vel = w.bodies.vel;
     slot->prm = w.params().solver;
+    slot->law = w.law();
+    slot->rotation = w.params().rotation;
     slot->prm.tol = 0.0;
     slot->prm.max_iter = kSweeps;
     std::vector<std::pair<int, int>> pairs;
@@ -187,14 +191,16 @@ int runs_for(int n, int sweeps) {
 
 void time_nlgs(benchmark::State& state, const Frozen& f, int n, int threads) {
   Threads scope(threads);
-  std::vector<cd::ContactRow> rows;
-  std::vector<cd::BodyVel> vel;
+  cd::ContactProblem p;
+  p.colouring = f.col;
+  p.law = f.law;
+  p.rotation = f.rotation;
   double t = 0, sweeps = 0;
   for (auto _ : state) {
-    rows = f.rows;  // the same problem every run (untimed: manual time)
-    vel = f.vel;
+    p.rows = f.rows;  // the same problem every run (untimed: manual time)
+    p.vel = f.vel;
     const auto t0 = Clock::now();
-    const cd::SolveStats st = cd::nlgs_solve(rows, f.col, vel, f.prm);
+    const cd::SolveStats st = cd::nlgs_solve(p, f.prm);
     const double dt = since(t0);
     state.SetIterationTime(dt);
     t += dt;
@@ -277,8 +283,8 @@ struct Effect {
 const Effect kEffects[] = {
     {"friction", [](cd::WorldParams& p) { p.mu = p.mu_wall = 0.0; },
      [](cd::WorldParams& p) { p.mu = p.mu_wall = 0.4; }},
-    {"rotation", [](cd::WorldParams& p) { p.solver.rotation = false; },
-     [](cd::WorldParams& p) { p.solver.rotation = true; }},
+    {"rotation", [](cd::WorldParams& p) { p.rotation = false; },
+     [](cd::WorldParams& p) { p.rotation = true; }},
     // Restitution also sets the alert distance to 0 (World::configure): fewer
     // rows, so compare the cost a row-sweep, not only a step.
     {"restitution", [](cd::WorldParams& p) { p.e_n = 0.0; },

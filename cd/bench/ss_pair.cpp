@@ -391,7 +391,10 @@ SweepStats sweep_solve(std::vector<cd::ContactRow>& rows, std::vector<cd::BodyVe
     st.iterations = it;
     if (it >= prm.max_iter || st.dp_rel < prm.tol) break;
   }
-  cd::law_residuals(rows, vel, prm, st);
+  {
+    cd::ContactProblem cp{rows, {}, vel, {}, cd::Coulomb{}, true};
+    cd::law_residuals(cp, prm, st);
+  }
   st.cap_hit = st.dp_rel >= prm.tol;
   out.pair_res_max = pair_law_residual(rows, vel, U, st.p_mean);
   return out;
@@ -462,7 +465,10 @@ Run run_frozen(const Frozen& f, const std::string& variant, double tol, int max_
     SweepStats s;
     const auto t0 = Clock::now();
     if (variant == "ref") {
-      s.st = cd::nlgs_solve(rows, f.col, vel, prm);
+      cd::ContactProblem cp{std::move(rows), f.col, std::move(vel), {}, cd::Coulomb{}, true};
+      s.st = cd::nlgs_solve(cp, prm);
+      rows = std::move(cp.rows);
+      vel = std::move(cp.vel);
     } else {
       const Units U = make_units(rows, f.info, vel);  // timed: part of the pair solver's cost
       s = variant == "row"     ? sweep_solve<false>(rows, vel, U, prm)
@@ -572,7 +578,13 @@ struct Stepper {
 cd::SolveStats solve_variant(const std::string& v, std::vector<cd::ContactRow>& rows,
                              const std::vector<cd::ContactInfo>& info, const cd::Colouring& col,
                              std::vector<cd::BodyVel>& vel, const cd::SolverParams& prm) {
-  if (v == "ref") return cd::nlgs_solve(rows, col, vel, prm);
+  if (v == "ref") {
+    cd::ContactProblem cp{std::move(rows), col, std::move(vel), {}, cd::Coulomb{}, true};
+    const cd::SolveStats st = cd::nlgs_solve(cp, prm);
+    rows = std::move(cp.rows);
+    vel = std::move(cp.vel);
+    return st;
+  }
   const Units U = make_units(rows, info, vel);
   return v == "row"    ? sweep_solve<false>(rows, vel, U, prm).st
          : v == "pair" ? sweep_solve<true>(rows, vel, U, prm).st

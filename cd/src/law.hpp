@@ -14,17 +14,12 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <variant>
+
+#include "contact.hpp"
 
 namespace cd {
-
-// Law features are compile-time, chosen once per scene: the sweep is a
-// template over the law, so a frictionless or non-cohesive scene carries no
-// friction or adhesion work in its inner loop.
-template <bool Friction, bool Adhesion>
-struct Law {
-  static constexpr bool friction = Friction;
-  static constexpr bool adhesion = Adhesion;
-};
 
 struct Block {
   double wnn, wnt, wtt;
@@ -91,6 +86,71 @@ inline double law_residual(double un, double ut, double pn, double pt, double mu
   const double lim = mu * std::max(sn, 0.0);
   const double rt = pt - std::clamp(pt - rho * ut, -lim, lim);
   return std::sqrt(rn * rn + rt * rt);
+}
+
+// ---- The local law of a scene, as a type --------------------------------
+// Chosen once per scene (World::configure, from mu, mu_wall and the
+// adhesion), never tested inside the sweep: the sweep is a template over the
+// law (nlgs.cpp), so a frictionless or non-cohesive scene carries no friction
+// or adhesion work in its inner loop. A law's data are per row, filled by the
+// build stage from the scene (ContactRow::mu: mu or mu_wall; ContactRow::adh:
+// f_a dt within the debonding distance), so that one type serves grains and
+// walls. Each law solves the local problem of one row from its relative
+// velocity u (everything in it, the row's own impulse included) and its
+// current impulse, as nlgs.cpp's row update and the matrix replay need.
+// Adding an effect adds a type here and to LocalLaw, not a branch in a kernel.
+// `tangential`: the law has a tangential impulse (the sweep computes u_t).
+struct Frictionless {
+  static constexpr bool tangential = false;
+  static constexpr const char* name = "frictionless";
+  static void solve(const ContactRow& r, double un, double /*ut*/, double& pn, double& pt) {
+    solve_frictionless(un - r.wnn * r.pn, Block{r.wnn, r.wnt, r.wtt}, 0.0, pn);
+    pt = 0.0;
+  }
+};
+
+struct Coulomb {
+  static constexpr bool tangential = true;
+  static constexpr const char* name = "coulomb";
+  static void solve(const ContactRow& r, double un, double ut, double& pn, double& pt) {
+    const double bn = un - (r.wnn * r.pn + r.wnt * r.pt);
+    const double bt = ut - (r.wnt * r.pn + r.wtt * r.pt);
+    solve_coulomb(bn, bt, Block{r.wnn, r.wnt, r.wtt}, r.mu, 0.0, pn, pt);
+  }
+};
+
+// Adhesion-shifted Signorini, without friction.
+struct CohesiveFrictionless {
+  static constexpr bool tangential = false;
+  static constexpr const char* name = "cohesive-frictionless";
+  static void solve(const ContactRow& r, double un, double /*ut*/, double& pn, double& pt) {
+    solve_frictionless(un - r.wnn * r.pn, Block{r.wnn, r.wnt, r.wtt}, r.adh, pn);
+    pt = 0.0;
+  }
+};
+
+// Adhesion-shifted Signorini with the shifted Coulomb cone |p_t| <= mu (p_n + a).
+struct CohesiveCoulomb {
+  static constexpr bool tangential = true;
+  static constexpr const char* name = "cohesive-coulomb";
+  static void solve(const ContactRow& r, double un, double ut, double& pn, double& pt) {
+    const double bn = un - (r.wnn * r.pn + r.wnt * r.pt);
+    const double bt = ut - (r.wnt * r.pn + r.wtt * r.pt);
+    solve_coulomb(bn, bt, Block{r.wnn, r.wnt, r.wtt}, r.mu, r.adh, pn, pt);
+  }
+};
+
+using LocalLaw = std::variant<Frictionless, Coulomb, CohesiveFrictionless, CohesiveCoulomb>;
+
+// The law a scene needs: friction if any coefficient is > 0, adhesion if
+// the pull-off force is > 0.
+inline LocalLaw choose_law(bool friction, bool adhesion) {
+  if (adhesion) return friction ? LocalLaw{CohesiveCoulomb{}} : LocalLaw{CohesiveFrictionless{}};
+  return friction ? LocalLaw{Coulomb{}} : LocalLaw{Frictionless{}};
+}
+
+inline std::string law_name(const LocalLaw& l) {
+  return std::visit([](const auto& x) { return std::string(x.name); }, l);
 }
 
 }  // namespace cd

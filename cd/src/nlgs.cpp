@@ -3,184 +3,74 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <variant>
 
 #include "law.hpp"
+#include "sweep.hpp"
 
 namespace cd {
 
 namespace {
 
 constexpr int kMaxColours = 63;  // colour 63 of the mask is the overflow colour
-constexpr int kBlock = 128;      // rows per reduction block (fixed: see header)
 
-// One row update. Write1 = false when body 1 is driven (a wall): it is read,
-// never written, so rows of one colour may share a wall without a data race.
-template <class L, bool Rot, bool Write1>
-inline void update_row(ContactRow& r, BodyVel* vel, double& dp2, double& pabs) {
-  BodyVel& A = vel[r.b1];
-  BodyVel& B = vel[r.b2];
-  const double dx = B.vx - A.vx, dy = B.vy - A.vy;
-  double un = r.nx * dx + r.ny * dy + r.bn;
-  if constexpr (Rot) un += -B.w * r.c2t + A.w * r.c1t;
-  const double a = L::adhesion ? r.adh : 0.0;
-  const Block W{r.wnn, r.wnt, r.wtt};
-  double dpn, dpt = 0.0;
-  if constexpr (L::friction) {
-    double ut = -r.ny * dx + r.nx * dy + r.bt;
-    if constexpr (Rot) ut += B.w * r.c2n - A.w * r.c1n;
-    const double bn = un - (r.wnn * r.pn + r.wnt * r.pt);
-    const double bt = ut - (r.wnt * r.pn + r.wtt * r.pt);
+// Rows coupled through the velocities of their bodies (the simulator).
+template <bool Rot>
+struct BodyCoupling {
+  BodyVel* vel;
+
+  // One row update. Write1 = false when body 1 is driven (a wall): it is
+  // read, never written, so rows of one colour may share a wall without a
+  // data race.
+  template <class L, bool Write1>
+  void update(ContactRow& r, double& dp2, double& pabs) const {
+    BodyVel& A = vel[r.b1];
+    BodyVel& B = vel[r.b2];
+    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
+    double un = r.nx * dx + r.ny * dy + r.bn;
+    if constexpr (Rot) un += -B.w * r.c2t + A.w * r.c1t;
+    double ut = 0.0;
+    if constexpr (L::tangential) {
+      ut = -r.ny * dx + r.nx * dy + r.bt;
+      if constexpr (Rot) ut += B.w * r.c2n - A.w * r.c1n;
+    }
     double pn, pt;
-    solve_coulomb(bn, bt, W, r.mu, a, pn, pt);
-    dpn = pn - r.pn;
-    dpt = pt - r.pt;
+    L::solve(r, un, ut, pn, pt);
+    const double dpn = pn - r.pn;
+    const double dpt = L::tangential ? pt - r.pt : 0.0;
     r.pn = pn;
-    r.pt = pt;
-    pabs = std::sqrt(pn * pn + pt * pt);
-  } else {
-    double pn;
-    solve_frictionless(un - r.wnn * r.pn, W, a, pn);
-    dpn = pn - r.pn;
-    r.pn = pn;
-    pabs = std::abs(pn);
+    if constexpr (L::tangential) {
+      r.pt = pt;
+      pabs = std::sqrt(pn * pn + pt * pt);
+    } else {
+      pabs = std::abs(pn);
+    }
+    dp2 = dpn * dpn + dpt * dpt;
+    const double px = r.nx * dpn - r.ny * dpt, py = r.ny * dpn + r.nx * dpt;
+    B.vx += B.inv_m * px;
+    B.vy += B.inv_m * py;
+    if constexpr (Rot) B.w += B.inv_I * (r.c2n * dpt - r.c2t * dpn);
+    if constexpr (Write1) {
+      A.vx -= A.inv_m * px;
+      A.vy -= A.inv_m * py;
+      if constexpr (Rot) A.w -= A.inv_I * (r.c1n * dpt - r.c1t * dpn);
+    }
   }
-  dp2 = dpn * dpn + dpt * dpt;
-  const double px = r.nx * dpn - r.ny * dpt, py = r.ny * dpn + r.nx * dpt;
-  B.vx += B.inv_m * px;
-  B.vy += B.inv_m * py;
-  if constexpr (Rot) B.w += B.inv_I * (r.c2n * dpt - r.c2t * dpn);
-  if constexpr (Write1) {
-    A.vx -= A.inv_m * px;
-    A.vy -= A.inv_m * py;
-    if constexpr (Rot) A.w -= A.inv_I * (r.c1n * dpt - r.c1t * dpn);
-  }
-}
 
-struct RowBlock {
-  std::int32_t begin, end;
-  bool write1;
+  void velocity(const ContactRow& r, double& un, double& ut) const {
+    const BodyVel& A = vel[r.b1];
+    const BodyVel& B = vel[r.b2];
+    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
+    un = r.nx * dx + r.ny * dy;
+    ut = -r.ny * dx + r.nx * dy;
+    if constexpr (Rot) {
+      un += -B.w * r.c2t + A.w * r.c1t;
+      ut += B.w * r.c2n - A.w * r.c1n;
+    }
+    un += r.bn;
+    ut += r.bt;
+  }
 };
-
-struct BlockStats {
-  double dp2sum = 0, psum = 0, rmax = 0, rsum = 0;
-};
-
-template <class L, bool Rot>
-void run_block(const RowBlock& k, ContactRow* rows, BodyVel* vel, BlockStats& s) {
-  double dsum = 0, psum = 0;
-  if (k.write1) {
-    for (int i = k.begin; i < k.end; ++i) {
-      double dp2, pabs;
-      update_row<L, Rot, true>(rows[i], vel, dp2, pabs);
-      dsum += dp2;
-      psum += pabs;
-    }
-  } else {
-    for (int i = k.begin; i < k.end; ++i) {
-      double dp2, pabs;
-      update_row<L, Rot, false>(rows[i], vel, dp2, pabs);
-      dsum += dp2;
-      psum += pabs;
-    }
-  }
-  s.dp2sum = dsum;
-  s.psum = psum;
-}
-
-void residual_block(const RowBlock& k, const ContactRow* rows, const std::vector<BodyVel>& vel,
-                    bool rot, BlockStats& s) {
-  double rmax = 0, rsum = 0;
-  for (int i = k.begin; i < k.end; ++i) {
-    const ContactRow& r = rows[i];
-    double un, ut;
-    row_velocity(r, vel, rot, un, ut);
-    const double e = law_residual(un + r.bn, ut + r.bt, r.pn, r.pt, r.mu, r.adh, 1.0 / r.wnn);
-    rmax = std::max(rmax, e);
-    rsum += e;
-  }
-  s.rmax = rmax;
-  s.rsum = rsum;
-}
-
-// Splits [begin, end) into fixed blocks.
-void push_blocks(std::vector<RowBlock>& out, int begin, int end, bool write1) {
-  for (int b = begin; b < end; b += kBlock) out.push_back({b, std::min(end, b + kBlock), write1});
-}
-
-template <class L, bool Rot>
-SolveStats nlgs_impl(std::vector<ContactRow>& rows, const Colouring& col,
-                     std::vector<BodyVel>& vel, const SolverParams& prm,
-                     std::vector<BoundaryDof>* dofs) {
-  SolveStats st;
-  const int n = static_cast<int>(rows.size());
-  if (n == 0) {
-    if (dofs)
-      for (BoundaryDof& d : *dofs) d.v = d.v0;
-    return st;
-  }
-
-  const int ncol = static_cast<int>(col.start.size()) - 1;
-  std::vector<RowBlock> blocks;
-  std::vector<int> cb(ncol + 1, 0);  // blocks of colour c: [cb[c], cb[c+1])
-  for (int c = 0; c < ncol; ++c) {
-    cb[c] = static_cast<int>(blocks.size());
-    push_blocks(blocks, col.start[c], col.split[c], false);
-    push_blocks(blocks, col.split[c], col.start[c + 1], true);
-  }
-  cb[ncol] = static_cast<int>(blocks.size());
-  const int nb = cb[ncol];
-  std::vector<BlockStats> bs(nb);
-  ContactRow* R = rows.data();
-  BodyVel* V = vel.data();
-  const bool parallel = n >= prm.min_parallel;
-  bool done = false;
-  int it = 0;
-
-#pragma omp parallel if (parallel)
-  {
-    while (!done) {
-      // Symmetric Gauss-Seidel: colours forward on odd sweeps, backward on
-      // even ones, so that forces travel both ways along a chain (a pile's
-      // weight down, the floor's reaction up) within two sweeps. Inside a
-      // colour the order does not matter. The overflow colour stays last.
-      const bool backward = (it % 2) == 1;
-      const int nreg = col.overflow ? ncol - 1 : ncol;
-      for (int cc = 0; cc < ncol; ++cc) {
-        const int c = (cc < nreg && backward) ? nreg - 1 - cc : cc;
-        if (col.overflow && c == ncol - 1) {
-#pragma omp single
-          for (int b = cb[c]; b < cb[c + 1]; ++b) run_block<L, Rot>(blocks[b], R, V, bs[b]);
-        } else {
-#pragma omp for schedule(static)
-          for (int b = cb[c]; b < cb[c + 1]; ++b) run_block<L, Rot>(blocks[b], R, V, bs[b]);
-        }
-      }
-#pragma omp single
-      {
-        ++it;
-        double dsum = 0, psum = 0;
-        for (int b = 0; b < nb; ++b) {
-          dsum += bs[b].dp2sum;
-          psum += bs[b].psum;
-        }
-        st.p_mean = psum / n;
-        const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
-        st.dp_rel = std::sqrt(dsum / n) / scale;
-        st.iterations = it;
-        st.dof_rel = 0.0;
-        if (dofs)
-          for (BoundaryDof& d : *dofs) st.dof_rel = std::max(st.dof_rel, update_dof(d, R));
-        if (it >= prm.max_iter) done = true;
-        if (st.dp_rel < prm.tol && st.dof_rel < prm.tol) done = true;
-      }
-      // implicit barrier: every thread sees the same 'done'
-    }
-  }
-
-  law_residuals(rows, vel, prm, st);
-  st.cap_hit = st.dp_rel >= prm.tol || st.dof_rel >= prm.tol;
-  return st;
-}
 
 }  // namespace
 
@@ -245,29 +135,12 @@ void apply_impulses(const std::vector<ContactRow>& rows, std::vector<BodyVel>& v
   }
 }
 
-void law_residuals(const std::vector<ContactRow>& rows, const std::vector<BodyVel>& vel,
-                   const SolverParams& prm, SolveStats& st) {
-  const int n = static_cast<int>(rows.size());
-  if (n == 0) {
-    st.residual_max = st.residual_mean = 0;
-    return;
-  }
-  std::vector<RowBlock> blocks;
-  push_blocks(blocks, 0, n, true);
-  std::vector<BlockStats> bs(blocks.size());
-  const int nb = static_cast<int>(blocks.size());
-#pragma omp parallel for schedule(static) if (n >= prm.min_parallel)
-  for (int b = 0; b < nb; ++b) residual_block(blocks[b], rows.data(), vel, prm.rotation, bs[b]);
-  double rmax = 0, rsum = 0, psum = 0;
-  for (const BlockStats& s : bs) {
-    rmax = std::max(rmax, s.rmax);
-    rsum += s.rsum;
-  }
-  for (const ContactRow& r : rows) psum += std::sqrt(r.pn * r.pn + r.pt * r.pt);
-  st.p_mean = psum / n;
-  const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
-  st.residual_max = rmax / scale;
-  st.residual_mean = rsum / n / scale;
+void law_residuals(const ContactProblem& p, const SolverParams& prm, SolveStats& st) {
+  auto* vel = const_cast<BodyVel*>(p.vel.data());  // read only: velocity() does not write
+  if (p.rotation)
+    sweep::residuals(p.rows, BodyCoupling<true>{vel}, prm.min_parallel, st);
+  else
+    sweep::residuals(p.rows, BodyCoupling<false>{vel}, prm.min_parallel, st);
 }
 
 double update_dof(BoundaryDof& d, ContactRow* rows) {
@@ -298,21 +171,20 @@ double update_dof(BoundaryDof& d, ContactRow* rows) {
   return std::abs(res) / (d.inv_mass * d.scale);
 }
 
-SolveStats nlgs_solve(std::vector<ContactRow>& rows, const Colouring& col,
-                      std::vector<BodyVel>& vel, const SolverParams& prm,
-                      std::vector<BoundaryDof>* dofs) {
-  // The law is resolved once here, never inside the sweep.
-  const int key = (prm.friction ? 4 : 0) | (prm.adhesion ? 2 : 0) | (prm.rotation ? 1 : 0);
-  switch (key) {
-    case 0: return nlgs_impl<Law<false, false>, false>(rows, col, vel, prm, dofs);
-    case 1: return nlgs_impl<Law<false, false>, true>(rows, col, vel, prm, dofs);
-    case 2: return nlgs_impl<Law<false, true>, false>(rows, col, vel, prm, dofs);
-    case 3: return nlgs_impl<Law<false, true>, true>(rows, col, vel, prm, dofs);
-    case 4: return nlgs_impl<Law<true, false>, false>(rows, col, vel, prm, dofs);
-    case 5: return nlgs_impl<Law<true, false>, true>(rows, col, vel, prm, dofs);
-    case 6: return nlgs_impl<Law<true, true>, false>(rows, col, vel, prm, dofs);
-    default: return nlgs_impl<Law<true, true>, true>(rows, col, vel, prm, dofs);
-  }
+SolveStats nlgs_solve(ContactProblem& p, const SolverParams& prm, const SweepObserver& observer) {
+  // The law and the rotation are resolved once here, never inside the sweep.
+  std::vector<BoundaryDof>* dofs = p.dofs.empty() ? nullptr : &p.dofs;
+  return std::visit(
+      [&](auto law) {
+        using L = decltype(law);
+        if (p.rotation) {
+          BodyCoupling<true> c{p.vel.data()};
+          return sweep::solve<L>(p.rows, p.colouring, c, prm, dofs, observer);
+        }
+        BodyCoupling<false> c{p.vel.data()};
+        return sweep::solve<L>(p.rows, p.colouring, c, prm, dofs, observer);
+      },
+      p.law);
 }
 
 }  // namespace cd

@@ -10,37 +10,23 @@
 // fixed blocks of rows added in block order, never per-thread partial sums.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "bodies.hpp"
 #include "contact.hpp"
+#include "contact_problem.hpp"
 
 namespace cd {
 
 struct SolverParams {
   double tol = 1e-4;       // eps_f on rms |dp| / mean |p| over a sweep (LMGC90's "Quad" norm)
   int max_iter = 2000;     // iteration cap
-  bool friction = true;    // law chosen once per scene
-  bool adhesion = false;
-  bool rotation = true;
   // Below this many rows the sweep runs on one thread: a colour of a few
   // dozen rows costs less than the barrier that ends it (measured: a
-  // 600-row pile ran 3x slower on 2 threads than on 1).
+  // 600-row pile ran 3x slower on 2 threads than on 1). Loops over bodies
+  // (predict, integrate) use half of it. The one threshold of the code.
   int min_parallel = 4096;
-};
-
-// A boundary degree of freedom solved with the contacts: a scalar velocity v
-// (a periodic cell's height rate, a wall's normal velocity) that enters the
-// relative velocity of some rows, u_n += an v and u_t += at v, and on which
-// their impulses act back (the transpose): v = v0 + inv_mass sum (an p_n +
-// at p_t), v0 holding the external impulse (imposed stress). Updated after
-// every sweep (Gauss-Seidel on one more body); the change of v goes into the
-// rows' offsets bn, bt, so the sweep itself does not know it exists.
-struct BoundaryDof {
-  double v0 = 0.0, v = 0.0, inv_mass = 0.0;
-  double scale = 1.0;  // impulse scale of the convergence test (|imposed impulse|)
-  std::vector<std::int32_t> rows;
-  std::vector<double> an, at;
 };
 
 struct SolveStats {
@@ -53,28 +39,22 @@ struct SolveStats {
   double dof_rel = 0;        // last sweep's largest dof residual / (inv_mass scale) (update_dof)
 };
 
-// Colouring: rows are permuted so that colour c is [start[c], start[c+1]);
-// inside a colour the rows whose body 1 is driven come first, up to split[c].
-// The last colour may be an overflow colour, solved on one thread.
-struct Colouring {
-  std::vector<std::int32_t> start, split;
-  bool overflow = false;
-  std::vector<std::int32_t> perm;  // new index -> old index
-};
+// Called after every sweep with the sweep count and its dp_rel, on one
+// thread, between sweeps (cdproblem's history); may be empty.
+using SweepObserver = std::function<void(int sweep, double dp_rel)>;
 
-// Colours rows (greedy, in row order: deterministic) and returns the
-// permutation; the caller applies it to rows and to any parallel arrays.
-Colouring colour_rows(const std::vector<ContactRow>& rows, const Bodies& bodies);
+// Solves the problem in place (impulses, body velocities, dofs), starting
+// from the impulses held in the rows, which must already be applied to the
+// velocities. Boundary dofs are updated after each sweep and must converge
+// too. The law is resolved here, once, into a template instance of the
+// sweep. Stops when dp_rel < tol (and every dof's residual < tol), or at
+// max_iter sweeps (cap_hit); then computes the law residuals.
+SolveStats nlgs_solve(ContactProblem& p, const SolverParams& prm,
+                      const SweepObserver& observer = {});
 
-// Adds the impulses held in the rows to the body velocities (warm start).
-void apply_impulses(const std::vector<ContactRow>& rows, std::vector<BodyVel>& vel, bool rotation);
-
-// Solves the rows in place (p and the body velocities), starting from the
-// impulses already held in the rows, which must already be applied to vel.
-// Boundary dofs, if any, are updated after each sweep and must converge too.
-SolveStats nlgs_solve(std::vector<ContactRow>& rows, const Colouring& col,
-                      std::vector<BodyVel>& vel, const SolverParams& prm,
-                      std::vector<BoundaryDof>* dofs = nullptr);
+// The matrix form of a problem (problem.hpp: W, q, mu) is solved by the
+// same sweep, law, convergence test and residual (sweep.hpp), through the
+// blocks of W instead of body velocities: solve_nlgs in problem.hpp.
 
 // One update of a boundary dof from the rows' impulses, damped by the active
 // rows' response (nlgs.cpp); returns the residual of its equation before the
@@ -106,7 +86,6 @@ inline void set_block(ContactRow& r, const BodyVel& A, const BodyVel& B, bool ro
 }
 
 // Law residual of every row (normalised by mean |p|), computed read-only.
-void law_residuals(const std::vector<ContactRow>& rows, const std::vector<BodyVel>& vel,
-                   const SolverParams& prm, SolveStats& st);
+void law_residuals(const ContactProblem& p, const SolverParams& prm, SolveStats& st);
 
 }  // namespace cd

@@ -1,6 +1,10 @@
 #include "problem.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
+#include <limits>
+#include <variant>
 #include <cctype>
 #include <cerrno>
 #include <chrono>
@@ -16,6 +20,8 @@
 #include <fmt/format.h>
 
 #include "law.hpp"
+#include "nlgs.hpp"
+#include "sweep.hpp"
 
 namespace cd {
 
@@ -302,16 +308,153 @@ void write_problem(const Problem& p, const std::string& path, Storage s) {
   if (!out.flush()) throw std::runtime_error(fmt::format("{}: write failed", path));
 }
 
-Problem assemble_problem(const Bodies& bodies, const std::vector<ContactRow>& rows, bool rotation) {
+// ---- cdlab's own format of a step's problem (contact_problem.hpp) -------
+
+void write_contact_problem(const ContactProblem& p, const SolverParams& prm, std::ostream& out) {
+  // %a: hexadecimal floats, read back to the same bits by strtod.
+  auto x = [](double v) { return fmt::format("{:a}", v); };
+  out << "cdlab-contact-problem 1\n";
+  out << "law " << law_name(p.law) << "\nrotation " << (p.rotation ? 1 : 0) << "\n";
+  out << "tol " << x(prm.tol) << "\nmax_iter " << prm.max_iter << "\nmin_parallel "
+      << prm.min_parallel << "\n";
+  out << "bodies " << p.vel.size() << "\n";
+  for (const BodyVel& v : p.vel)
+    out << fmt::format("{} {} {} {} {}\n", x(v.vx), x(v.vy), x(v.w), x(v.inv_m), x(v.inv_I));
+  const Colouring& c = p.colouring;
+  out << "colours " << c.split.size() << " overflow " << (c.overflow ? 1 : 0) << "\nstart";
+  for (const auto v : c.start) out << ' ' << v;
+  out << "\nsplit";
+  for (const auto v : c.split) out << ' ' << v;
+  out << "\nrows " << p.rows.size() << "\n";
+  for (const ContactRow& r : p.rows)
+    out << fmt::format("{} {} {} {} {} {} {} {} {} {} {} {} {} {} {} {} {}\n", r.b1, r.b2,
+                       x(r.nx), x(r.ny), x(r.c1n), x(r.c1t), x(r.c2n), x(r.c2t), x(r.wnn),
+                       x(r.wnt), x(r.wtt), x(r.bn), x(r.bt), x(r.pn), x(r.pt), x(r.mu),
+                       x(r.adh));
+  out << "dofs " << p.dofs.size() << "\n";
+  for (const BoundaryDof& d : p.dofs) {
+    out << fmt::format("{} {} {} {} {}\n", x(d.v0), x(d.v), x(d.inv_mass), x(d.scale),
+                       d.rows.size());
+    for (std::size_t m = 0; m < d.rows.size(); ++m)
+      out << fmt::format("{} {} {}\n", d.rows[m], x(d.an[m]), x(d.at[m]));
+  }
+}
+
+void write_contact_problem(const ContactProblem& p, const SolverParams& prm,
+                           const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
+  write_contact_problem(p, prm, out);
+  if (!out.flush()) throw std::runtime_error(fmt::format("{}: write failed", path));
+}
+
+ContactProblem read_contact_problem(std::istream& in, const std::string& name, SolverParams& prm) {
+  Reader rd(in, name);
+  rd.expect("cdlab-contact-problem", "at the start (not a cdlab problem file)");
+  if (rd.integer("the format version", 1, 1) != 1) rd.fail("unknown format version");
+  ContactProblem p;
+  rd.expect("law", "after the header");
+  const std::string law(rd.need("the law's name"));
+  bool found = false;
+  for (const LocalLaw& l : {LocalLaw{Frictionless{}}, LocalLaw{Coulomb{}},
+                            LocalLaw{CohesiveFrictionless{}}, LocalLaw{CohesiveCoulomb{}}})
+    if (law_name(l) == law) {
+      p.law = l;
+      found = true;
+    }
+  if (!found) rd.fail(fmt::format("unknown law '{}'", law));
+  rd.expect("rotation", "after the law");
+  p.rotation = rd.integer("rotation (0 or 1)", 0, 1) == 1;
+  rd.expect("tol", "after rotation");
+  prm.tol = rd.number("the tolerance");
+  rd.expect("max_iter", "after tol");
+  prm.max_iter = static_cast<int>(rd.integer("the sweep cap", 1, INT_MAX));
+  rd.expect("min_parallel", "after max_iter");
+  prm.min_parallel = static_cast<int>(rd.integer("the parallel threshold", 0, INT_MAX));
+  rd.expect("bodies", "after the solver's parameters");
+  const long long nb = rd.integer("the number of bodies", 0, INT_MAX);
+  p.vel.resize(nb);
+  for (long long i = 0; i < nb; ++i) {
+    BodyVel& v = p.vel[i];
+    const std::string w = fmt::format(" of body {}", i);
+    v.vx = rd.number("vx" + w);
+    v.vy = rd.number("vy" + w);
+    v.w = rd.number("w" + w);
+    v.inv_m = rd.number("inv_m" + w);
+    v.inv_I = rd.number("inv_I" + w);
+  }
+  rd.expect("colours", "after the bodies");
+  const long long nc = rd.integer("the number of colours", 0, 64);
+  rd.expect("overflow", "after the number of colours");
+  p.colouring.overflow = rd.integer("overflow (0 or 1)", 0, 1) == 1;
+  rd.expect("start", "after the colour count");
+  p.colouring.start.resize(nc + 1);
+  for (auto& v : p.colouring.start)
+    v = static_cast<std::int32_t>(rd.integer("a colour start", 0, INT_MAX));
+  rd.expect("split", "after the colour starts");
+  p.colouring.split.resize(nc);
+  for (long long c = 0; c < nc; ++c) {
+    p.colouring.split[c] = static_cast<std::int32_t>(rd.integer(
+        "a colour split", p.colouring.start[c], p.colouring.start[c + 1]));
+  }
+  rd.expect("rows", "after the colouring");
+  const long long nr = rd.integer("the number of rows", 0, INT_MAX);
+  if (p.colouring.start.front() != 0 || p.colouring.start.back() != nr)
+    rd.fail(fmt::format("the colours cover rows {} to {}, the problem has {}",
+                        p.colouring.start.front(), p.colouring.start.back(), nr));
+  p.rows.resize(nr);
+  for (long long k = 0; k < nr; ++k) {
+    ContactRow& r = p.rows[k];
+    const std::string w = fmt::format(" of row {}", k);
+    r.b1 = static_cast<std::int32_t>(rd.integer("body 1" + w, 0, nb - 1));
+    r.b2 = static_cast<std::int32_t>(rd.integer("body 2" + w, 0, nb - 1));
+    for (double* f : {&r.nx, &r.ny, &r.c1n, &r.c1t, &r.c2n, &r.c2t, &r.wnn, &r.wnt, &r.wtt,
+                      &r.bn, &r.bt, &r.pn, &r.pt, &r.mu, &r.adh})
+      *f = rd.number("a number" + w);
+    if (!(r.wnn > 0)) rd.fail(fmt::format("W_nn{} is {}, not positive", w, r.wnn));
+  }
+  rd.expect("dofs", "after the rows");
+  const long long nd = rd.integer("the number of dofs", 0, 16);
+  p.dofs.resize(nd);
+  for (long long d = 0; d < nd; ++d) {
+    BoundaryDof& D = p.dofs[d];
+    const std::string w = fmt::format(" of dof {}", d);
+    D.v0 = rd.number("v0" + w);
+    D.v = rd.number("v" + w);
+    D.inv_mass = rd.number("inv_mass" + w);
+    D.scale = rd.number("scale" + w);
+    const long long m = rd.integer("the number of rows" + w, 0, nr);
+    D.rows.resize(m);
+    D.an.resize(m);
+    D.at.resize(m);
+    for (long long j = 0; j < m; ++j) {
+      D.rows[j] = static_cast<std::int32_t>(rd.integer("a row" + w, 0, nr - 1));
+      D.an[j] = rd.number("an" + w);
+      D.at[j] = rd.number("at" + w);
+    }
+  }
+  if (!rd.token().empty()) rd.fail("unexpected text after the last dof");
+  return p;
+}
+
+ContactProblem read_contact_problem(const std::string& path, SolverParams& prm) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open for reading", path));
+  return read_contact_problem(in, path, prm);
+}
+
+Problem assemble_problem(const std::vector<BodyVel>& V, const std::vector<ContactRow>& rows,
+                         bool rotation, const std::vector<BoundaryDof>* dofs) {
   const int nc = static_cast<int>(rows.size());
-  const int nb = static_cast<int>(bodies.size());
-  // H (3nb x 2nc): column 2k is the normal of contact k, 2k+1 its tangent;
-  // body rows 3b (x), 3b+1 (y), 3b+2 (rotation). MH = M^-1 H keeps only the
-  // dynamic bodies, so W = H^T MH has no structural entry through a wall.
+  const int nb = static_cast<int>(V.size());
+  const int nd = dofs ? static_cast<int>(dofs->size()) : 0;
+  // H (3nb + nd x 2nc): column 2k is the normal of contact k, 2k+1 its
+  // tangent; body rows 3b (x), 3b+1 (y), 3b+2 (rotation), then one row per
+  // boundary dof. MH = M^-1 H keeps only the dynamic bodies, so W = H^T MH
+  // has no structural entry through a wall.
   Triplets h, mh;
   h.reserve(12 * nc);
   mh.reserve(12 * nc);
-  const auto& V = bodies.vel;
   auto add = [&](int b, int dof, int col, double v) {
     h.emplace_back(3 * b + dof, col, v);
     const double inv = dof < 2 ? V[b].inv_m : V[b].inv_I;
@@ -335,10 +478,24 @@ Problem assemble_problem(const Bodies& bodies, const std::vector<ContactRow>& ro
       add(r.b1, 2, 2 * k + 1, -r.c1n);
     }
   }
-  Eigen::SparseMatrix<double> H(3 * nb, 2 * nc), MH(3 * nb, 2 * nc);
+  // A boundary dof is one more body: u_k += (an, at) v, and v = v0 +
+  // inv_mass sum (an p_n + at p_t). Its v0 part is already in the rows'
+  // offsets (World::set_cell_dofs) and v = v0 before the solve, so it adds
+  // inv_mass a a^T to W and nothing to q.
+  for (int d = 0; d < nd; ++d) {
+    const BoundaryDof& D = (*dofs)[d];
+    for (std::size_t m = 0; m < D.rows.size(); ++m) {
+      const int k = D.rows[m];
+      for (const auto& [col, a] : {std::pair{2 * k, D.an[m]}, std::pair{2 * k + 1, D.at[m]}}) {
+        h.emplace_back(3 * nb + d, col, a);
+        if (D.inv_mass != 0.0) mh.emplace_back(3 * nb + d, col, D.inv_mass * a);
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> H(3 * nb + nd, 2 * nc), MH(3 * nb + nd, 2 * nc);
   H.setFromTriplets(h.begin(), h.end());
   MH.setFromTriplets(mh.begin(), mh.end());
-  Eigen::VectorXd U(3 * nb), p(2 * nc), b(2 * nc);
+  Eigen::VectorXd U = Eigen::VectorXd::Zero(3 * nb + nd), p(2 * nc), b(2 * nc);
   for (int i = 0; i < nb; ++i) U.segment<3>(3 * i) << V[i].vx, V[i].vy, V[i].w;
   for (int k = 0; k < nc; ++k) {
     p.segment<2>(2 * k) << rows[k].pn, rows[k].pt;
@@ -348,10 +505,26 @@ Problem assemble_problem(const Bodies& bodies, const std::vector<ContactRow>& ro
   P.nc = nc;
   P.W = Eigen::SparseMatrix<double>(H.transpose() * MH);
   P.W.makeCompressed();
-  P.q = H.transpose() * U - P.W * p + b;
+  // The bodies' velocities hold the warm start (G U includes W_body p), the
+  // dofs' do not (v = v0): q = G U - W_body p + b, the dof rows of U zero.
+  Eigen::SparseMatrix<double> Hb = H.topRows(3 * nb), MHb = MH.topRows(3 * nb);
+  const Eigen::SparseMatrix<double> Wb(Hb.transpose() * MHb);
+  P.q = Hb.transpose() * U.head(3 * nb) - Wb * p + b;
   P.mu.resize(nc);
   for (int k = 0; k < nc; ++k) P.mu[k] = rows[k].mu;
   return P;
+}
+
+Problem assemble_problem(const Bodies& bodies, const std::vector<ContactRow>& rows, bool rotation) {
+  return assemble_problem(bodies.vel, rows, rotation, nullptr);
+}
+
+Problem to_matrix(const ContactProblem& p) {
+  for (const ContactRow& r : p.rows)
+    if (r.adh != 0.0)
+      throw std::invalid_argument(
+          "a cohesive problem (adhesion impulse > 0) has no Siconos matrix form");
+  return assemble_problem(p.vel, p.rows, p.rotation, p.dofs.empty() ? nullptr : &p.dofs);
 }
 
 Residual problem_residual(const Problem& p, const Eigen::VectorXd& r) {
@@ -362,6 +535,105 @@ Residual problem_residual(const Problem& p, const Eigen::VectorXd& r) {
   return residual_of(p, r, u, checked_diagonal(p));
 }
 
+namespace {
+
+// Contacts coupled through the blocks of W (a frozen problem): row i holds
+// W_ii's symmetric part (the local solver's block), q_i as offsets and r_i;
+// u_i = q_i + sum_j W_ij r_j over the stored blocks of W's block row i, the
+// diagonal one included (non-symmetric, as dumped). A row reads the
+// impulses of the rows it couples to and writes only its own: rows of one
+// colour share no block, so they may be updated at once.
+struct MatrixCoupling {
+  const ContactRow* base = nullptr;
+  std::vector<std::int32_t> start, col;  // block row i: [start[i], start[i+1])
+  std::vector<std::array<double, 4>> blk;  // (nn, nt, tn, tt)
+
+  void velocity(const ContactRow& r, double& un, double& ut) const {
+    const std::size_t i = &r - base;
+    un = r.bn;
+    ut = r.bt;
+    for (std::int32_t b = start[i]; b < start[i + 1]; ++b) {
+      const ContactRow& o = base[col[b]];
+      const auto& w = blk[b];
+      un += w[0] * o.pn + w[1] * o.pt;
+      ut += w[2] * o.pn + w[3] * o.pt;
+    }
+  }
+
+  template <class L, bool Write1>
+  void update(ContactRow& r, double& dp2, double& pabs) const {
+    double un, ut;
+    velocity(r, un, ut);
+    double pn, pt;
+    L::solve(r, un, ut, pn, pt);
+    const double dpn = pn - r.pn, dpt = pt - r.pt;
+    r.pn = pn;
+    r.pt = pt;
+    dp2 = dpn * dpn + dpt * dpt;
+    pabs = std::sqrt(pn * pn + pt * pt);
+  }
+};
+
+// Greedy colouring of the contacts' coupling graph (W's block pattern), in
+// index order; as colour_rows, at most 63 colours and an overflow colour.
+Colouring colour_blocks(int nc, const std::vector<std::vector<std::int32_t>>& adj) {
+  constexpr int kMax = 63;
+  std::vector<int> colour(nc, -1);
+  int used = 0;
+  bool overflow = false;
+  for (int k = 0; k < nc; ++k) {
+    std::uint64_t m = 0;
+    for (const std::int32_t j : adj[k])
+      if (colour[j] >= 0 && colour[j] < kMax) m |= std::uint64_t{1} << colour[j];
+    int c = std::countr_one(m);
+    if (c >= kMax) {
+      c = kMax;
+      overflow = true;
+    } else {
+      used = std::max(used, c + 1);
+    }
+    colour[k] = c;
+  }
+  const int ncol = overflow ? used + 1 : used;
+  Colouring col;
+  col.overflow = overflow;
+  col.start.assign(ncol + 1, 0);
+  for (int k = 0; k < nc; ++k) ++col.start[(colour[k] == kMax ? used : colour[k]) + 1];
+  for (int c = 0; c < ncol; ++c) col.start[c + 1] += col.start[c];
+  col.split.assign(col.start.begin(), col.start.end() - 1);  // no driven bodies: all "write1"
+  col.perm.resize(nc);
+  std::vector<std::int32_t> pos(col.start.begin(), col.start.end() - 1);
+  for (int k = 0; k < nc; ++k) col.perm[pos[colour[k] == kMax ? used : colour[k]]++] = k;
+  return col;
+}
+
+}  // namespace
+
+double siconos_error(const Problem& p, const Eigen::VectorXd& r) {
+  check_shape(p);
+  const Eigen::VectorXd u = p.W * r + p.q;
+  double e2 = 0;
+  for (int k = 0; k < p.nc; ++k) {
+    const double mu = p.mu[k], rn = r[2 * k], rt = r[2 * k + 1];
+    // r - P_K(r - (u_n + mu |u_t|, u_t)), P_K the projection on the cone
+    // |x_t| <= mu x_n (De Saxce's modified velocity, rho = 1).
+    double xn = rn - (u[2 * k] + mu * std::abs(u[2 * k + 1]));
+    double xt = rt - u[2 * k + 1];
+    const double at = std::abs(xt);
+    if (mu * at <= -xn) {  // in the polar cone: projects to 0
+      xn = 0.0;
+      xt = 0.0;
+    } else if (at > mu * xn) {  // outside the cone: onto its edge
+      xn = (mu * at + xn) / (mu * mu + 1.0);
+      xt = mu * xn * (xt > 0 ? 1.0 : xt < 0 ? -1.0 : 0.0);
+    }
+    const double dn = rn - xn, dt = rt - xt;
+    e2 += dn * dn + dt * dt;
+  }
+  const double nq = p.q.norm();
+  return nq > std::numeric_limits<double>::epsilon() ? std::sqrt(e2) / nq : std::sqrt(e2);
+}
+
 NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& opt) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
@@ -370,64 +642,103 @@ NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& op
   if (r.size() != 2 * nc) r = Eigen::VectorXd::Zero(2 * nc);
   NlgsStats st;
   const Eigen::VectorXd diag = checked_diagonal(p);
-  // Local blocks. A dumped W need not be exactly symmetric (the slider-crank
-  // files' W_nt and W_tn differ by 6e-7 relative), but solve_coulomb takes
-  // a symmetric block. The local solve therefore uses the symmetric part S of
-  // W_kk and the skew part rides with the other contacts' terms in b:
-  //   b = u_k - S r_k,   u_k = b + S r_k'   at the local solution,
-  // and u_k is then updated with the true columns of W, so a fixed point of
-  // the sweep satisfies u = W r + q exactly. (Rejected: a non-symmetric local
-  // solver, only to serve dumped round-off.)
-  std::vector<Block> blk(nc);
-  for (int k = 0; k < nc; ++k) {
-    const double wnt = 0.5 * (p.W.coeff(2 * k, 2 * k + 1) + p.W.coeff(2 * k + 1, 2 * k));
-    blk[k] = {diag[2 * k], wnt, diag[2 * k + 1]};
-    if (p.mu[k] > 0 && !(blk[k].wnn * blk[k].wtt - wnt * wnt > 0))
-      throw std::invalid_argument(fmt::format("contact {}: singular block W_kk with friction", k));
-  }
-  Eigen::VectorXd u = p.W * r + p.q;
+
+  // Block rows of W: for contact a, the 2x2 blocks W_ab of every b it
+  // couples to (W is column-major: entry (i, j) goes to block (i/2, j/2)).
+  std::vector<std::vector<std::pair<std::int32_t, std::array<double, 4>>>> brow(nc);
   using It = Eigen::SparseMatrix<double>::InnerIterator;
-  for (int s = 1; s <= opt.max_sweeps && nc > 0; ++s) {
-    double d2max = 0, rsum = 0;
-    for (int k = 0; k < nc; ++k) {
-      const Block& B = blk[k];
-      const double rn = r[2 * k], rt = r[2 * k + 1];
-      const double bn = u[2 * k] - (B.wnn * rn + B.wnt * rt);
-      const double bt = u[2 * k + 1] - (B.wnt * rn + B.wtt * rt);
-      double pn, pt = 0.0;
-      if (p.mu[k] > 0)
-        solve_coulomb(bn, bt, B, p.mu[k], 0.0, pn, pt);
-      else
-        solve_frictionless(bn, B, 0.0, pn);
-      const double dn = pn - rn, dt = pt - rt;
-      // u += W(:, k) dr_k: W's columns play the part of the bodies'
-      // velocity increments in the simulator's sweep.
-      if (dn != 0.0)
-        for (It it(p.W, 2 * k); it; ++it) u[it.row()] += it.value() * dn;
-      if (dt != 0.0)
-        for (It it(p.W, 2 * k + 1); it; ++it) u[it.row()] += it.value() * dt;
-      r[2 * k] = pn;
-      r[2 * k + 1] = pt;
-      d2max = std::max(d2max, dn * dn + dt * dt);
-      rsum += std::sqrt(pn * pn + pt * pt);
-    }
-    st.sweeps = s;
-    const double scale = rsum > 0 ? rsum / nc : 1.0;
-    st.dr_rel = std::sqrt(d2max) / scale;
-    const bool dr_ok = st.dr_rel < opt.tol;
-    if (dr_ok || s % std::max(1, opt.check_every) == 0 || s == opt.max_sweeps) {
-      u = p.W * r + p.q;  // also clears the round-off the increments accumulate
-      st.residual = residual_of(p, r, u, diag);
-      st.history.push_back({s, st.dr_rel, st.residual.max, st.residual.mean});
-      if (dr_ok && st.residual.max < opt.tol) {
-        st.converged = true;
-        break;
+  for (int j = 0; j < 2 * nc; ++j)
+    for (It it(p.W, j); it; ++it) {
+      const int a = static_cast<int>(it.row()) / 2, b = j / 2;
+      auto& v = brow[a];
+      auto f = std::find_if(v.begin(), v.end(), [&](const auto& e) { return e.first == b; });
+      if (f == v.end()) {
+        v.push_back({b, {0, 0, 0, 0}});
+        f = v.end() - 1;
       }
+      f->second[2 * (it.row() % 2) + j % 2] += it.value();
+    }
+  std::vector<std::vector<std::int32_t>> adj(nc);
+  for (int a = 0; a < nc; ++a)
+    for (const auto& e : brow[a])
+      if (e.first != a) {
+        adj[a].push_back(e.first);
+        adj[e.first].push_back(a);
+      }
+
+  // Rows in colour order. A dumped W need not be exactly symmetric (the
+  // slider-crank files' W_nt and W_tn differ by 6e-7 relative), but the
+  // local solver takes a symmetric block: the row holds the symmetric part
+  // S of W_kk and the law sees b = u_k - S r_k with u_k from the true
+  // blocks, so a fixed point of the sweep satisfies u = W r + q exactly.
+  // (Rejected: a non-symmetric local solver, only to serve dumped round-off.)
+  const Colouring col = colour_blocks(nc, adj);
+  std::vector<std::int32_t> inv(nc);
+  for (int i = 0; i < nc; ++i) inv[col.perm[i]] = i;
+  std::vector<ContactRow> rows(nc);
+  bool friction = false;
+  for (int i = 0; i < nc; ++i) {
+    const int k = col.perm[i];
+    ContactRow& w = rows[i];
+    w = {};
+    w.wnn = diag[2 * k];
+    w.wnt = 0.5 * (p.W.coeff(2 * k, 2 * k + 1) + p.W.coeff(2 * k + 1, 2 * k));
+    w.wtt = diag[2 * k + 1];
+    if (p.mu[k] > 0 && !(w.wnn * w.wtt - w.wnt * w.wnt > 0))
+      throw std::invalid_argument(fmt::format("contact {}: singular block W_kk with friction", k));
+    w.bn = p.q[2 * k];
+    w.bt = p.q[2 * k + 1];
+    w.pn = r[2 * k];
+    w.pt = r[2 * k + 1];
+    w.mu = p.mu[k];
+    friction = friction || p.mu[k] > 0;
+  }
+  MatrixCoupling c;
+  c.base = rows.data();
+  c.start.assign(nc + 1, 0);
+  for (int i = 0; i < nc; ++i) c.start[i + 1] = c.start[i] + static_cast<int>(brow[col.perm[i]].size());
+  c.col.resize(c.start[nc]);
+  c.blk.resize(c.start[nc]);
+  for (int i = 0; i < nc; ++i) {
+    auto& v = brow[col.perm[i]];
+    std::sort(v.begin(), v.end(), [&](const auto& x, const auto& y) { return inv[x.first] < inv[y.first]; });
+    for (std::size_t m = 0; m < v.size(); ++m) {
+      c.col[c.start[i] + m] = inv[v[m].first];
+      c.blk[c.start[i] + m] = v[m].second;
     }
   }
-  if (nc == 0) st.converged = true;
-  if (st.history.empty() || st.history.back().sweep != st.sweeps)
-    st.residual = residual_of(p, r, p.W * r + p.q, diag);
+
+  SolverParams prm;
+  prm.tol = opt.tol;
+  prm.max_iter = opt.max_sweeps;
+  if (opt.min_parallel > 0) prm.min_parallel = opt.min_parallel;
+  const int every = std::max(1, opt.check_every);
+  auto record = [&](int sweep, double dp_rel) {
+    SolveStats s;
+    sweep::residuals(rows, c, INT_MAX, s);
+    st.history.push_back({sweep, dp_rel, s.residual_max, s.residual_mean});
+  };
+  SolveStats s;
+  if (nc > 0)
+    s = std::visit(
+        [&](auto law) {
+          using L = decltype(law);
+          return sweep::solve<L>(rows, col, c, prm, nullptr, [&](int it, double dp) {
+            if (it % every == 0) record(it, dp);
+          });
+        },
+        choose_law(friction, false));
+  st.sweeps = s.iterations;
+  st.converged = !s.cap_hit;
+  st.dr_rel = s.dp_rel;
+  for (int i = 0; i < nc; ++i) {
+    r[2 * col.perm[i]] = rows[i].pn;
+    r[2 * col.perm[i] + 1] = rows[i].pt;
+  }
+  if (nc > 0 && (st.history.empty() || st.history.back().sweep != st.sweeps))
+    record(st.sweeps, st.dr_rel);
+  st.residual = residual_of(p, r, p.W * r + p.q, diag);
+  st.siconos_error = siconos_error(p, r);
   st.time = std::chrono::duration<double>(clock::now() - t0).count();
   return st;
 }

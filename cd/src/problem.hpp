@@ -6,10 +6,12 @@
 // H^T M^-1 H (2nc x 2nc), q the free local velocity, mu one coefficient per
 // contact. r is an impulse (force times dt), as in the simulator's rows.
 //
-// The matrix form exists so that the solver can be replayed on frozen
-// problems dumped from other codes (shared/data/contact-problems) and be
-// compared with a reference solver (lemke.hpp). The simulator's own NLGS
-// (nlgs.hpp) never assembles W; assemble_problem() builds it only to compare.
+// The matrix form exists so that the production solver can be replayed on
+// frozen problems dumped from other codes (tests/data/contact-problems) or
+// from cdsim (--dump-problem), and be compared with a reference solver
+// (lemke.hpp). The simulator's own steps never assemble W (they solve a
+// ContactProblem, contact_problem.hpp); to_matrix() builds it to compare and
+// to write a step in Siconos' format.
 #pragma once
 #include <iosfwd>
 #include <string>
@@ -20,6 +22,7 @@
 
 #include "bodies.hpp"
 #include "contact.hpp"
+#include "contact_problem.hpp"
 
 namespace cd {
 
@@ -54,12 +57,20 @@ void write_problem(const Problem& p, std::ostream& out, Storage s = Storage::Spa
 // H follows contact.hpp (u = G U, G = H^T):
 //   u_n = n.(U2 - U1) - w2 c2t + w1 c1t,   u_t = t.(U2 - U1) + w2 c2n - w1 c1n
 // (rotation = false drops the w terms, as the solver does).
-// The velocities held in 'bodies' are taken to already include the rows'
-// current impulses p (the simulator applies the warm start before solving),
-// so the free velocity is G U - W p, and the law sees u + (bn, bt):
+// The velocities are taken to already include the rows' current impulses p
+// (the simulator applies the warm start before solving), so the free
+// velocity is G U - W p, and the law sees u + (bn, bt):
 //   q = G U - W p + b,   so that the law's velocity is u = W p' + q
-// for any new impulses p'. Body velocities are read, never changed.
+// for any new impulses p'. Boundary dofs, if given, are eliminated: each is
+// one more body of inverse mass inv_mass, which adds inv_mass a a^T to W.
+// Body velocities are read, never changed.
+Problem assemble_problem(const std::vector<BodyVel>& vel, const std::vector<ContactRow>& rows,
+                         bool rotation, const std::vector<BoundaryDof>* dofs = nullptr);
 Problem assemble_problem(const Bodies& bodies, const std::vector<ContactRow>& rows, bool rotation);
+// The matrix form of a step's problem (rows, velocities, dofs). Throws
+// std::invalid_argument for a cohesive problem (Siconos' format has no
+// adhesion).
+Problem to_matrix(const ContactProblem& p);
 
 // Law residual of (r, u = W r + q): cd::law_residual per contact with
 // rho = 1/W_nn, max and mean over contacts, both divided by the mean impulse
@@ -71,9 +82,10 @@ struct Residual {
 Residual problem_residual(const Problem& p, const Eigen::VectorXd& r);
 
 struct NlgsOptions {
-  double tol = 1e-6;  // both max_k |dr_k| / mean |r| over a sweep and Residual::max
+  double tol = 1e-6;     // the production test: rms |dr| / mean |r| over a sweep < tol
   int max_sweeps = 10000;
-  int check_every = 10;  // law residual (one product W r) every k sweeps, and when dr passes
+  int check_every = 10;  // law residual into the history every k sweeps (and at the end)
+  int min_parallel = 0;  // > 0: the sweep's parallel threshold (0: the production default)
 };
 
 struct NlgsCheckpoint {
@@ -83,18 +95,26 @@ struct NlgsCheckpoint {
 
 struct NlgsStats {
   int sweeps = 0;
-  bool converged = false;  // dr_rel < tol and residual.max < tol at the last check
-  double dr_rel = 0;       // last sweep
+  bool converged = false;  // dr_rel < tol before the sweep cap
+  double dr_rel = 0;       // last sweep's rms |dr| / mean |r|
   Residual residual;       // at the end (recomputed from r)
+  double siconos_error = 0;  // Siconos' fc2d error at the end (siconos_error)
   double time = 0;         // wall-clock seconds of the solve (setup included)
   std::vector<NlgsCheckpoint> history;
 };
 
-// Matrix-form nonlinear Gauss-Seidel (method.md section 5), contacts in index
-// order, starting from r (resized to zero if its size is not 2nc). The local
-// problem of contact k is solved exactly by cd::solve_coulomb (mu = 0:
-// solve_frictionless) on the block W_kk. Throws std::invalid_argument if a
-// block has W_nn <= 0 or is singular with friction.
+// The production NLGS (sweep.hpp: the sweep, local solver, convergence test
+// and residual of every cdsim step) on the matrix form: rows coupled through
+// the blocks of W instead of body velocities, coloured on W's block pattern,
+// starting from r (resized to zero if its size is not 2nc). Throws
+// std::invalid_argument if a block has W_nn <= 0 or is singular with
+// friction.
 NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& opt = {});
+
+// Siconos' error of fc2d solvers (fc2d_compute_error, Acary & Brogliato
+// 2008, A.13), reported beside ours: ||r - P_K(r - u~)|| / ||q|| over all
+// contacts, u~ = (u_n + mu |u_t|, u_t) De Saxce's modified velocity, P_K the
+// projection on the Coulomb cone, rho = 1 (absolute if ||q|| ~ 0).
+double siconos_error(const Problem& p, const Eigen::VectorXd& r);
 
 }  // namespace cd

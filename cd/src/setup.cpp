@@ -138,7 +138,7 @@ WorldParams world_params(const Scene& s) {
   }
   p.solver.tol = s.tol;
   p.solver.max_iter = s.max_iter;
-  p.solver.rotation = s.rotation;
+  p.rotation = s.rotation;
   return p;
 }
 

@@ -23,11 +23,11 @@ void World::configure() {
   // Without restitution, contacts within the alert distance enter the solver
   // with the gap term u_n + g_m/dt >= 0, which closes gaps without overlap.
   alert_ = restitution_on_ ? 0.0 : prm_.alert;
-  prm_.solver.friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
   // Cohesive scenes only: contacts up to the debonding distance pull with
   // f_a (no bond history: a pair within debond of each other is bonded).
   adhesion_on_ = prm_.adhesion > 0.0;
-  prm_.solver.adhesion = adhesion_on_;
+  prob_.law = choose_law(prm_.mu > 0.0 || prm_.mu_wall > 0.0, adhesion_on_);
+  prob_.rotation = prm_.rotation;
   if (adhesion_on_) alert_ = std::max(alert_, prm_.debond);
   periodic_ = prm_.cell.mode == CellParams::Mode::LeesEdwards;
   walls_ = prm_.cell.mode == CellParams::Mode::Walls;
@@ -96,18 +96,18 @@ void World::predict() {
 }
 
 void World::detect_stage() {
-  detect(bodies, xm_, thm_, alert_, grid_, rows_, info_, (periodic_ || walls_) ? &pc_ : nullptr);
+  detect(bodies, xm_, thm_, alert_, grid_, prob_.rows, info_, (periodic_ || walls_) ? &pc_ : nullptr);
 }
 
 void World::build() {
   const double dt = prm_.dt;
-  const bool rot = prm_.solver.rotation;
+  const bool rot = prm_.rotation;
   const auto& V = bodies.vel;
-  const std::size_t nr = rows_.size();
+  const std::size_t nr = prob_.rows.size();
   const bool par = static_cast<int>(nr) >= prm_.solver.min_parallel;
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t k = 0; k < nr; ++k) {
-    ContactRow& r = rows_[k];
+    ContactRow& r = prob_.rows[k];
     set_block(r, V[r.b1], V[r.b2], rot);
     r.mu = bodies.driven[r.b1] ? prm_.mu_wall : prm_.mu;
     const double gap = info_[k].gap;
@@ -123,7 +123,7 @@ void World::build() {
     // H, dH/dt) relative to body 2, across a side at (dW/dt, 0).
     for (std::size_t k = 0; k < nr; ++k) {
       if (info_[k].ix == 0 && info_[k].iy == 0) continue;
-      ContactRow& r = rows_[k];
+      ContactRow& r = prob_.rows[k];
       const Vec2 v = image_velocity(info_[k]);
       r.bn += r.nx * v.x() + r.ny * v.y();
       r.bt += -r.ny * v.x() + r.nx * v.y();
@@ -131,7 +131,7 @@ void World::build() {
   }
   if (adhesion_on_) {
     const double a = prm_.adhesion * dt;
-    for (std::size_t k = 0; k < nr; ++k) rows_[k].adh = info_[k].gap <= prm_.debond ? a : 0.0;
+    for (std::size_t k = 0; k < nr; ++k) prob_.rows[k].adh = info_[k].gap <= prm_.debond ? a : 0.0;
   }
   if (restitution_on_) {
     // Law on u+ + e u-, with u- the relative velocity at the start of the
@@ -139,7 +139,7 @@ void World::build() {
     // normal velocities are restituted. (bn, bt so far hold only the gap
     // term and the periodic images' velocity: that velocity is part of u-.)
     for (std::size_t k = 0; k < nr; ++k) {
-      ContactRow& r = rows_[k];
+      ContactRow& r = prob_.rows[k];
       double un, ut;
       row_velocity(r, V, rot, un, ut);
       if (periodic_ && (info_[k].ix != 0 || info_[k].iy != 0)) {
@@ -157,8 +157,8 @@ void World::build() {
     const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
     if (it != warm_.keys.end() && *it == info_[k].key) {
       const auto& p = warm_.p[it - warm_.keys.begin()];
-      rows_[k].pn = p.first;
-      rows_[k].pt = p.second;
+      prob_.rows[k].pn = p.first;
+      prob_.rows[k].pt = p.second;
     }
   }
 }
@@ -176,34 +176,39 @@ void World::external() {
 
 void World::solve() {
   // Colour and permute rows so that each colour is contiguous.
-  col_ = colour_rows(rows_, bodies);
+  prob_.colouring = colour_rows(prob_.rows, bodies);
+  const Colouring& col = prob_.colouring;
   {
-    std::vector<ContactRow> r(rows_.size());
+    std::vector<ContactRow> r(prob_.rows.size());
     std::vector<ContactInfo> f(info_.size());
-#pragma omp parallel for schedule(static) if (static_cast<int>(rows_.size()) >= prm_.solver.min_parallel)
-    for (std::size_t k = 0; k < rows_.size(); ++k) {
-      r[k] = rows_[col_.perm[k]];
-      f[k] = info_[col_.perm[k]];
+#pragma omp parallel for schedule(static) if (static_cast<int>(prob_.rows.size()) >= prm_.solver.min_parallel)
+    for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
+      r[k] = prob_.rows[col.perm[k]];
+      f[k] = info_[col.perm[k]];
     }
-    rows_.swap(r);
+    prob_.rows.swap(r);
     info_.swap(f);
   }
   if (gravity_on_ || forces_on_) external();
-  apply_impulses(rows_, bodies.vel, prm_.solver.rotation);
+  apply_impulses(prob_.rows, bodies.vel, prm_.rotation);
   if (periodic_ || walls_) set_cell_dofs();
-  last_.solve = nlgs_solve(rows_, col_, bodies.vel, prm_.solver, dofs_.empty() ? nullptr : &dofs_);
-  if (!dofs_.empty()) {
+  // The problem takes the velocities for the solve and gives them back.
+  prob_.vel.swap(bodies.vel);
+  if (hook_) hook_(prob_, prm_.solver);
+  last_.solve = solver_ ? solver_(prob_, prm_.solver) : nlgs_solve(prob_, prm_.solver);
+  prob_.vel.swap(bodies.vel);
+  if (!prob_.dofs.empty()) {
     if (periodic_) {
-      cell.hdot = dofs_[0].v;
-      if (dofs_.size() > 1) cell.wdot = dofs_[1].v;
+      cell.hdot = prob_.dofs[0].v;
+      if (prob_.dofs.size() > 1) cell.wdot = prob_.dofs[1].v;
     } else {
-      cell.hdot = dofs_[0].v;
+      cell.hdot = prob_.dofs[0].v;
       for (const std::int32_t i : top_wall) bodies.vel[i].vy = cell.hdot;
     }
   }
 
   // Keep the impulses for the next step's warm start.
-  const std::size_t nr = rows_.size();
+  const std::size_t nr = prob_.rows.size();
   std::vector<std::size_t> idx(nr);
   std::iota(idx.begin(), idx.end(), 0);
   std::sort(idx.begin(), idx.end(),
@@ -212,7 +217,7 @@ void World::solve() {
   warm_.p.resize(nr);
   for (std::size_t k = 0; k < nr; ++k) {
     warm_.keys[k] = info_[idx[k]].key;
-    warm_.p[k] = {rows_[idx[k]].pn, rows_[idx[k]].pt};
+    warm_.p[k] = {prob_.rows[idx[k]].pn, prob_.rows[idx[k]].pt};
   }
 
   // Step quality: contacts, overlaps.
@@ -220,7 +225,7 @@ void World::solve() {
   int active = 0, nover = 0;
   double omax = 0, osum = 0;
   for (std::size_t k = 0; k < nr; ++k) {
-    if (rows_[k].pn + rows_[k].adh > 0.0) ++active;
+    if (prob_.rows[k].pn + prob_.rows[k].adh > 0.0) ++active;
     const double ov = -info_[k].gap;
     if (ov > 0) {
       ++nover;
@@ -234,7 +239,7 @@ void World::solve() {
   double work = 0.0;
   if (prm_.overlap_correction > 0.0)
     for (std::size_t k = 0; k < nr; ++k)
-      if (info_[k].gap < 0.0 && rows_[k].bn < 0.0) work += rows_[k].pn * -rows_[k].bn;
+      if (info_[k].gap < 0.0 && prob_.rows[k].bn < 0.0) work += prob_.rows[k].pn * -prob_.rows[k].bn;
   last_.correction_work = work;
   last_.max_overlap = omax / prm_.d_ref;
   last_.mean_overlap = nover ? osum / nover / prm_.d_ref : 0.0;
@@ -242,7 +247,7 @@ void World::solve() {
 
 void World::integrate() {
   const double h = 0.5 * prm_.dt;
-  const bool rot = prm_.solver.rotation;
+  const bool rot = prm_.rotation;
   const std::size_t n = bodies.size();
 #pragma omp parallel for schedule(static) if (static_cast<int>(n) >= prm_.solver.min_parallel / 2)
   for (std::size_t i = 0; i < n; ++i) {
@@ -272,7 +277,7 @@ void World::set_cell_dofs() {
   // (already in the rows' offsets, or in the top bodies' velocities), and
   // v0 with the imposed stress's impulse; the offsets get the difference.
   const double dt = prm_.dt, P = prm_.cell.pressure, M = prm_.cell.mass;
-  dofs_.clear();
+  prob_.dofs.clear();
   if (P <= 0.0 || M <= 0.0) return;
   // load: the external force on the dof (imposed stress x length); scale:
   // the imposed impulse p x length x dt, the unit of its convergence test.
@@ -284,13 +289,13 @@ void World::set_cell_dofs() {
     d.scale = dt * P * length;
     return d;
   };
-  const std::size_t nr = rows_.size();
+  const std::size_t nr = prob_.rows.size();
   auto couple = [&](BoundaryDof& d, std::size_t k, double an, double at, double v_start) {
     d.rows.push_back(static_cast<std::int32_t>(k));
     d.an.push_back(an);
     d.at.push_back(at);
-    rows_[k].bn += an * (d.v0 - v_start);
-    rows_[k].bt += at * (d.v0 - v_start);
+    prob_.rows[k].bn += an * (d.v0 - v_start);
+    prob_.rows[k].bt += at * (d.v0 - v_start);
   };
   if (periodic_) {
     // The imposed stress balances the whole normal stress: the height sees
@@ -300,21 +305,21 @@ void World::set_cell_dofs() {
     // Dense flows: K_yy << p, no change; collisional flows (I >~ 0.5): without
     // it the contact stress alone held p, and sigma_yy + K_yy overshot it.
     const Eigen::Matrix2d K = kinetic_stress();
-    dofs_.push_back(make(cell.hdot, (P - K(1, 1)) * cm_.width, cm_.width));
+    prob_.dofs.push_back(make(cell.hdot, (P - K(1, 1)) * cm_.width, cm_.width));
     if (prm_.cell.isotropic)
-      dofs_.push_back(make(cell.wdot, (P - K(0, 0)) * cm_.height, cm_.height));
+      prob_.dofs.push_back(make(cell.wdot, (P - K(0, 0)) * cm_.height, cm_.height));
     for (std::size_t k = 0; k < nr; ++k) {
       const ContactInfo& f = info_[k];
-      const ContactRow& r = rows_[k];
-      if (f.iy != 0) couple(dofs_[0], k, f.iy * r.ny, f.iy * r.nx, cell.hdot);
-      if (f.ix != 0 && prm_.cell.isotropic) couple(dofs_[1], k, f.ix * r.nx, -f.ix * r.ny, cell.wdot);
+      const ContactRow& r = prob_.rows[k];
+      if (f.iy != 0) couple(prob_.dofs[0], k, f.iy * r.ny, f.iy * r.nx, cell.hdot);
+      if (f.ix != 0 && prm_.cell.isotropic) couple(prob_.dofs[1], k, f.ix * r.nx, -f.ix * r.ny, cell.wdot);
     }
   } else {
-    dofs_.push_back(make(cell.hdot, P * cm_.width, cm_.width));
+    prob_.dofs.push_back(make(cell.hdot, P * cm_.width, cm_.width));
     for (std::size_t k = 0; k < nr; ++k) {
-      const ContactRow& r = rows_[k];
+      const ContactRow& r = prob_.rows[k];
       const double s = on_top_[r.b2] ? 1.0 : on_top_[r.b1] ? -1.0 : 0.0;
-      if (s != 0.0) couple(dofs_[0], k, s * r.ny, s * r.nx, cell.hdot);
+      if (s != 0.0) couple(prob_.dofs[0], k, s * r.ny, s * r.nx, cell.hdot);
     }
   }
 }
@@ -400,8 +405,8 @@ Eigen::Matrix2d World::kinetic_stress() const {
 
 Eigen::Matrix2d World::contact_stress(double volume) const {
   Eigen::Matrix2d s = Eigen::Matrix2d::Zero();
-  for (std::size_t k = 0; k < rows_.size(); ++k) {
-    const ContactRow& r = rows_[k];
+  for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
+    const ContactRow& r = prob_.rows[k];
     const Vec2 p(r.nx * r.pn - r.ny * r.pt, r.ny * r.pn + r.nx * r.pt);
     s += p * Vec2(info_[k].lx, info_[k].ly).transpose();
   }
@@ -427,7 +432,7 @@ double World::potential_energy() const {
 }
 
 ContactStatus World::status(std::size_t k) const {
-  const ContactRow& r = rows_[k];
+  const ContactRow& r = prob_.rows[k];
   const double s = r.pn + r.adh;
   if (s <= 0.0) return ContactStatus::Open;
   if (r.mu > 0.0 && std::abs(r.pt) >= r.mu * s * (1.0 - 1e-9)) return ContactStatus::Slide;

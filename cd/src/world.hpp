@@ -9,10 +9,12 @@
 // Stages a scene does not need are not run; the law is fixed once per scene.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "bodies.hpp"
 #include "contact.hpp"
+#include "contact_problem.hpp"
 #include "detect.hpp"
 #include "nlgs.hpp"
 
@@ -53,6 +55,7 @@ struct WorldParams {
   // on every contact whose midpoint gap is <= debond (absolute); 0: none.
   double adhesion = 0.0, debond = 0.0;
   double d_ref = 1.0;     // length scale for overlaps (mean diameter)
+  bool rotation = true;   // bodies rotate (false: translations only, every W block without 1/I)
   CellParams cell;
   SolverParams solver;
 };
@@ -96,7 +99,20 @@ class World {
 
   void step();
   const StepStats& last() const { return last_; }
-  const std::vector<ContactRow>& rows() const { return rows_; }
+  const std::vector<ContactRow>& rows() const { return prob_.rows; }
+  // The contact problem of the last step (solved), in colour order; its
+  // `vel` is empty outside the solve stage (the velocities are in bodies).
+  const ContactProblem& problem() const { return prob_; }
+  const LocalLaw& law() const { return prob_.law; }
+
+  // The solve stage's solver (default nlgs_solve): a study may put another
+  // one in (cd/bench), the rest of the step unchanged.
+  using Solver = std::function<SolveStats(ContactProblem&, const SolverParams&)>;
+  void set_solver(Solver s) { solver_ = std::move(s); }
+  // Called with the problem just before it is solved (its impulses the warm
+  // start, already in its velocities): --dump-problem writes it out.
+  using ProblemHook = std::function<void(const ContactProblem&, const SolverParams&)>;
+  void set_problem_hook(ProblemHook h) { hook_ = std::move(h); }
   const std::vector<ContactInfo>& infos() const { return info_; }
 
   // Periodic cell (LeesEdwards) or gap between the walls (Walls).
@@ -152,18 +168,18 @@ class World {
   bool periodic_ = false, walls_ = false;
   CellState cm_;           // cell at the midpoint configuration
   PeriodicCell pc_;        // its periodic view for detection
-  std::vector<BoundaryDof> dofs_;
   std::vector<std::uint8_t> on_top_;  // Walls: body is glued to the top wall
   bool forces_on_ = false, prepared_ = false;  // forces_on_: some body has an applied force
   double alert_ = 0.0;
   StepStats last_;
   std::vector<Vec2> xm_;
   std::vector<double> thm_;
-  std::vector<ContactRow> rows_;
+  ContactProblem prob_;  // rows, colouring, dofs, law (velocities during the solve)
   std::vector<ContactInfo> info_;
   CellGrid grid_;
-  Colouring col_;
   WarmStart warm_;
+  Solver solver_;
+  ProblemHook hook_;
 };
 
 }  // namespace cd

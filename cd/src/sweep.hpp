@@ -1,0 +1,177 @@
+// The NLGS sweep (method.md section 5), written once over a "coupling": how a
+// row sees the impulses of the others. nlgs.cpp couples rows through the
+// velocities of the bodies they touch (the simulator's steps); problem.cpp
+// through the off-diagonal blocks of W (frozen problems in matrix form). The
+// sweep order, the convergence test, the boundary dofs and the residuals are
+// this code for both, so a frozen problem is replayed by the production
+// solver. Internal header: include it only where a coupling is defined.
+//
+// A coupling provides
+//   template <class L, bool Write1>
+//   void update(ContactRow& r, double& dp2, double& pabs)
+//       one local solve of row r with law L; dp2 = |dp|^2, pabs = |p|.
+//       Write1 = false when body 1 is driven (read, never written).
+//   void velocity(const ContactRow& r, double& un, double& ut) const
+//       the law's relative velocity of row r, offsets included (residuals).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "law.hpp"
+#include "nlgs.hpp"
+
+namespace cd::sweep {
+
+constexpr int kBlock = 128;  // rows per reduction block (fixed: see nlgs.hpp)
+
+struct RowBlock {
+  std::int32_t begin, end;
+  bool write1;
+};
+
+struct BlockStats {
+  double dp2sum = 0, psum = 0, rmax = 0, rsum = 0;
+};
+
+// Splits [begin, end) into fixed blocks.
+inline void push_blocks(std::vector<RowBlock>& out, int begin, int end, bool write1) {
+  for (int b = begin; b < end; b += kBlock) out.push_back({b, std::min(end, b + kBlock), write1});
+}
+
+template <class L, class C>
+void run_block(const RowBlock& k, ContactRow* rows, C& c, BlockStats& s) {
+  double dsum = 0, psum = 0;
+  if (k.write1) {
+    for (int i = k.begin; i < k.end; ++i) {
+      double dp2, pabs;
+      c.template update<L, true>(rows[i], dp2, pabs);
+      dsum += dp2;
+      psum += pabs;
+    }
+  } else {
+    for (int i = k.begin; i < k.end; ++i) {
+      double dp2, pabs;
+      c.template update<L, false>(rows[i], dp2, pabs);
+      dsum += dp2;
+      psum += pabs;
+    }
+  }
+  s.dp2sum = dsum;
+  s.psum = psum;
+}
+
+// Law residual of every row (normalised by mean |p|), read-only.
+template <class C>
+void residuals(const std::vector<ContactRow>& rows, const C& c, int min_parallel, SolveStats& st) {
+  const int n = static_cast<int>(rows.size());
+  if (n == 0) {
+    st.residual_max = st.residual_mean = 0;
+    return;
+  }
+  std::vector<RowBlock> blocks;
+  push_blocks(blocks, 0, n, true);
+  std::vector<BlockStats> bs(blocks.size());
+  const int nb = static_cast<int>(blocks.size());
+#pragma omp parallel for schedule(static) if (n >= min_parallel)
+  for (int b = 0; b < nb; ++b) {
+    double rmax = 0, rsum = 0;
+    for (int i = blocks[b].begin; i < blocks[b].end; ++i) {
+      const ContactRow& r = rows[i];
+      double un, ut;
+      c.velocity(r, un, ut);
+      const double e = law_residual(un, ut, r.pn, r.pt, r.mu, r.adh, 1.0 / r.wnn);
+      rmax = std::max(rmax, e);
+      rsum += e;
+    }
+    bs[b].rmax = rmax;
+    bs[b].rsum = rsum;
+  }
+  double rmax = 0, rsum = 0, psum = 0;
+  for (const BlockStats& s : bs) {
+    rmax = std::max(rmax, s.rmax);
+    rsum += s.rsum;
+  }
+  for (const ContactRow& r : rows) psum += std::sqrt(r.pn * r.pn + r.pt * r.pt);
+  st.p_mean = psum / n;
+  const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
+  st.residual_max = rmax / scale;
+  st.residual_mean = rsum / n / scale;
+}
+
+template <class L, class C>
+SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
+                 const SolverParams& prm, std::vector<BoundaryDof>* dofs,
+                 const SweepObserver& observer) {
+  SolveStats st;
+  const int n = static_cast<int>(rows.size());
+  if (n == 0) {
+    if (dofs)
+      for (BoundaryDof& d : *dofs) d.v = d.v0;
+    return st;
+  }
+
+  const int ncol = static_cast<int>(col.start.size()) - 1;
+  std::vector<RowBlock> blocks;
+  std::vector<int> cb(ncol + 1, 0);  // blocks of colour c: [cb[c], cb[c+1])
+  for (int k = 0; k < ncol; ++k) {
+    cb[k] = static_cast<int>(blocks.size());
+    push_blocks(blocks, col.start[k], col.split[k], false);
+    push_blocks(blocks, col.split[k], col.start[k + 1], true);
+  }
+  cb[ncol] = static_cast<int>(blocks.size());
+  const int nb = cb[ncol];
+  std::vector<BlockStats> bs(nb);
+  ContactRow* R = rows.data();
+  const bool parallel = n >= prm.min_parallel;
+  bool done = false;
+  int it = 0;
+
+#pragma omp parallel if (parallel)
+  {
+    while (!done) {
+      // Symmetric Gauss-Seidel: colours forward on odd sweeps, backward on
+      // even ones, so that forces travel both ways along a chain (a pile's
+      // weight down, the floor's reaction up) within two sweeps. Inside a
+      // colour the order does not matter. The overflow colour stays last.
+      const bool backward = (it % 2) == 1;
+      const int nreg = col.overflow ? ncol - 1 : ncol;
+      for (int cc = 0; cc < ncol; ++cc) {
+        const int k = (cc < nreg && backward) ? nreg - 1 - cc : cc;
+        if (col.overflow && k == ncol - 1) {
+#pragma omp single
+          for (int b = cb[k]; b < cb[k + 1]; ++b) run_block<L>(blocks[b], R, c, bs[b]);
+        } else {
+#pragma omp for schedule(static)
+          for (int b = cb[k]; b < cb[k + 1]; ++b) run_block<L>(blocks[b], R, c, bs[b]);
+        }
+      }
+#pragma omp single
+      {
+        ++it;
+        double dsum = 0, psum = 0;
+        for (int b = 0; b < nb; ++b) {
+          dsum += bs[b].dp2sum;
+          psum += bs[b].psum;
+        }
+        st.p_mean = psum / n;
+        const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
+        st.dp_rel = std::sqrt(dsum / n) / scale;
+        st.iterations = it;
+        st.dof_rel = 0.0;
+        if (dofs)
+          for (BoundaryDof& d : *dofs) st.dof_rel = std::max(st.dof_rel, update_dof(d, R));
+        if (observer) observer(it, st.dp_rel);
+        if (it >= prm.max_iter) done = true;
+        if (st.dp_rel < prm.tol && st.dof_rel < prm.tol) done = true;
+      }
+      // implicit barrier: every thread sees the same 'done'
+    }
+  }
+
+  residuals(rows, c, prm.min_parallel, st);
+  st.cap_hit = st.dp_rel >= prm.tol || st.dof_rel >= prm.tol;
+  return st;
+}
+
+}  // namespace cd::sweep
