@@ -1,5 +1,6 @@
 // cdsim: runs a scene.
 //   cdsim SCENE.toml [--set section.key=value]... [--out DIR] [--threads N] [--quiet] [--fresh]
+//         [--dump-problem STEP]...
 // Everything is checked (scene, particles, output folder) before anything is
 // written; any error is one message naming the problem, and exit code 2.
 #include <omp.h>
@@ -28,6 +29,11 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet,-q", quiet, "no progress line on stderr");
   app.add_flag("--fresh", fresh, "start over, discarding a checkpoint in the output folder");
   app.add_flag("--help-scene", help_scene, "print every scene parameter with its default");
+  std::vector<std::int64_t> dump_steps;
+  app.add_option("--dump-problem", dump_steps,
+                 "write step STEP's contact problem into the output folder (repeatable): "
+                 "problem_STEP.cdp (replayed exactly by cdproblem), .dat (Siconos), .impulses")
+      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
 
   if (help_scene) {
@@ -47,7 +53,7 @@ int main(int argc, char** argv) {
     cd::check_output_dir(out);
     if (scene.threads > 0) omp_set_num_threads(scene.threads);
 
-    cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh};
+    cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps};
     const cd::RunSummary s = cd::run(world, scene, opt);
     if (s.first_step > 0)
       fmt::print("cdsim: resumed from {}/checkpoint.bin at step {} of {}\n", out, s.first_step,

@@ -12,6 +12,7 @@
 
 #include "checkpoint.hpp"
 #include "output.hpp"
+#include "problem.hpp"
 #include "setup.hpp"
 
 namespace cd {
@@ -28,7 +29,7 @@ void clear_previous(const std::filesystem::path& dir) {
   for (const auto& e : fs::directory_iterator(dir)) {
     const std::string f = e.path().filename().string();
     const bool ours = f == "series.csv" || f == "scene.toml" || e.path().extension() == ".pvd" ||
-                      f.starts_with("checkpoint.bin") ||
+                      f.starts_with("checkpoint.bin") || f.starts_with("problem_") ||
                       (e.path().extension() == ".vtp" &&
                        (f.starts_with("particles_") || f.starts_with("contacts_") ||
                         f.starts_with("walls_") || f.starts_with("shapes_")));
@@ -214,9 +215,30 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   };
   if (every_snap && !resume) timed_output([&] { snaps.write(w); });
 
+  // --dump-problem: the hook sees the problem of the step being taken
+  // (w.steps + 1) just before its solve.
+  auto dumped = [&](std::int64_t k) {
+    return std::find(opt.dump_steps.begin(), opt.dump_steps.end(), k) != opt.dump_steps.end();
+  };
+  if (!opt.dump_steps.empty())
+    w.set_problem_hook([&](const ContactProblem& p, const SolverParams& prm) {
+      const std::int64_t k = w.steps + 1;
+      if (!dumped(k)) return;
+      const std::string stem = (dir / fmt::format("problem_{}", k)).string();
+      write_contact_problem(p, prm, stem + ".cdp");
+      const bool cohesive = std::any_of(p.rows.begin(), p.rows.end(),
+                                        [](const ContactRow& r) { return r.adh != 0.0; });
+      if (!cohesive) write_problem(to_matrix(p), stem + ".dat");
+    });
+
   for (std::int64_t k = k0 + 1; k <= nsteps; ++k) {
     w.step();
     const StepStats& st = w.last();
+    if (dumped(k)) {
+      std::string text;
+      for (const ContactRow& r : w.rows()) text += fmt::format("{:a} {:a}\n", r.pn, r.pt);
+      write_file_atomic((dir / fmt::format("problem_{}.impulses", k)).string(), text);
+    }
     iv.add(st);
     if (shear) sh.add(w);
     iter_total += st.solve.iterations;

@@ -1,7 +1,9 @@
 // A run: the time loop around World::step, writing series rows, VTK
 // snapshots and a progress line.
 #pragma once
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "scene.hpp"
 #include "world.hpp"
@@ -13,6 +15,12 @@ struct RunOptions {
   bool quiet = false;       // no progress line
   std::string scene_toml;   // resolved scene, written as scene.toml
   bool fresh = false;       // start over even if `out` holds a checkpoint
+  // Steps whose contact problem is written into `out` before it is solved:
+  // problem_STEP.cdp (exact, contact_problem.hpp; cdproblem replays it to
+  // the same impulses), problem_STEP.dat (Siconos' matrix form; not for
+  // cohesive steps) and, after the solve, problem_STEP.impulses (the
+  // step's impulses, row order, hex floats).
+  std::vector<std::int64_t> dump_steps;
 };
 
 struct RunSummary {
