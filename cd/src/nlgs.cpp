@@ -14,64 +14,6 @@ namespace {
 
 constexpr int kMaxColours = 63;  // colour 63 of the mask is the overflow colour
 
-// Rows coupled through the velocities of their bodies (the simulator).
-template <bool Rot>
-struct BodyCoupling {
-  BodyVel* vel;
-
-  // One row update. Write1 = false when body 1 is driven (a wall): it is
-  // read, never written, so rows of one colour may share a wall without a
-  // data race.
-  template <class L, bool Write1>
-  void update(ContactRow& r, double& dp2, double& pabs) const {
-    BodyVel& A = vel[r.b1];
-    BodyVel& B = vel[r.b2];
-    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
-    double un = r.nx * dx + r.ny * dy + r.bn;
-    if constexpr (Rot) un += -B.w * r.c2t + A.w * r.c1t;
-    double ut = 0.0;
-    if constexpr (L::tangential) {
-      ut = -r.ny * dx + r.nx * dy + r.bt;
-      if constexpr (Rot) ut += B.w * r.c2n - A.w * r.c1n;
-    }
-    double pn, pt;
-    L::solve(r, un, ut, pn, pt);
-    const double dpn = pn - r.pn;
-    const double dpt = L::tangential ? pt - r.pt : 0.0;
-    r.pn = pn;
-    if constexpr (L::tangential) {
-      r.pt = pt;
-      pabs = std::sqrt(pn * pn + pt * pt);
-    } else {
-      pabs = std::abs(pn);
-    }
-    dp2 = dpn * dpn + dpt * dpt;
-    const double px = r.nx * dpn - r.ny * dpt, py = r.ny * dpn + r.nx * dpt;
-    B.vx += B.inv_m * px;
-    B.vy += B.inv_m * py;
-    if constexpr (Rot) B.w += B.inv_I * (r.c2n * dpt - r.c2t * dpn);
-    if constexpr (Write1) {
-      A.vx -= A.inv_m * px;
-      A.vy -= A.inv_m * py;
-      if constexpr (Rot) A.w -= A.inv_I * (r.c1n * dpt - r.c1t * dpn);
-    }
-  }
-
-  void velocity(const ContactRow& r, double& un, double& ut) const {
-    const BodyVel& A = vel[r.b1];
-    const BodyVel& B = vel[r.b2];
-    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
-    un = r.nx * dx + r.ny * dy;
-    ut = -r.ny * dx + r.nx * dy;
-    if constexpr (Rot) {
-      un += -B.w * r.c2t + A.w * r.c1t;
-      ut += B.w * r.c2n - A.w * r.c1n;
-    }
-    un += r.bn;
-    ut += r.bt;
-  }
-};
-
 }  // namespace
 
 Colouring colour_rows(const std::vector<ContactRow>& rows, const Bodies& bodies) {
@@ -138,9 +80,9 @@ void apply_impulses(const std::vector<ContactRow>& rows, std::vector<BodyVel>& v
 void law_residuals(const ContactProblem& p, const SolverParams& prm, SolveStats& st) {
   auto* vel = const_cast<BodyVel*>(p.vel.data());  // read only: velocity() does not write
   if (p.rotation)
-    sweep::residuals(p.rows, BodyCoupling<true>{vel}, prm.min_parallel, st);
+    sweep::residuals(p.rows, sweep::BodyCoupling<true>{vel}, prm.min_parallel, st);
   else
-    sweep::residuals(p.rows, BodyCoupling<false>{vel}, prm.min_parallel, st);
+    sweep::residuals(p.rows, sweep::BodyCoupling<false>{vel}, prm.min_parallel, st);
 }
 
 double update_dof(BoundaryDof& d, ContactRow* rows) {
@@ -178,10 +120,10 @@ SolveStats nlgs_solve(ContactProblem& p, const SolverParams& prm, const SweepObs
       [&](auto law) {
         using L = decltype(law);
         if (p.rotation) {
-          BodyCoupling<true> c{p.vel.data()};
+          sweep::BodyCoupling<true> c{p.vel.data()};
           return sweep::solve<L>(p.rows, p.colouring, c, prm, dofs, observer);
         }
-        BodyCoupling<false> c{p.vel.data()};
+        sweep::BodyCoupling<false> c{p.vel.data()};
         return sweep::solve<L>(p.rows, p.colouring, c, prm, dofs, observer);
       },
       p.law);

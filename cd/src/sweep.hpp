@@ -4,7 +4,8 @@
 // through the off-diagonal blocks of W (frozen problems in matrix form). The
 // sweep order, the convergence test, the boundary dofs and the residuals are
 // this code for both, so a frozen problem is replayed by the production
-// solver. Internal header: include it only where a coupling is defined.
+// solver. Studies that visit rows in their own order (cd/bench/ss_pair) use
+// BodyCoupling's update, the sweep's own row update, rather than a copy.
 //
 // A coupling provides
 //   template <class L, bool Write1>
@@ -38,6 +39,64 @@ struct BlockStats {
 inline void push_blocks(std::vector<RowBlock>& out, int begin, int end, bool write1) {
   for (int b = begin; b < end; b += kBlock) out.push_back({b, std::min(end, b + kBlock), write1});
 }
+
+// Rows coupled through the velocities of their bodies (the simulator).
+template <bool Rot>
+struct BodyCoupling {
+  BodyVel* vel;
+
+  // One row update. Write1 = false when body 1 is driven (a wall): it is
+  // read, never written, so rows of one colour may share a wall without a
+  // data race.
+  template <class L, bool Write1>
+  void update(ContactRow& r, double& dp2, double& pabs) const {
+    BodyVel& A = vel[r.b1];
+    BodyVel& B = vel[r.b2];
+    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
+    double un = r.nx * dx + r.ny * dy + r.bn;
+    if constexpr (Rot) un += -B.w * r.c2t + A.w * r.c1t;
+    double ut = 0.0;
+    if constexpr (L::tangential) {
+      ut = -r.ny * dx + r.nx * dy + r.bt;
+      if constexpr (Rot) ut += B.w * r.c2n - A.w * r.c1n;
+    }
+    double pn, pt;
+    L::solve(r, un, ut, pn, pt);
+    const double dpn = pn - r.pn;
+    const double dpt = L::tangential ? pt - r.pt : 0.0;
+    r.pn = pn;
+    if constexpr (L::tangential) {
+      r.pt = pt;
+      pabs = std::sqrt(pn * pn + pt * pt);
+    } else {
+      pabs = std::abs(pn);
+    }
+    dp2 = dpn * dpn + dpt * dpt;
+    const double px = r.nx * dpn - r.ny * dpt, py = r.ny * dpn + r.nx * dpt;
+    B.vx += B.inv_m * px;
+    B.vy += B.inv_m * py;
+    if constexpr (Rot) B.w += B.inv_I * (r.c2n * dpt - r.c2t * dpn);
+    if constexpr (Write1) {
+      A.vx -= A.inv_m * px;
+      A.vy -= A.inv_m * py;
+      if constexpr (Rot) A.w -= A.inv_I * (r.c1n * dpt - r.c1t * dpn);
+    }
+  }
+
+  void velocity(const ContactRow& r, double& un, double& ut) const {
+    const BodyVel& A = vel[r.b1];
+    const BodyVel& B = vel[r.b2];
+    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
+    un = r.nx * dx + r.ny * dy;
+    ut = -r.ny * dx + r.nx * dy;
+    if constexpr (Rot) {
+      un += -B.w * r.c2t + A.w * r.c1t;
+      ut += B.w * r.c2n - A.w * r.c1n;
+    }
+    un += r.bn;
+    ut += r.bt;
+  }
+};
 
 template <class L, class C>
 void run_block(const RowBlock& k, ContactRow* rows, C& c, BlockStats& s) {
