@@ -135,8 +135,8 @@ TEST(CdsimCli, GoodRunWritesSeriesSceneAndCollections) {
   std::string header, line;
   std::getline(in, header);
   for (const char* c : {"step", "time", "contacts", "iterations", "residual", "cap_hit",
-                        "max_overlap", "mean_overlap", "kinetic_energy", "t_detect", "t_solve",
-                        "t_integrate", "t_output"})
+                        "max_overlap", "mean_overlap", "kinetic_energy", "t_predict", "t_detect",
+                        "t_build", "t_colour", "t_solve", "t_integrate", "t_observe", "t_output"})
     EXPECT_NE(("," + header + ",").find(std::string(",") + c + ","), std::string::npos) << c;
   int rows = 0;
   while (std::getline(in, line)) ++rows;

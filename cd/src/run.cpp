@@ -211,7 +211,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   auto timed_output = [&](auto&& f) {
     const auto t = Clock::now();
     f();
-    w.times.output += std::chrono::duration<double>(Clock::now() - t).count();
+    w.times[Stage::Output] += std::chrono::duration<double>(Clock::now() - t).count();
   };
   if (every_snap && !resume) timed_output([&] { snaps.write(w); });
 
@@ -262,11 +262,9 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
                     {"max_overlap", iv.ov_max},
                     {"mean_overlap", st.mean_overlap},
                     {"kinetic_energy", w.kinetic_energy()},
-                    {"correction_work", iv.corr_work},
-                    {"t_detect", t.detect - iv.t0.detect},
-                    {"t_solve", t.solve - iv.t0.solve},
-                    {"t_integrate", t.integrate - iv.t0.integrate},
-                    {"t_output", t.output - iv.t0.output}};
+                    {"correction_work", iv.corr_work}};
+        for (int s = 0; s < kStages; ++s)
+          cols.emplace_back(std::string("t_") + kStageNames[s], t.t[s] - iv.t0.t[s]);
         if (shear) {
           // Contact stress (mean over the interval's steps), compression
           // positive; p = (s1 + s2)/2, q = (s1 - s2)/2 from the symmetric part.

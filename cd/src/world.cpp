@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <type_traits>
+#include <variant>
 
 namespace cd {
 
@@ -29,39 +31,40 @@ void World::configure() {
   prob_.law = choose_law(prm_.mu > 0.0 || prm_.mu_wall > 0.0, adhesion_on_);
   prob_.rotation = prm_.rotation;
   if (adhesion_on_) alert_ = std::max(alert_, prm_.debond);
-  periodic_ = prm_.cell.mode == CellParams::Mode::LeesEdwards;
-  walls_ = prm_.cell.mode == CellParams::Mode::Walls;
-  pc_.x = periodic_ || walls_;
-  pc_.y = periodic_;
-  if ((periodic_ || walls_) && cell.width <= 0.0) cell.width = prm_.cell.width;
+  switch (prm_.cell.mode) {
+    case CellParams::Mode::None: boundary_ = NoBoundary{}; break;
+    case CellParams::Mode::LeesEdwards: boundary_ = LeesEdwardsCell{}; break;
+    case CellParams::Mode::Walls: boundary_ = WallShear{}; break;
+  }
+  std::visit([&](const auto& b) { b.configure(*this); }, boundary_);
   prepared_ = false;
 }
 
+// The step: its stages in order, each timed into its own slot (Box2D's
+// stage list). A stage with nothing to do for a scene returns at once.
 void World::step() {
+  static constexpr std::array<std::pair<Stage, void (World::*)()>, 7> kTable = {{
+      {Stage::Predict, &World::predict},
+      {Stage::Detect, &World::detect_stage},
+      {Stage::Build, &World::build},
+      {Stage::Colour, &World::colour},
+      {Stage::Solve, &World::solve},
+      {Stage::Integrate, &World::integrate},
+      {Stage::Observe, &World::observe},
+  }};
   if (!prepared_) {  // per-scene choices that depend on the bodies
     forces_on_ = std::any_of(bodies.force.begin(), bodies.force.end(),
                              [](const Vec2& f) { return f.squaredNorm() > 0.0; });
-    on_top_.assign(walls_ ? bodies.size() : 0, 0);
+    on_top_.assign(std::holds_alternative<WallShear>(boundary_) ? bodies.size() : 0, 0);
     for (const std::int32_t i : top_wall) on_top_[i] = 1;
     prepared_ = true;
   }
-  if (walls_) {  // the shear rate, not the wall speed, is imposed: V = gamma-dot x gap
-    const double v = prm_.cell.shear_rate * cell.height;
-    for (const std::int32_t i : top_wall) bodies.vel[i].vx = v;
+  std::visit([&](const auto& b) { b.begin_step(*this); }, boundary_);
+  for (const auto& [stage, run] : kTable) {
+    const auto t0 = Clock::now();
+    (this->*run)();
+    times[stage] += since(t0);
   }
-  auto t0 = Clock::now();
-  predict();
-  detect_stage();
-  build();
-  times.detect += since(t0);
-
-  t0 = Clock::now();
-  solve();
-  times.solve += since(t0);
-
-  t0 = Clock::now();
-  integrate();
-  times.integrate += since(t0);
   ++steps;
   time = static_cast<double>(steps) * prm_.dt;  // not a running sum: no drift
 }
@@ -81,22 +84,12 @@ void World::predict() {
     xm_[i] = bodies.pos[i] + h * Vec2(v.vx, v.vy);
     thm_[i] = bodies.angle[i] + h * v.w;
   }
-  if (periodic_ || walls_) {
-    cm_ = cell;
-    cm_.height += h * cell.hdot;
-    cm_.width += h * cell.wdot;
-    if (periodic_) {
-      cm_.offset = std::fmod(cell.offset + h * prm_.cell.shear_rate * cell.height, cm_.width);
-      if (cm_.offset < 0) cm_.offset += cm_.width;
-    }
-    pc_.width = cm_.width;
-    pc_.height = cm_.height;
-    pc_.offset = cm_.offset;
-  }
+  std::visit([&](const auto& b) { b.predict(*this, h); }, boundary_);
 }
 
 void World::detect_stage() {
-  detect(bodies, xm_, thm_, alert_, grid_, prob_.rows, info_, (periodic_ || walls_) ? &pc_ : nullptr);
+  const bool images = std::visit([](const auto& b) { return b.images(); }, boundary_);
+  detect(bodies, xm_, thm_, alert_, grid_, prob_.rows, info_, images ? &pc_ : nullptr);
 }
 
 void World::build() {
@@ -118,39 +111,12 @@ void World::build() {
     r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
     r.bt = 0.0;
   }
-  if (periodic_) {
-    // Lees-Edwards: the image of body 2 across the top moves at (gamma-dot
-    // H, dH/dt) relative to body 2, across a side at (dW/dt, 0).
-    for (std::size_t k = 0; k < nr; ++k) {
-      if (info_[k].ix == 0 && info_[k].iy == 0) continue;
-      ContactRow& r = prob_.rows[k];
-      const Vec2 v = image_velocity(info_[k]);
-      r.bn += r.nx * v.x() + r.ny * v.y();
-      r.bt += -r.ny * v.x() + r.nx * v.y();
-    }
-  }
+  std::visit([&](const auto& b) { b.build(*this); }, boundary_);
   if (adhesion_on_) {
     const double a = prm_.adhesion * dt;
     for (std::size_t k = 0; k < nr; ++k) prob_.rows[k].adh = info_[k].gap <= prm_.debond ? a : 0.0;
   }
-  if (restitution_on_) {
-    // Law on u+ + e u-, with u- the relative velocity at the start of the
-    // step (before external forces) in the midpoint frame. Only approaching
-    // normal velocities are restituted. (bn, bt so far hold only the gap
-    // term and the periodic images' velocity: that velocity is part of u-.)
-    for (std::size_t k = 0; k < nr; ++k) {
-      ContactRow& r = prob_.rows[k];
-      double un, ut;
-      row_velocity(r, V, rot, un, ut);
-      if (periodic_ && (info_[k].ix != 0 || info_[k].iy != 0)) {
-        const Vec2 v = image_velocity(info_[k]);
-        un += r.nx * v.x() + r.ny * v.y();
-        ut += -r.ny * v.x() + r.nx * v.y();
-      }
-      r.bn += prm_.e_n * std::min(un, 0.0);
-      r.bt += prm_.e_t * ut;
-    }
-  }
+  if (restitution_on_) std::visit([&](const auto& b) { restitution_offsets(b); }, boundary_);
   // Warm start from the previous step's impulses, matched by contact key.
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t k = 0; k < nr; ++k) {
@@ -160,6 +126,30 @@ void World::build() {
       prob_.rows[k].pn = p.first;
       prob_.rows[k].pt = p.second;
     }
+  }
+}
+
+// Law on u+ + e u-, with u- the relative velocity at the start of the step
+// (before external forces) in the midpoint frame. Only approaching normal
+// velocities are restituted. (bn, bt so far hold only the gap term and the
+// periodic images' velocity: that velocity is part of u-.)
+template <class B>
+void World::restitution_offsets(const B& b) {
+  const auto& V = bodies.vel;
+  const bool rot = prm_.rotation;
+  for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
+    ContactRow& r = prob_.rows[k];
+    double un, ut;
+    row_velocity(r, V, rot, un, ut);
+    if constexpr (B::moving_images) {
+      if (info_[k].ix != 0 || info_[k].iy != 0) {
+        const Vec2 v = b.image_velocity(*this, info_[k]);
+        un += r.nx * v.x() + r.ny * v.y();
+        ut += -r.ny * v.x() + r.nx * v.y();
+      }
+    }
+    r.bn += prm_.e_n * std::min(un, 0.0);
+    r.bt += prm_.e_t * ut;
   }
 }
 
@@ -174,38 +164,31 @@ void World::external() {
   }
 }
 
-void World::solve() {
+void World::colour() {
   // Colour and permute rows so that each colour is contiguous.
   prob_.colouring = colour_rows(prob_.rows, bodies);
   const Colouring& col = prob_.colouring;
-  {
-    std::vector<ContactRow> r(prob_.rows.size());
-    std::vector<ContactInfo> f(info_.size());
+  std::vector<ContactRow> r(prob_.rows.size());
+  std::vector<ContactInfo> f(info_.size());
 #pragma omp parallel for schedule(static) if (static_cast<int>(prob_.rows.size()) >= prm_.solver.min_parallel)
-    for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
-      r[k] = prob_.rows[col.perm[k]];
-      f[k] = info_[col.perm[k]];
-    }
-    prob_.rows.swap(r);
-    info_.swap(f);
+  for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
+    r[k] = prob_.rows[col.perm[k]];
+    f[k] = info_[col.perm[k]];
   }
+  prob_.rows.swap(r);
+  info_.swap(f);
+}
+
+void World::solve() {
   if (gravity_on_ || forces_on_) external();
   apply_impulses(prob_.rows, bodies.vel, prm_.rotation);
-  if (periodic_ || walls_) set_cell_dofs();
+  std::visit([&](const auto& b) { b.set_dofs(*this); }, boundary_);
   // The problem takes the velocities for the solve and gives them back.
   prob_.vel.swap(bodies.vel);
   if (hook_) hook_(prob_, prm_.solver);
   last_.solve = solver_ ? solver_(prob_, prm_.solver) : nlgs_solve(prob_, prm_.solver);
   prob_.vel.swap(bodies.vel);
-  if (!prob_.dofs.empty()) {
-    if (periodic_) {
-      cell.hdot = prob_.dofs[0].v;
-      if (prob_.dofs.size() > 1) cell.wdot = prob_.dofs[1].v;
-    } else {
-      cell.hdot = prob_.dofs[0].v;
-      for (const std::int32_t i : top_wall) bodies.vel[i].vy = cell.hdot;
-    }
-  }
+  std::visit([&](const auto& b) { b.take_dofs(*this); }, boundary_);
 
   // Keep the impulses for the next step's warm start.
   const std::size_t nr = prob_.rows.size();
@@ -219,8 +202,11 @@ void World::solve() {
     warm_.keys[k] = info_[idx[k]].key;
     warm_.p[k] = {prob_.rows[idx[k]].pn, prob_.rows[idx[k]].pt};
   }
+}
 
+void World::observe() {
   // Step quality: contacts, overlaps.
+  const std::size_t nr = prob_.rows.size();
   last_.contacts = static_cast<int>(nr);
   int active = 0, nover = 0;
   double omax = 0, osum = 0;
@@ -255,140 +241,39 @@ void World::integrate() {
     bodies.pos[i] = xm_[i] + h * Vec2(v.vx, v.vy);
     if (rot || !bodies.is_dynamic(i)) bodies.angle[i] = thm_[i] + h * v.w;
   }
-  if (periodic_ || walls_) {
-    const double gd = shear_rate();
-    cell.height = cm_.height + h * cell.hdot;
-    cell.width = cm_.width + h * cell.wdot;
-    cell.strain += prm_.dt * gd;
-    if (periodic_) {
-      cell.offset = std::fmod(cell.offset + prm_.dt * prm_.cell.shear_rate * cm_.height, cell.width);
-      if (cell.offset < 0) cell.offset += cell.width;
-    }
-    wrap_into_cell();
-  }
+  std::visit([&](const auto& b) { b.integrate(*this, h); }, boundary_);
 }
 
-Vec2 World::image_velocity(const ContactInfo& f) const {
-  return {f.iy * prm_.cell.shear_rate * cm_.height + f.ix * cell.wdot, f.iy * cell.hdot};
+BoundaryDof World::make_dof(double v_start, double load, double length) const {
+  const double dt = prm_.dt, M = prm_.cell.mass;
+  BoundaryDof d;
+  d.inv_mass = 1.0 / M;
+  d.v0 = v_start - dt * load / M;
+  d.v = d.v0;
+  d.scale = dt * prm_.cell.pressure * length;  // the imposed impulse, unit of its convergence test
+  return d;
 }
 
-void World::set_cell_dofs() {
-  // One dof per controlled length: its velocity at the start of the step
-  // (already in the rows' offsets, or in the top bodies' velocities), and
-  // v0 with the imposed stress's impulse; the offsets get the difference.
-  const double dt = prm_.dt, P = prm_.cell.pressure, M = prm_.cell.mass;
-  prob_.dofs.clear();
-  if (P <= 0.0 || M <= 0.0) return;
-  // load: the external force on the dof (imposed stress x length); scale:
-  // the imposed impulse p x length x dt, the unit of its convergence test.
-  auto make = [&](double v_start, double load, double length) {
-    BoundaryDof d;
-    d.inv_mass = 1.0 / M;
-    d.v0 = v_start - dt * load / M;
-    d.v = d.v0;
-    d.scale = dt * P * length;
-    return d;
-  };
-  const std::size_t nr = prob_.rows.size();
-  auto couple = [&](BoundaryDof& d, std::size_t k, double an, double at, double v_start) {
-    d.rows.push_back(static_cast<std::int32_t>(k));
-    d.an.push_back(an);
-    d.at.push_back(at);
-    prob_.rows[k].bn += an * (d.v0 - v_start);
-    prob_.rows[k].bt += at * (d.v0 - v_start);
-  };
-  if (periodic_) {
-    // The imposed stress balances the whole normal stress: the height sees
-    // only the contacts that cross the boundary, so the kinetic stress (the
-    // momentum grains carry through it, relabelled by the periodicity) is
-    // taken off the load, from the velocities at the start of the step.
-    // Dense flows: K_yy << p, no change; collisional flows (I >~ 0.5): without
-    // it the contact stress alone held p, and sigma_yy + K_yy overshot it.
-    const Eigen::Matrix2d K = kinetic_stress();
-    prob_.dofs.push_back(make(cell.hdot, (P - K(1, 1)) * cm_.width, cm_.width));
-    if (prm_.cell.isotropic)
-      prob_.dofs.push_back(make(cell.wdot, (P - K(0, 0)) * cm_.height, cm_.height));
-    for (std::size_t k = 0; k < nr; ++k) {
-      const ContactInfo& f = info_[k];
-      const ContactRow& r = prob_.rows[k];
-      if (f.iy != 0) couple(prob_.dofs[0], k, f.iy * r.ny, f.iy * r.nx, cell.hdot);
-      if (f.ix != 0 && prm_.cell.isotropic) couple(prob_.dofs[1], k, f.ix * r.nx, -f.ix * r.ny, cell.wdot);
-    }
-  } else {
-    prob_.dofs.push_back(make(cell.hdot, P * cm_.width, cm_.width));
-    for (std::size_t k = 0; k < nr; ++k) {
-      const ContactRow& r = prob_.rows[k];
-      const double s = on_top_[r.b2] ? 1.0 : on_top_[r.b1] ? -1.0 : 0.0;
-      if (s != 0.0) couple(prob_.dofs[0], k, s * r.ny, s * r.nx, cell.hdot);
-    }
-  }
+void World::couple_dof(BoundaryDof& d, std::size_t k, double an, double at, double v_start) {
+  d.rows.push_back(static_cast<std::int32_t>(k));
+  d.an.push_back(an);
+  d.at.push_back(at);
+  prob_.rows[k].bn += an * (d.v0 - v_start);
+  prob_.rows[k].bt += at * (d.v0 - v_start);
 }
 
-void World::wrap_into_cell() {
-  const double W = cell.width, H = cell.height;
-  const double vs = prm_.cell.shear_rate * H;
-  // Momentum the crossings' dH/dt and dW/dt parts give the sample, and its mass.
-  double px = 0.0, py = 0.0, mass = 0.0;
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    if (bodies.shape[i] == Shape::Segment) continue;
-    Vec2& x = bodies.pos[i];
-    if (periodic_) {
-      // A body leaving through the top comes back through the bottom as
-      // its own Lees-Edwards image: shifted back by the offset, and slower
-      // by the images' velocity. Likewise through a side: the images there
-      // move at dW/dt (World::build), so the body comes back slower by it.
-      BodyVel& v = bodies.vel[i];
-      const double m = bodies.mass[i];
-      while (x.y() >= H) {
-        x.y() -= H;
-        x.x() -= cell.offset;
-        v.vx -= vs;
-        v.vy -= cell.hdot;
-        py -= m * cell.hdot;
-      }
-      while (x.y() < 0.0) {
-        x.y() += H;
-        x.x() += cell.offset;
-        v.vx += vs;
-        v.vy += cell.hdot;
-        py += m * cell.hdot;
-      }
-      const double k = std::floor(x.x() / W);
-      x.x() -= W * k;
-      v.vx -= k * cell.wdot;
-      px -= k * m * cell.wdot;
-      mass += m;
-    } else {
-      x.x() -= W * std::floor(x.x() / W);
-    }
-  }
-  // The bottom and left edges are fixed, so a changing cell sweeps bodies
-  // through the top and right only, and the rates' parts above would add
-  // up to a drift of the whole sample (measured: 0.7 sqrt(p/rho) after an
-  // isotropic compaction of 150 disks, all of the kinetic energy of the
-  // jammed sample; the drift then streams the sample through the
-  // Lees-Edwards boundary, and its mean vx falls at gamma-dot times that
-  // drift). A uniform velocity is a symmetry of the periodic cell (no
-  // walls, no gravity: relative velocities, the contacts and the cell's
-  // dofs do not see it), so remove it: the contacts and the cell rates
-  // conserve the sample's momentum. (The gamma-dot H part is the usual
-  // Lees-Edwards one, kept.)
-  if (periodic_ && mass > 0.0 && (px != 0.0 || py != 0.0)) {
-    const double ux = px / mass, uy = py / mass;
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      if (!bodies.is_dynamic(i)) continue;
-      bodies.vel[i].vx -= ux;
-      bodies.vel[i].vy -= uy;
-    }
-  }
+double World::shear_rate() const {
+  return std::visit([&](const auto& b) { return std::decay_t<decltype(b)>::cell; }, boundary_)
+             ? prm_.cell.shear_rate
+             : 0.0;
 }
-
-double World::shear_rate() const { return (periodic_ || walls_) ? prm_.cell.shear_rate : 0.0; }
 
 Eigen::Matrix2d World::kinetic_stress() const {
   Eigen::Matrix2d k = Eigen::Matrix2d::Zero();
   const double V = cell.width * cell.height;
-  if (!(periodic_ || walls_) || V <= 0.0) return k;
+  const bool has_cell =
+      std::visit([](const auto& b) { return std::decay_t<decltype(b)>::cell; }, boundary_);
+  if (!has_cell || V <= 0.0) return k;
   const double gd = shear_rate();
   double m = 0.0;
   Vec2 mv = Vec2::Zero();

@@ -1,18 +1,26 @@
-// World: bodies, per-scene settings, and the time step as a list of named,
-// timed stages (method.md section 6, midpoint scheme):
-//   predict    r_m = r + dt/2 U-
+// World: bodies, per-scene settings, and the time step as a table of named,
+// timed stages (method.md section 6, midpoint scheme; the table is in
+// world.cpp, World::step):
+//   predict    r_m = r + dt/2 U-, and the cell at the midpoint
 //   detect     contacts at the midpoint configuration
-//   build      W blocks, law offsets (gap, restitution), warm start
-//   external   U_free = U- + dt M^-1 F_ext   (only if the scene has gravity)
-//   solve      NLGS on the coloured rows
-//   integrate  r+ = r_m + dt/2 U+
-// Stages a scene does not need are not run; the law is fixed once per scene.
+//   build      W blocks, law offsets (gap, restitution, images), adhesion,
+//              warm start
+//   colour     rows in colour order (the ContactProblem's colouring)
+//   solve      external impulses, warm start into the velocities, boundary
+//              dofs, NLGS on the ContactProblem, impulses kept for the next
+//              warm start
+//   integrate  r+ = r_m + dt/2 U+, and the cell
+//   observe    the step's quality figures (contacts, overlaps, work)
+// Work a scene does not need is not done; the law and the boundary
+// protocol (boundary.hpp) are fixed once per scene.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
 #include "bodies.hpp"
+#include "boundary.hpp"
 #include "contact.hpp"
 #include "contact_problem.hpp"
 #include "detect.hpp"
@@ -68,8 +76,18 @@ struct CellState {
   double strain = 0.0;               // integral of the shear rate
 };
 
-struct StageTimes {  // wall-clock seconds, accumulated
-  double detect = 0, solve = 0, integrate = 0, output = 0;
+// The stages of a step, in the order they run, and `output` (timed by the
+// run loop). Their names are the series columns t_<name> and the
+// checkpoint's record of the timers.
+enum class Stage : int { Predict, Detect, Build, Colour, Solve, Integrate, Observe, Output };
+inline constexpr int kStages = 8;
+inline constexpr std::array<const char*, kStages> kStageNames = {
+    "predict", "detect", "build", "colour", "solve", "integrate", "observe", "output"};
+
+struct StageTimes {  // wall-clock seconds, accumulated, per stage
+  std::array<double, kStages> t{};
+  double& operator[](Stage s) { return t[static_cast<int>(s)]; }
+  double operator[](Stage s) const { return t[static_cast<int>(s)]; }
 };
 
 struct StepStats {
@@ -149,26 +167,31 @@ class World {
   void set_warm_start(WarmStart w) { warm_ = std::move(w); }
 
  private:
+  friend struct LeesEdwardsCell;
+  friend struct WallShear;
   void configure();
+  // The stages (world.cpp's table).
   void predict();
   void detect_stage();
   void build();
-  void external();
+  void colour();
   void solve();
   void integrate();
+  void observe();
+  void external();
+  template <class B>
+  void restitution_offsets(const B& b);
+  // A boundary dof of mass cell.mass loaded by `load` (imposed stress x
+  // length), at velocity v_start at the step's start; coupling row k to it.
+  BoundaryDof make_dof(double v_start, double load, double length) const;
+  void couple_dof(BoundaryDof& d, std::size_t k, double an, double at, double v_start);
 
   WorldParams prm_;
-  void wrap_into_cell();
-  // Lees-Edwards: velocity of the image of body 2 that a contact touches,
-  // relative to body 2 itself ((gamma-dot H, dH/dt) per cell up, (dW/dt, 0)
-  // per cell right), at the step's start.
-  Vec2 image_velocity(const ContactInfo& f) const;
-  void set_cell_dofs();
+  Boundary boundary_;
   bool gravity_on_ = false, restitution_on_ = false, adhesion_on_ = false;
-  bool periodic_ = false, walls_ = false;
   CellState cm_;           // cell at the midpoint configuration
-  PeriodicCell pc_;        // its periodic view for detection
-  std::vector<std::uint8_t> on_top_;  // Walls: body is glued to the top wall
+  PeriodicCell pc_;        // its periodic view for detection (boundary_.images())
+  std::vector<std::uint8_t> on_top_;  // WallShear: body is glued to the top wall
   bool forces_on_ = false, prepared_ = false;  // forces_on_: some body has an applied force
   double alert_ = 0.0;
   StepStats last_;

@@ -1,0 +1,73 @@
+// Boundary protocols (method.md section 9): what the periodic cell or the
+// rough walls add to a step, behind one object chosen once per scene
+// (World::configure, from CellParams::mode), so that the stages of
+// world.cpp hold no test of the protocol:
+//   NoBoundary       walls and gravity only (piles): every hook does nothing.
+//   LeesEdwardsCell  bi-periodic cell [0, W) x [0, H); the images above slide
+//                    at gamma-dot H; with a pressure the height (and, for
+//                    isotropic compaction, the width) is a degree of
+//                    freedom solved with the contacts (BoundaryDof).
+//   WallShear        periodic in x; grains glued to the bottom wall (fixed)
+//                    and to the top wall, which moves at gamma-dot x gap and
+//                    whose height is a dof at the imposed pressure.
+// Each hook is called by one stage of World::step (world.cpp), named after it.
+#pragma once
+#include <variant>
+
+#include "bodies.hpp"
+#include "contact.hpp"
+
+namespace cd {
+
+class World;
+
+// `cell`: the protocol has a cell (a shear rate, a volume, a kinetic stress).
+// `moving_images`: periodic images move relative to the bodies (their
+// velocity enters the rows that touch them).
+struct NoBoundary {
+  static constexpr bool cell = false, moving_images = false;
+  void configure(World&) const {}
+  void begin_step(World&) const {}
+  void predict(World&, double /*h*/) const {}
+  bool images() const { return false; }
+  void build(World&) const {}
+  Vec2 image_velocity(const World&, const ContactInfo&) const { return Vec2::Zero(); }
+  void set_dofs(World&) const {}
+  void take_dofs(World&) const {}
+  void integrate(World&, double /*h*/) const {}
+};
+
+struct LeesEdwardsCell {
+  static constexpr bool cell = true, moving_images = true;
+  void configure(World& w) const;
+  void begin_step(World&) const {}
+  void predict(World& w, double h) const;
+  bool images() const { return true; }
+  // The images' velocity into the offsets of the rows that touch them.
+  void build(World& w) const;
+  // Velocity of the image of body 2 that a contact touches, relative to
+  // body 2 ((gamma-dot H, dH/dt) per cell up, (dW/dt, 0) per cell right), at
+  // the step's start: in the offsets (build) and in u- (restitution).
+  Vec2 image_velocity(const World& w, const ContactInfo& f) const;
+  void set_dofs(World& w) const;
+  void take_dofs(World& w) const;
+  void integrate(World& w, double h) const;
+};
+
+struct WallShear {
+  static constexpr bool cell = true, moving_images = false;
+  void configure(World& w) const;
+  // The shear rate, not the wall speed, is imposed: V = gamma-dot x gap.
+  void begin_step(World& w) const;
+  void predict(World& w, double h) const;
+  bool images() const { return true; }
+  void build(World&) const {}
+  Vec2 image_velocity(const World&, const ContactInfo&) const { return Vec2::Zero(); }
+  void set_dofs(World& w) const;
+  void take_dofs(World& w) const;
+  void integrate(World& w, double h) const;
+};
+
+using Boundary = std::variant<NoBoundary, LeesEdwardsCell, WallShear>;
+
+}  // namespace cd
