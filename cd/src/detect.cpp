@@ -6,11 +6,12 @@
 
 #include <omp.h>
 
+#include "parallel.hpp"
+
 namespace cd {
 
 namespace {
 
-constexpr int kMinParallelDetect = 2000;
 
 // Lever arms of a contact point in the frame (n, t = n rotated +90 degrees).
 inline void set_frame(ContactRow& row, const Vec2& n, const Vec2& c1, const Vec2& c2) {
@@ -432,9 +433,8 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
       for (int i : parts) grid.items[fill[cell_of(i)]++] = i;  // ascending index inside a cell
     }
     const double offset = cell ? cell->offset : 0.0;
-    // Small systems detect on one thread: waking a team costs more than the
-    // work, and much more on a loaded machine.
-#pragma omp parallel if (nd >= kMinParallelDetect)
+    // Small systems detect on one thread (parallel.hpp).
+#pragma omp parallel if (nd >= kMinParallelBodies)
     {
       auto& R = grid.rows_t[omp_get_thread_num()];
       auto& I = grid.info_t[omp_get_thread_num()];

@@ -16,6 +16,7 @@
 #include "bodies.hpp"
 #include "contact.hpp"
 #include "contact_problem.hpp"
+#include "parallel.hpp"
 
 namespace cd {
 
@@ -25,8 +26,8 @@ struct SolverParams {
   // Below this many rows the sweep runs on one thread: a colour of a few
   // dozen rows costs less than the barrier that ends it (measured: a
   // 600-row pile ran 3x slower on 2 threads than on 1). Loops over bodies
-  // (predict, integrate) use half of it. The one threshold of the code.
-  int min_parallel = 4096;
+  // (predict, integrate, detection) use half of it (kMinParallelBodies).
+  int min_parallel = kMinParallelRows;
 };
 
 struct SolveStats {

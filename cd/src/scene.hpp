@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "world.hpp"
+
 namespace cd {
 
 struct DiskSpec {            // [[disk]]: one explicit disk
@@ -32,7 +34,7 @@ struct Scene {
   std::string source;        // file the scene came from (for messages)
 
   // [time]
-  double dt = 1e-4;          // time step (s)
+  double dt = WorldParams{}.dt;  // time step (s)
   double duration = 0.5;     // simulated time (s)
 
   // [gravity]
@@ -44,14 +46,15 @@ struct Scene {
   double e_n = 0.0;          // normal restitution
   double e_t = 0.0;          // tangential restitution
   double alert = 0.1;        // alert distance, in mean diameters
-  bool rotation = true;      // integrate rotations
+  bool rotation = WorldParams{}.rotation;  // integrate rotations
   double overlap_correction = 0.0;  // beta: overlaps separate at beta |gap|/dt (0: none)
   double adhesion = 0.0;     // pull-off force f_a (N); 0: no cohesion
   double debond = 0.01;      // debonding distance delta_a, in mean diameters
 
   // [solver]
-  double tol = 1e-4;         // NLGS tolerance eps_f (relative)
-  int max_iter = 2000;       // iteration cap per step
+  // The solver's defaults are SolverParams' (nlgs.hpp): one source.
+  double tol = SolverParams{}.tol;           // NLGS tolerance eps_f (relative)
+  int max_iter = SolverParams{}.max_iter;    // iteration cap per step
   int threads = 0;           // 0: OpenMP default
 
   // [particles]: random generation (n = 0 for none)
