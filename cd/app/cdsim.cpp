@@ -3,6 +3,9 @@
 //         [--dump-problem STEP]...
 // Everything is checked (scene, particles, output folder) before anything is
 // written; any error is one message naming the problem, and exit code 2.
+// Exit codes: 0 done; 2 bad input (usage, scene, start sample, checkpoint,
+// output folder); 3 the run diverged (non-finite state: the watchdog);
+// 128 + signal when stopped by SIGINT/SIGTERM at a step boundary.
 #include <omp.h>
 
 #include <cstdio>
@@ -34,7 +37,14 @@ int main(int argc, char** argv) {
                  "write step STEP's contact problem into the output folder (repeatable): "
                  "problem_STEP.cdp (replayed exactly by cdproblem), .dat (Siconos), .impulses")
       ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help prints and exits 0; every usage error is bad input: exit 2.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  // Status lines reach a log file as they are printed, even if the run is killed.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
 
   if (help_scene) {
     std::cout << cd::parameter_table_markdown();
@@ -54,6 +64,7 @@ int main(int argc, char** argv) {
     if (scene.threads > 0) omp_set_num_threads(scene.threads);
 
     cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps};
+    cd::install_stop_handlers();
     const cd::RunSummary s = cd::run(world, scene, opt);
     if (s.first_step > 0)
       fmt::print("cdsim: resumed from {}/checkpoint.bin at step {} of {}\n", out, s.first_step,
@@ -65,6 +76,17 @@ int main(int argc, char** argv) {
         s.steps, s.wall_time, 1e3 * per_step, omp_get_max_threads(), s.mean_iterations,
         s.max_iterations, s.cap_hits, s.max_residual, s.max_overlap);
     fmt::print("cdsim: outputs in {}/\n", out);
+    if (s.stop_signal) {
+      fmt::print("cdsim: stopped by signal {} after step {}{}\n", s.stop_signal,
+                 s.first_step + s.steps,
+                 scene.checkpoint_interval > 0 || s.first_step > 0
+                     ? "; checkpoint written: the same command resumes"
+                     : " (no checkpoint: output.checkpoint_interval = 0)");
+      return 128 + s.stop_signal;
+    }
+  } catch (const cd::RunDiverged& e) {
+    std::cerr << "cdsim: run diverged: " << e.what() << "\n";
+    return 3;
   } catch (const std::exception& e) {
     std::cerr << "cdsim: error: " << e.what() << "\n";
     return 2;

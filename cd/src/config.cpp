@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -39,6 +40,10 @@ Rule ge(double lo) { return {fmt::format(">= {}", lo), [=](const Val& v) { retur
 Rule in(double lo, double hi) {
   return {fmt::format("in [{}, {}]", lo, hi),
           [=](const Val& v) { return num(v) >= lo && num(v) <= hi; }};
+}
+Rule in_open_closed(double lo, double hi) {
+  return {fmt::format("in ({}, {}]", lo, hi),
+          [=](const Val& v) { return num(v) > lo && num(v) <= hi; }};
 }
 Rule non_empty() {
   return {"non-empty", [](const Val& v) { return !std::get<std::string>(v).empty(); }};
@@ -105,10 +110,10 @@ const std::vector<Param<Scene>>& scene_params() {
       {"contact", "debond", &Scene::debond, "d_mean", ge(0), "debonding distance delta_a, in mean diameters: a bond breaks beyond it"},
       {"contact", "cohesion_number", &Scene::cohesion_number, "", ge(0), "cohesion number eta: f_a = eta p d with the imposed shear.pressure p and the mean diameter d (instead of contact.adhesion); 0: use contact.adhesion"},
       {"contact", "overlap_correction", &Scene::overlap_correction, "", in(0, 1), "beta: an overlapping contact must separate at beta |gap|/dt; injects energy (bounded by the series column correction_work); 0: pure CD, overlaps never pushed apart"},
-      {"solver", "tol", &Scene::tol, "", gt(0), "NLGS convergence tolerance (relative)"},
-      {"solver", "max_iter", &Scene::max_iter, "", ge(1), "NLGS iteration cap per time step"},
-      {"solver", "threads", &Scene::threads, "", ge(0), "OpenMP threads; 0: OpenMP default"},
-      {"particles", "n", &Scene::n, "", ge(0), "number of randomly generated disks; 0: none"},
+      {"solver", "tol", &Scene::tol, "", in_open_closed(0, 1), "NLGS convergence tolerance (relative)"},
+      {"solver", "max_iter", &Scene::max_iter, "", in(1, 1e8), "NLGS iteration cap per time step"},
+      {"solver", "threads", &Scene::threads, "", in(0, 1024), "OpenMP threads; 0: OpenMP default"},
+      {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
       {"particles", "size_ratio", &Scene::size_ratio, "", ge(1), "d_max / d_min"},
       {"particles", "size_dist", &Scene::size_dist, "", size_dist(), "diameter distribution: uniform in d, or uniform_area (equal area per size class)"},
@@ -193,10 +198,18 @@ std::string type_name(const toml::value& v) {
   }
 }
 
-std::string get(const toml::value& v, double& x) {
+// A number of any TOML kind; whether it is finite is checked by the callers
+// (TOML spells inf and nan, and no scene value may be either).
+std::string get_number(const toml::value& v, double& x) {
   if (v.is_floating()) x = v.as_floating();
   else if (v.is_integer()) x = static_cast<double>(v.as_integer());
   else return ": expected a number, got " + type_name(v);
+  return "";
+}
+
+std::string get(const toml::value& v, double& x) {
+  if (std::string e = get_number(v, x); !e.empty()) return e;
+  if (!std::isfinite(x)) return fmt::format(" = {}: must be a finite number", x);
   return "";
 }
 
@@ -228,8 +241,11 @@ std::string get(const toml::value& v, std::vector<double>& x) {
   if (!v.is_array()) return ": expected an array of numbers, got " + type_name(v);
   std::vector<double> out(v.as_array().size());
   for (std::size_t i = 0; i < out.size(); ++i)
-    if (!get(v.as_array()[i], out[i]).empty())
+    if (!get_number(v.as_array()[i], out[i]).empty())
       return ": expected an array of numbers, got an array containing " + type_name(v.as_array()[i]);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    if (!std::isfinite(out[i]))
+      return fmt::format(": element {} is {}: must be finite numbers", i, out[i]);
   x = std::move(out);
   return "";
 }

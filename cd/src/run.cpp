@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -20,6 +21,33 @@ namespace cd {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop(int sig) { g_stop = sig; }
+
+// The watchdog: the first non-finite quantity of the state a step left, or
+// "". O(bodies + contacts), a few per cent of a step's detection.
+std::string non_finite(const World& w) {
+  const Bodies& b = w.bodies;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (!std::isfinite(b.pos[i].x()) || !std::isfinite(b.pos[i].y()) || !std::isfinite(b.angle[i]))
+      return fmt::format("body {}: position ({}, {}), angle {}", i, b.pos[i].x(), b.pos[i].y(), b.angle[i]);
+    if (!std::isfinite(b.vel[i].vx) || !std::isfinite(b.vel[i].vy) || !std::isfinite(b.vel[i].w))
+      return fmt::format("body {}: velocity ({}, {}), angular velocity {}", i, b.vel[i].vx,
+                         b.vel[i].vy, b.vel[i].w);
+  }
+  const auto& rows = w.rows();
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    if (!std::isfinite(rows[k].pn) || !std::isfinite(rows[k].pt))
+      return fmt::format("contact {} (bodies {} and {}): impulses p_n = {}, p_t = {}", k,
+                         rows[k].b1, rows[k].b2, rows[k].pn, rows[k].pt);
+  const CellState& c = w.cell;
+  for (const double x : {c.width, c.height, c.offset, c.hdot, c.wdot, c.strain})
+    if (!std::isfinite(x))
+      return fmt::format("cell: width {}, height {}, offset {}, rates ({}, {}), strain {}", c.width,
+                         c.height, c.offset, c.wdot, c.hdot, c.strain);
+  return "";
+}
 
 // Removes the files an earlier run wrote in the folder, so that a shorter
 // run does not leave stale snapshots behind.
@@ -149,6 +177,11 @@ struct ShearInterval {
 
 }  // namespace
 
+void install_stop_handlers() {
+  std::signal(SIGINT, on_stop);
+  std::signal(SIGTERM, on_stop);
+}
+
 RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   namespace fs = std::filesystem;
   const fs::path dir(opt.out);
@@ -159,15 +192,20 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   const bool shear = s.shear_mode != "none";
   const double d_mean = mean_diameter(s);
   const double area = shear ? solid_area(w.bodies) : 0.0;
-  const std::int64_t every_row = std::max<std::int64_t>(1, std::llround(s.series_interval / dt));
-  const std::int64_t every_snap =
-      s.snapshot_interval > 0 ? std::max<std::int64_t>(1, std::llround(s.snapshot_interval / dt))
-                              : 0;
+  // An interval in steps, >= 1; one longer than the run is the run (no
+  // overflow for huge intervals).
+  const auto steps_of = [&](double interval) {
+    const double k = interval / dt;
+    return k >= double(nsteps) ? std::max<std::int64_t>(1, nsteps)
+                               : std::max<std::int64_t>(1, std::llround(k));
+  };
+  const std::int64_t every_row = steps_of(s.series_interval);
+  const std::int64_t every_snap = s.snapshot_interval > 0 ? steps_of(s.snapshot_interval) : 0;
   // Checkpoints fall on series rows, so that no row's interval spans a restart.
   const std::int64_t every_ckpt =
       s.checkpoint_interval > 0
           ? every_row * std::max<std::int64_t>(
-                            1, (std::llround(s.checkpoint_interval / dt) + every_row - 1) / every_row)
+                            1, (steps_of(s.checkpoint_interval) + every_row - 1) / every_row)
           : 0;
   const bool progress = !opt.quiet && isatty(STDERR_FILENO);
 
@@ -231,9 +269,16 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
       if (!cohesive) write_problem(to_matrix(p), stem + ".dat");
     });
 
+  std::int64_t k_end = nsteps;  // the last step taken (earlier if stopped by a signal)
   for (std::int64_t k = k0 + 1; k <= nsteps; ++k) {
     w.step();
     const StepStats& st = w.last();
+    if (const std::string bad = non_finite(w); !bad.empty())
+      throw RunDiverged(fmt::format("step {} (t = {:.6g} s): non-finite state: {}; series.csv "
+                                    "holds the rows before it{}", k, w.time, bad,
+                                    every_ckpt ? ", checkpoint.bin (if written) the last good state" : ""));
+    const bool stopping = g_stop != 0;
+    if (stopping) k_end = k;
     if (dumped(k)) {
       std::string text;
       for (const ContactRow& r : w.rows()) text += fmt::format("{:a} {:a}\n", r.pn, r.pt);
@@ -247,7 +292,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     sum.max_residual = std::max(sum.max_residual, st.solve.residual_max);
     sum.max_overlap = std::max(sum.max_overlap, st.max_overlap);
 
-    if (k % every_row == 0 || k == nsteps) {
+    if (k % every_row == 0 || k == nsteps || stopping) {
       timed_output([&] {
         const StageTimes& t = w.times;
         std::vector<std::pair<std::string, double>> cols = {{"step", double(k)},
@@ -306,6 +351,10 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
           t_prev = w.time;
           sh = ShearInterval{};
         }
+        for (const auto& [name, x] : cols)
+          if (!std::isfinite(x))
+            throw RunDiverged(fmt::format("step {} (t = {:.6g} s): series column {} is {}; "
+                                          "series.csv holds the rows before it", k, w.time, name, x));
         series.row(cols);
         series.flush();
       });
@@ -315,8 +364,12 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     if (every_snap && k % every_snap == 0) timed_output([&] { snaps.write(w); });
     // After this step's outputs, so that a restart has them all. A resumed
     // run keeps its checkpoint current even with checkpoints off.
-    if ((every_ckpt && k % every_ckpt == 0) || (k == nsteps && (every_ckpt || resume)))
+    if ((every_ckpt && k % every_ckpt == 0) || ((k == nsteps || stopping) && (every_ckpt || resume)))
       timed_output([&] { save_checkpoint(ckpt, w, key); });
+    if (stopping) {
+      sum.stop_signal = g_stop;
+      break;
+    }
 
     if (progress) {
       const auto now = Clock::now();
@@ -333,7 +386,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   }
   if (progress) std::fprintf(stderr, "\n");
   sum.first_step = k0;
-  sum.steps = nsteps - k0;
+  sum.steps = k_end - k0;
   sum.mean_iterations = sum.steps ? double(iter_total) / sum.steps : 0.0;
   sum.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
   sum.kinetic_energy = w.kinetic_energy();

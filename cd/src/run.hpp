@@ -2,6 +2,7 @@
 // snapshots and a progress line.
 #pragma once
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -23,7 +24,20 @@ struct RunOptions {
   std::vector<std::int64_t> dump_steps;
 };
 
+// A run that produced a non-finite position, velocity, impulse, cell
+// quantity or series value: the message names the step, the body or contact
+// and the quantity. The series holds the rows before it; the last
+// checkpoint written is intact (none is written after the bad step).
+struct RunDiverged : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Set by SIGINT/SIGTERM (install_stop_handlers): the run stops at the next
+// step boundary, writing a checkpoint if checkpoints are on.
+void install_stop_handlers();
+
 struct RunSummary {
+  int stop_signal = 0;          // > 0: stopped early by this signal
   std::int64_t first_step = 0;  // > 0: resumed from a checkpoint at this step
   std::int64_t steps = 0;       // steps run by this call
   double mean_iterations = 0;

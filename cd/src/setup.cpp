@@ -34,6 +34,7 @@ void diameter_range(const Scene& s, double& a, double& b) {
 }
 
 std::string body_name(const Scene& s, int i, int first_generated) {
+  if (!s.start.empty()) return fmt::format("particle {} of the sample", i);
   if (i < static_cast<int>(s.disks.size())) return fmt::format("disk[{}]", i);
   return fmt::format("generated particle {}", i - first_generated);
 }
@@ -109,12 +110,49 @@ void check_shear(const Scene& s) {
   if (s.isotropic && (s.shear_mode != "periodic" || s.inertial_number > 0))
     fail("shear.isotropic (compaction) needs shear.mode = \"periodic\" and shear.inertial_number = 0");
   if (s.strain > 0 && s.inertial_number <= 0) fail("shear.strain > 0 needs shear.inertial_number > 0");
+  if (!s.start.empty() && s.shear_mode != "periodic")
+    fail("shear.start needs shear.mode = \"periodic\" (a walls run places its own grains "
+         "between its walls)");
+}
+
+// Quantities derived from several keys, checked before anything is built or
+// written: each must be finite, and the run must take at least one step and
+// no more than kMaxSteps.
+constexpr double kMaxSteps = 1e9;
+
+void check_derived(const Scene& s) {
+  auto fail = [](const std::string& m) { throw SceneError(m); };
+  const double dt = time_step(s);
+  const char* dt_from = s.dt_tp > 0 ? "shear.dt_tp x t_p" : "time.dt";
+  if (!std::isfinite(dt) || dt <= 0) fail(fmt::format("the time step ({}) is {}: must be finite and > 0", dt_from, dt));
+  if (s.shear_mode != "none" && s.pressure > 0) {
+    const double tp = pressure_time(s), gd = shear_rate(s);
+    if (!std::isfinite(tp) || !std::isfinite(gd))
+      fail(fmt::format("t_p = d sqrt(rho/p) = {} s and the shear rate {} 1/s must be finite "
+                       "(particles.d_mean, particles.density, shear.pressure, shear.inertial_number)",
+                       tp, gd));
+  }
+  if (s.adhesion > 0 || s.cohesion_number > 0) {
+    const double fa = s.cohesion_number > 0 ? s.cohesion_number * s.pressure * mean_diameter(s) : s.adhesion;
+    if (!std::isfinite(fa)) fail(fmt::format("the pull-off force f_a = {} N must be finite", fa));
+  }
+  const double T = run_duration(s);
+  const char* T_from = s.strain > 0 ? "shear.strain / shear rate" : "time.duration";
+  const double steps = T / dt;
+  if (!std::isfinite(T) || !(steps < kMaxSteps))
+    fail(fmt::format("the run would take {:.3g} steps ({} = {:.4g} s, time step {:.4g} s), more "
+                     "than the limit of {:.0e}: shorten the run or lengthen the step",
+                     steps, T_from, T, dt, kMaxSteps));
+  if (!(steps >= 1 - 1e-9))
+    fail(fmt::format("the run would take less than one step: its duration ({} = {:.4g} s) is "
+                     "shorter than the time step ({} = {:.4g} s)", T_from, T, dt_from, dt));
 }
 
 }  // namespace
 
 WorldParams world_params(const Scene& s) {
   check_shear(s);
+  check_derived(s);
   WorldParams p;
   p.dt = time_step(s);
   p.gravity = Vec2(s.gravity[0], s.gravity[1]);
@@ -169,6 +207,20 @@ World build_world(const Scene& s) {
                                    "preparation run)", s.start));
     if (!s.disks.empty() || s.n > 0)
       throw SceneError("shear.start gives the particles: set particles.n = 0 and no [[disk]]");
+    for (std::size_t i = 0; i < B.size(); ++i) {
+      if (!B.is_dynamic(i))
+        throw SceneError(fmt::format("shear.start: '{}' holds walls or wall grains (body {}); a "
+                                     "periodic run starts from a periodic preparation", s.start, i));
+      // The masses come with the sample: they must be the scene's.
+      const double n = B.nsides[i], R = B.radius[i];
+      const double area = n > 0 ? 0.5 * n * R * R * std::sin(2 * std::numbers::pi / n)
+                                : std::numbers::pi * R * R;
+      if (std::abs(B.mass[i] / area - s.density) > 1e-9 * s.density)
+        throw SceneError(fmt::format("shear.start: the sample's particles have density {:.6g} "
+                                     "kg/m^2 (body {}), particles.density is {:.6g}; set "
+                                     "particles.density to the preparation's",
+                                     B.mass[i] / area, i, s.density));
+    }
     w.cell.offset = w.cell.hdot = w.cell.wdot = w.cell.strain = 0.0;
     w.set_warm_start(prep.warm_start());
     const double gd = wp.cell.shear_rate;
@@ -277,11 +329,10 @@ World build_world(const Scene& s) {
   for (const WallSpec& ws : s.walls)
     B.add_wall({ws.a[0], ws.a[1]}, {ws.b[0], ws.b[1]}, {ws.vel[0], ws.vel[1]}, ws.omega);
 
-  // A started state comes from a simulation, with its solver-sized overlaps.
-  if (!s.start.empty()) return w;
   // No overlap at t = 0: run the detector with zero alert on the initial
   // configuration. Round-off sized overlaps (1e-9 d) are tolerated so that
-  // disks placed exactly touching are accepted.
+  // disks placed exactly touching are accepted. A started state comes from a
+  // simulation, with its solver-sized overlaps: up to kStartOverlap d.
   std::vector<ContactRow> rows;
   std::vector<ContactInfo> info;
   CellGrid grid;
@@ -291,7 +342,8 @@ World build_world(const Scene& s) {
   } catch (const std::runtime_error& e) {
     throw SceneError(fmt::format("shear.width, shear.height: {}", e.what()));
   }
-  const double tol = 1e-9 * w.params().d_ref;
+  constexpr double kStartOverlap = 0.05;
+  const double tol = (s.start.empty() ? 1e-9 : kStartOverlap) * w.params().d_ref;
   for (std::size_t k = 0; k < rows.size(); ++k) {
     if (info[k].gap >= -tol) continue;
     const int i = rows[k].b1, j = rows[k].b2;
@@ -299,9 +351,12 @@ World build_world(const Scene& s) {
                                       : body_name(s, i, first_generated);
     throw SceneError(fmt::format(
         "initial overlap: {} at ({:.6g}, {:.6g}) and {} at ({:.6g}, {:.6g}) overlap by {:.3g} "
-        "(= {:.3g} mean diameters); particles must not overlap at t = 0",
+        "(= {:.3g} mean diameters); {}",
         a, B.pos[i].x(), B.pos[i].y(), body_name(s, j, first_generated), B.pos[j].x(),
-        B.pos[j].y(), -info[k].gap, -info[k].gap / w.params().d_ref));
+        B.pos[j].y(), -info[k].gap, -info[k].gap / w.params().d_ref,
+        s.start.empty() ? std::string("particles must not overlap at t = 0")
+                        : fmt::format("a started sample may overlap by at most {} mean diameters "
+                                      "(shear.start = '{}')", kStartOverlap, s.start)));
   }
   return w;
 }

@@ -229,7 +229,8 @@ SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
   }
 
   residuals(rows, c, prm.min_parallel, st);
-  st.cap_hit = st.dp_rel >= prm.tol || st.dof_rel >= prm.tol;
+  // Written as "not converged", so that a NaN criterion counts as a cap hit.
+  st.cap_hit = !(st.dp_rel < prm.tol && st.dof_rel < prm.tol);
   return st;
 }
 

@@ -1,0 +1,184 @@
+// Bad input never runs, and a run that goes bad stops (issue 15): derived
+// quantities (steps, time step, pull-off force) are checked before anything
+// is written; start samples are checked against the scene; the watchdog
+// stops a run whose state turns non-finite with exit 3 and a message naming
+// the step, the body and the quantity; SIGTERM stops a run at a step
+// boundary with a checkpoint the same command resumes from; usage errors
+// exit 2 like every other bad input.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_util.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kCdsim = CDLAB_BINARY_DIR "/cd/cdsim";
+
+fs::path write(const fs::path& dir, const std::string& name, const std::string& text) {
+  const fs::path p = dir / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+cdtest::CmdResult cdsim(const std::string& args) { return cdtest::run_command(kCdsim + " " + args); }
+
+// Two disks on a floor.
+const std::string kScene = R"(name = "tiny"
+[time]
+dt = 1e-3
+duration = 0.01
+[[disk]]
+pos = [0.0, 0.5]
+radius = 0.5
+[[disk]]
+pos = [1.0, 0.5]
+radius = 0.5
+[[wall]]
+a = [-5.0, 0.0]
+b = [5.0, 0.0]
+[output]
+series_interval = 1e-3
+)";
+
+// Every value of every data row of series.csv, with its column name.
+std::vector<std::vector<std::string>> csv(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::vector<std::string>> out;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> row;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(cell);
+    out.push_back(row);
+  }
+  return out;
+}
+
+// A refused run: exit 2, the message names each of `words`, nothing written.
+void expect_refused(const std::string& sets, const std::vector<std::string>& words,
+                    const std::string& scene = kScene) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "refused");
+  const fs::path sc = write(dir, "s.toml", scene);
+  const cdtest::CmdResult r = cdsim(sc.string() + " " + sets + " -q --out " + (dir / "out").string());
+  EXPECT_EQ(r.code, 2) << sets << "\n" << r.out;
+  for (const std::string& w : words) EXPECT_NE(r.out.find(w), std::string::npos) << sets << "\n" << r.out;
+  EXPECT_FALSE(fs::exists(dir / "out")) << sets << ": wrote an output folder";
+}
+
+}  // namespace
+
+TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
+  // The issue's cases, each once exit 0 with nothing simulated.
+  expect_refused("--set time.duration=1e300", {"1e+09", "time.duration"});
+  expect_refused("--set time.dt=1", {"less than one step", "time.dt"});
+  expect_refused("--set time.duration=0", {"less than one step", "time.duration"});
+  expect_refused("--set time.duration=inf", {"time.duration = inf", "finite"});
+  expect_refused("--set 'gravity.g=[0,-inf]'", {"gravity.g", "finite"});
+  expect_refused("--set 'gravity.g=[nan,-9.81]'", {"gravity.g", "nan"});
+  expect_refused("--set solver.tol=inf", {"solver.tol"});
+  expect_refused("--set contact.adhesion=inf", {"contact.adhesion"});
+  // t_p = d sqrt(rho/p): a huge dt_tp makes a step longer than the run.
+  const std::string shear =
+      "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 20\n[time]\nduration = 0.01\n"
+      "[shear]\nmode = \"periodic\"\nwidth = 0.02\nheight = 0.02\npressure = 100.0\n";
+  expect_refused("--set shear.dt_tp=100", {"less than one step", "shear.dt_tp"}, shear);
+  expect_refused("--set shear.inertial_number=0.1 --set shear.strain=1e300", {"shear.strain", "1e+09"}, shear);
+  // An enormous cohesion number gives an infinite pull-off force.
+  expect_refused("--set contact.cohesion_number=1e308 --set shear.pressure=1e10", {"f_a"}, shear);
+}
+
+TEST(BadInput, UsageErrorsExitTwo) {
+  for (const std::string args : {"--bogus", "--threads x s.toml", "--dump-problem -3 s.toml"}) {
+    const cdtest::CmdResult r = cdsim(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+  }
+  EXPECT_EQ(cdsim("--help").code, 0);
+}
+
+// A very light disk pushed by a finite but enormous force: its velocity
+// overflows to inf in the first step. The run stops with exit 3 naming the step, the
+// body and the quantity, and nothing non-finite is written.
+TEST(Watchdog, NonFiniteStateStopsTheRunWithExitThree) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "watchdog");
+  std::string scene = kScene;
+  scene.insert(scene.find("[[disk]]\npos = [1.0"), "[[disk]]\npos = [3.0, 0.5]\nradius = 0.5\ndensity = 1e-10\nforce = [1e308, 0.0]\n");
+  scene += "checkpoint_interval = 2e-3\n";
+  const fs::path sc = write(dir, "s.toml", scene);
+  const cdtest::CmdResult r = cdsim(sc.string() + " -q --out " + (dir / "out").string());
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("run diverged"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("step 1 "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("body 1"), std::string::npos) << r.out;  // the pushed disk
+  EXPECT_NE(r.out.find("position"), std::string::npos) << r.out;
+  // series.csv: no row (there is no good row before step 1).
+  EXPECT_LE(csv(dir / "out" / "series.csv").size(), 1u);
+  // No checkpoint was written from the bad state.
+  EXPECT_FALSE(fs::exists(dir / "out" / "checkpoint.bin"));
+}
+
+// SIGTERM mid-run: exit 128 + 15 at a step boundary, a checkpoint written;
+// the same command resumes and ends in the state of an uninterrupted run
+// (kinetic energy of the last row bit-identical).
+TEST(Signals, TermStopsAtAStepBoundaryWithACheckpointTheRunResumesFrom) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "signal");
+  const std::string scene =
+      "name = \"pile\"\n[time]\ndt = 1e-4\nduration = 0.4\n[particles]\nn = 200\nd_mean = 1e-3\n"
+      "[box]\nwidth = 0.03\nheight = 0.06\n[output]\nseries_interval = 1e-2\ncheckpoint_interval = 0.5\n";
+  const fs::path sc = write(dir, "s.toml", scene);
+  const std::string args = sc.string() + " -q --threads 1 --out ";
+  const auto t0 = std::chrono::steady_clock::now();
+  const cdtest::CmdResult ref = cdsim(args + (dir / "ref").string());
+  ASSERT_EQ(ref.code, 0) << ref.out;
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Stopped halfway through in wall time: somewhere inside the 4000 steps.
+  const cdtest::CmdResult stopped = cdtest::run_command(
+      "timeout --preserve-status -s TERM " + std::to_string(0.5 * wall) + " " + kCdsim + " " + args +
+      (dir / "run").string());
+  ASSERT_EQ(stopped.code, 128 + 15) << stopped.out;
+  EXPECT_NE(stopped.out.find("stopped by signal 15"), std::string::npos) << stopped.out;
+  ASSERT_TRUE(fs::exists(dir / "run" / "checkpoint.bin"));
+  const cdtest::CmdResult resumed = cdsim(args + (dir / "run").string());
+  ASSERT_EQ(resumed.code, 0) << resumed.out;
+  EXPECT_NE(resumed.out.find("resumed from"), std::string::npos) << resumed.out;
+  const auto a = csv(dir / "ref" / "series.csv"), b = csv(dir / "run" / "series.csv");
+  ASSERT_GE(b.size(), a.size());
+  std::size_t ke = 0;
+  while (ke < a[0].size() && a[0][ke] != "kinetic_energy") ++ke;
+  ASSERT_LT(ke, a[0].size());
+  EXPECT_EQ(a.back()[0], b.back()[0]);    // the same last step
+  EXPECT_EQ(a.back()[ke], b.back()[ke]);  // the same state
+}
+
+// A start sample must be the scene's: a periodic preparation (no wall
+// grains), of the scene's density, and not overlapping by more than a
+// solver-sized amount; a walls run cannot start from one.
+TEST(BadInput, StartSamplesAreCheckedAgainstTheScene) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "start");
+  const std::string prep =
+      "name = \"prep\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 30\nd_mean = 1e-3\ndensity = 2.6\n"
+      "[shear]\nmode = \"periodic\"\nwidth = 0.01\nheight = 0.01\npressure = 100.0\nisotropic = true\n"
+      "dt_tp = 0.05\n[time]\nduration = 2e-3\n[output]\nseries_interval = 1e-3\ncheckpoint_interval = 1e-3\n";
+  const fs::path sc = write(dir, "prep.toml", prep);
+  const cdtest::CmdResult r = cdsim(sc.string() + " -q --out " + (dir / "prep").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string shear =
+      "name = \"shear\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 0\nd_mean = 1e-3\ndensity = 2.6\n"
+      "[shear]\nmode = \"periodic\"\nwidth = 0.01\nheight = 0.01\npressure = 100.0\n"
+      "inertial_number = 0.01\nstrain = 0.01\ndt_tp = 0.05\nstart = \"" +
+      (dir / "prep" / "checkpoint.bin").string() + "\"\n";
+  {  // the reference: accepted
+    const fs::path s2 = write(dir, "ok.toml", shear);
+    const cdtest::CmdResult ok = cdsim(s2.string() + " -q --out " + (dir / "ok").string());
+    EXPECT_EQ(ok.code, 0) << ok.out;
+  }
+  expect_refused("--set particles.density=5.0", {"shear.start", "density", "2.6"}, shear);
+  expect_refused("--set shear.mode=walls", {"shear.start", "periodic"}, shear);
+}
