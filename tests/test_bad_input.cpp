@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -181,4 +182,93 @@ TEST(BadInput, StartSamplesAreCheckedAgainstTheScene) {
   }
   expect_refused("--set particles.density=5.0", {"shear.start", "density", "2.6"}, shear);
   expect_refused("--set shear.mode=walls", {"shear.start", "periodic"}, shear);
+}
+
+// ---- cdanalysis and cdproblem --------------------------------------------
+
+namespace {
+const std::string kCdanalysis = CDLAB_BINARY_DIR "/analysis/cdanalysis";
+const std::string kCdproblem = CDLAB_BINARY_DIR "/cd/cdproblem";
+}  // namespace
+
+// A mu(I) table whose points share one I determines no curve: refused
+// (exit 1), never "converged" with zero error bars. Two distinct I for three
+// parameters: refused too. Four distinct I: a fit.
+TEST(BadInput, DegenerateFitsAreRefused) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "fits");
+  const auto fit = [&](const std::string& rows) {
+    const fs::path t = write(dir, "t.csv", "I,mu,mu_err\n" + rows);
+    return cdtest::run_command(kCdanalysis + " fit mu-i --table " + t.string());
+  };
+  cdtest::CmdResult r = fit("0.01,0.30,0.01\n0.01,0.31,0.01\n0.01,0.29,0.01\n0.01,0.30,0.01\n");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("1 distinct value of (I) for 3 parameters"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("converged"), std::string::npos) << r.out;
+  r = fit("0.01,0.30,0.01\n0.01,0.31,0.01\n0.1,0.45,0.01\n0.1,0.46,0.01\n");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("2 distinct values"), std::string::npos) << r.out;
+  // A constant mu at four I: mu1 = mu2 leaves I0 free (singular Jacobian).
+  r = fit("0.001,0.3,0.01\n0.01,0.3,0.01\n0.1,0.3,0.01\n0.3,0.3,0.01\n");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("Jacobian is singular"), std::string::npos) << r.out;
+  // mu = 0.26 + 0.34/(1 + 0.08/I) at five I: a determined fit.
+  std::string rows;
+  for (const double I : {0.003, 0.01, 0.03, 0.1, 0.3})
+    rows += std::to_string(I) + "," + std::to_string(0.26 + 0.34 / (1 + 0.08 / I)) + ",0.005\n";
+  r = fit(rows);
+  EXPECT_EQ(r.code, 0) << r.out;
+  // A non-finite value in the table: bad input, naming line and column.
+  r = fit("0.01,0.30,0.01\n0.02,nan,0.01\n0.05,0.35,0.01\n");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("line 3, column 'mu': 'nan' is not a finite number"), std::string::npos) << r.out;
+}
+
+TEST(BadInput, AnalysisOptionsAndDamagedSnapshots) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "analysis");
+  // A run with snapshots.
+  std::string scene = kScene;
+  scene += "snapshot_interval = 5e-3\n";
+  const fs::path sc = write(dir, "s.toml", scene);
+  ASSERT_EQ(cdsim(sc.string() + " -q --out " + (dir / "run").string()).code, 0);
+  const std::string run = (dir / "run").string();
+  cdtest::CmdResult r = cdtest::run_command(kCdanalysis + " fabric " + run + " --volume -1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--volume"), std::string::npos) << r.out;
+  r = cdtest::run_command(kCdanalysis + " fabric " + run + " --bins 1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  r = cdtest::run_command(kCdanalysis + " steady");  // the run folder is required
+  EXPECT_EQ(r.code, 2) << r.out;
+  // A damaged contacts file: one message naming it, not pages of VTK errors.
+  fs::path last;
+  for (const auto& e : fs::directory_iterator(dir / "run"))
+    if (e.path().filename().string().starts_with("contacts_") && (last.empty() || e.path() > last)) last = e.path();
+  ASSERT_FALSE(last.empty());
+  std::string text;
+  {
+    std::ifstream in(last);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  std::ofstream(last) << text.substr(0, text.size() / 2);
+  r = cdtest::run_command(kCdanalysis + " fabric " + run);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(last.filename().string()), std::string::npos) << r.out;
+  EXPECT_LT(std::count(r.out.begin(), r.out.end(), '\n'), 3) << r.out;
+}
+
+TEST(BadInput, CdproblemRefusesBadOptionsAndTrailingText) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "cdproblem");
+  // One contact: a disk on the floor, W = diag(1, 1), q = (-1, 0), mu = 0.5.
+  const std::string ok = "2\n1\n0\n2 2\n2 2\n1 0\n0 1\n-1 0\n0.5\n";
+  const fs::path good = write(dir, "ok.dat", ok);
+  EXPECT_EQ(cdtest::run_command(kCdproblem + " solve " + good.string()).code, 0);
+  const fs::path bad = write(dir, "bad.dat", ok + "garbage\n");
+  cdtest::CmdResult r = cdtest::run_command(kCdproblem + " solve " + bad.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("garbage"), std::string::npos) << r.out;
+  for (const std::string opt : {"--tol -1", "--tol 0", "--tol 2", "--tol nan", "--max-sweeps 0", "--bogus"}) {
+    r = cdtest::run_command(kCdproblem + " solve " + good.string() + " " + opt);
+    EXPECT_EQ(r.code, 2) << opt << "\n" << r.out;
+  }
 }

@@ -1,8 +1,8 @@
 // cdanalysis: steady-state statistics, fabric, fits and reports of cdsim
-// runs. Every failure that is the input's fault prints one line naming the
-// file or quantity at fault and exits with status 1; usage errors exit with
-// CLI11's own non-zero codes; compare-fits exits with 2 when a parameter
-// FAILs (so a script can tell a regression from an unreadable file).
+// runs. Every failure prints one line naming the file or quantity at fault.
+// Exit codes (error.hpp): 0 done; 1 analysis refused (a degenerate fit, no
+// steady window, a compare-fits FAIL); 2 bad input (usage, unreadable or
+// malformed file, non-finite value, option out of range).
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
@@ -97,8 +97,11 @@ int main(int argc, char** argv) {
   double volume = -1;
   fabric->add_option("run", run, "run folder (holding contacts_NNNNN.vtp)")->required();
   fabric->add_option("--snapshot", snapshot, "snapshot index (negative: from the end)")->capture_default_str();
-  fabric->add_option("--bins", bins, "angular bins over [0, pi)")->capture_default_str();
-  fabric->add_option("--volume", volume, "volume (area) V for the stress; default: stress times V");
+  fabric->add_option("--bins", bins, "angular bins over [0, pi)")
+      ->check(CLI::Range(4, 36000))
+      ->capture_default_str();
+  fabric->add_option("--volume", volume, "volume (area) V for the stress, > 0; default: stress times V")
+      ->check(CLI::PositiveNumber);
   fabric->add_option("--out", out, "folder for the angular profiles and polar plots");
 
   // fit
@@ -147,7 +150,9 @@ int main(int argc, char** argv) {
   auto* bounds = fit->add_subcommand("fabric-bounds", "envelope z_min, z_max of (z, a_c) points");
   double k_bound = 1.0;
   bounds->add_option("--table", table, "CSV with columns z, a_c (optionally z_err, a_c_err)")->required();
-  bounds->add_option("--k", k_bound, "bound prefactor (1 from method.md's definition)")->capture_default_str();
+  bounds->add_option("--k", k_bound, "bound prefactor (1 from method.md's definition)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 
   // compare-fits
   auto* cmp = app.add_subcommand(
@@ -155,7 +160,7 @@ int main(int argc, char** argv) {
       "compare the parameters of two fit TOML files (as written by --toml or report). A parameter FAILs "
       "when |new - ref| > TOL_SIGMA sqrt(err_ref^2 + err_new^2) AND |new - ref| > TOL_REL |ref|; a model "
       "or parameter of REFERENCE missing from NEW, a non-finite value, or a fit no longer converged FAILs "
-      "too. Exit status: 0 all OK, 2 some FAIL, 1 a file unreadable.");
+      "too. Exit status: 0 all OK, 1 some FAIL, 2 a file unreadable.");
   std::string ref_toml, new_toml;
   double tol_sigma = 3, tol_rel = 0;
   cmp->add_option("reference", ref_toml, "reference fit TOML")->required();
@@ -170,9 +175,15 @@ int main(int argc, char** argv) {
   std::string campaign;
   report->add_option("campaign", campaign, "campaign folder (its subfolders are runs)")->required();
   report->add_option("--out", out, "report folder (default: CAMPAIGN/report)");
-  report->add_option("--bins", bins, "angular bins over [0, pi)")->capture_default_str();
+  report->add_option("--bins", bins, "angular bins over [0, pi)")
+      ->check(CLI::Range(4, 36000))
+      ->capture_default_str();
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // --help: 0; every usage error: bad input
+  }
 
   try {
     if (steady->parsed()) {
@@ -338,7 +349,7 @@ int main(int argc, char** argv) {
       const auto b = read_fit_toml(new_toml);
       const auto c = compare_fits(a, b, tol_sigma, tol_rel);
       fmt::print("reference {}\nnew       {}\n{}", ref_toml, new_toml, format_comparison(c, tol_sigma, tol_rel));
-      if (!c.ok()) return 2;
+      if (!c.ok()) return 1;
     } else if (bounds->parsed()) {
       const auto t = Table::read_csv(table);
       const auto b = fabric_bounds(t.column("z"), t.column("a_c"), col_or_empty(t, "z_err"),
@@ -355,12 +366,15 @@ int main(int argc, char** argv) {
       for (const auto& p : s.problems) fmt::print(stderr, "problem: {}\n", p);
       fmt::print("open {}/index.html\n", dir);
     }
+  } catch (const InputError& e) {
+    fmt::print(stderr, "cdanalysis: bad input: {}\n", e.what());
+    return 2;
   } catch (const AnalysisError& e) {
-    fmt::print(stderr, "cdanalysis: {}\n", e.what());
+    fmt::print(stderr, "cdanalysis: refused: {}\n", e.what());
     return 1;
   } catch (const std::exception& e) {
     fmt::print(stderr, "cdanalysis: error: {}\n", e.what());
-    return 1;
+    return 2;
   }
   return 0;
 }

@@ -14,7 +14,7 @@ namespace {
 double as_number(const toml::value& v, const std::string& what) {
   if (v.is_floating()) return v.as_floating();
   if (v.is_integer()) return static_cast<double>(v.as_integer());
-  throw AnalysisError(fmt::format("{} is not a number", what));
+  throw InputError(fmt::format("{} is not a number", what));
 }
 
 }  // namespace
@@ -23,12 +23,12 @@ FitFile read_fit_toml(const std::string& path) {
   FitFile f;
   f.path = path;
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw AnalysisError(fmt::format("fit file '{}' does not exist", path));
+  if (!std::filesystem::exists(path, ec)) throw InputError(fmt::format("fit file '{}' does not exist", path));
   toml::value root;
   try {
     root = toml::parse(path);
   } catch (const std::exception& e) {
-    throw AnalysisError(fmt::format("fit file '{}' does not parse as TOML: {}", path, e.what()));
+    throw InputError(fmt::format("fit file '{}' does not parse as TOML: {}", path, e.what()));
   }
   // toml11's default table is unordered; the names arrays keep the file's
   // parameter order, and models are sorted by name.
@@ -41,7 +41,7 @@ FitFile read_fit_toml(const std::string& path) {
     FitRecord r;
     if (m.contains("converged") && m.at("converged").is_boolean()) r.converged = m.at("converged").as_boolean();
     if (!m.contains("params") || !m.at("params").is_table())
-      throw AnalysisError(fmt::format("fit file '{}': [{}] has no [{}.params] tables", path, name, name));
+      throw InputError(fmt::format("fit file '{}': [{}] has no [{}.params] tables", path, name, name));
     std::vector<std::string> names;
     if (m.contains("names") && m.at("names").is_array())
       for (const auto& n : m.at("names").as_array())
@@ -50,17 +50,17 @@ FitFile read_fit_toml(const std::string& path) {
       if (std::find(names.begin(), names.end(), pn) == names.end()) names.push_back(pn);
     for (const auto& pn : names) {
       const std::string where = fmt::format("fit file '{}': [{}.params.{}]", path, name, pn);
-      if (!m.at("params").contains(pn)) throw AnalysisError(where + " is missing (listed in names)");
+      if (!m.at("params").contains(pn)) throw InputError(where + " is missing (listed in names)");
       const auto& pv = m.at("params").at(pn);
       if (!pv.is_table() || !pv.contains("value") || !pv.contains("error"))
-        throw AnalysisError(where + " needs both value and error");
+        throw InputError(where + " needs both value and error");
       r.params[pn] = {as_number(pv.at("value"), where + " value"), as_number(pv.at("error"), where + " error")};
     }
     r.order = names;
     f.order.push_back(name);
     f.models[name] = std::move(r);
   }
-  if (f.models.empty()) throw AnalysisError(fmt::format("fit file '{}' holds no fit table", path));
+  if (f.models.empty()) throw InputError(fmt::format("fit file '{}' holds no fit table", path));
   return f;
 }
 

@@ -1,6 +1,7 @@
 #include "fit.hpp"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_multifit_nlinear.h>
@@ -76,6 +77,23 @@ FitResult fit(const Model& model, const FitData& data, std::vector<double> p0) {
                                     data.sigma.size(), n));
   for (double s : data.sigma)
     if (!(s > 0)) throw AnalysisError(fmt::format("fit {}: an error bar is not positive ({})", model.name, s));
+  for (std::size_t i = 0; i < n; ++i) {
+    bool finite = std::isfinite(data.y[i]) && (data.sigma.empty() || std::isfinite(data.sigma[i]));
+    for (std::size_t k = 0; k < data.dim; ++k) finite = finite && std::isfinite(data.x[i * data.dim + k]);
+    if (!finite) throw InputError(fmt::format("fit {}: point {} is not finite", model.name, i));
+  }
+  // p parameters need p distinct inputs: a curve through fewer is not
+  // determined, whatever the optimiser says.
+  {
+    std::vector<std::vector<double>> xs;
+    for (std::size_t i = 0; i < n; ++i) xs.emplace_back(&data.x[i * data.dim], &data.x[(i + 1) * data.dim]);
+    std::sort(xs.begin(), xs.end());
+    const std::size_t distinct = std::unique(xs.begin(), xs.end()) - xs.begin();
+    if (distinct < p)
+      throw AnalysisError(fmt::format("fit {}: {} distinct value{} of ({}) for {} parameters: the fit "
+                                      "is not determined", model.name, distinct, distinct == 1 ? "" : "s",
+                                      fmt::join(model.inputs, ", "), p));
+  }
   for (std::size_t i = 0; i < n; ++i)
     if (!std::isfinite(model.f(&data.x[i * data.dim], p0.data())))
       throw AnalysisError(fmt::format("fit {}: model not finite at the starting point (point {})",
@@ -99,6 +117,15 @@ FitResult fit(const Model& model, const FitData& data, std::vector<double> p0) {
   int info = 0;
   const int status =
       gsl_multifit_nlinear_driver(500, 1e-10, 1e-10, 1e-12, nullptr, nullptr, &info, w.get());
+
+  // A Jacobian of (numerically) lower rank than p at the optimum leaves a
+  // combination of the parameters free: refused, never "converged".
+  double rcond = 0;
+  gsl_multifit_nlinear_rcond(&rcond, w.get());
+  if (!(rcond > 1e-12))
+    throw AnalysisError(fmt::format("fit {}: the Jacobian is singular at the optimum (reciprocal "
+                                    "condition number {:.2g}): the data do not determine all of {}",
+                                    model.name, rcond, fmt::join(model.params, ", ")));
 
   FitResult r;
   r.model = model.name;
@@ -124,6 +151,9 @@ FitResult fit(const Model& model, const FitData& data, std::vector<double> p0) {
   for (std::size_t i = 0; i < p; ++i) {
     for (std::size_t j = 0; j < p; ++j) r.cov[i * p + j] = r.scale * gsl_matrix_get(C.get(), i, j);
     r.error[i] = std::sqrt(r.cov[i * p + i]);
+    if (!std::isfinite(r.value[i]) || !std::isfinite(r.error[i]))
+      throw AnalysisError(fmt::format("fit {}: parameter {} = {} +- {} is not finite", model.name,
+                                      model.params[i], r.value[i], r.error[i]));
   }
   return r;
 }

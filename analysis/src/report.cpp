@@ -16,7 +16,7 @@ namespace {
 
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream out(path);
-  if (!out) throw AnalysisError(fmt::format("cannot write '{}'", path));
+  if (!out) throw InputError(fmt::format("cannot write '{}'", path));
   out << text;
 }
 
@@ -175,14 +175,14 @@ bool plot_polar(const std::string& dir, const std::string& stem, const RunFabric
 std::vector<std::string> campaign_runs(const std::string& campaign) {
   std::error_code ec;
   if (!fs::is_directory(campaign, ec))
-    throw AnalysisError(fmt::format("campaign folder '{}' does not exist", campaign));
+    throw InputError(fmt::format("campaign folder '{}' does not exist", campaign));
   std::vector<std::string> runs;
   if (fs::exists(fs::path(campaign) / "series.csv")) runs.push_back(campaign);
   for (const auto& e : fs::directory_iterator(campaign))
     if (e.is_directory() && fs::exists(e.path() / "series.csv")) runs.push_back(e.path().string());
   std::sort(runs.begin(), runs.end());
   if (runs.empty())
-    throw AnalysisError(fmt::format(
+    throw InputError(fmt::format(
         "campaign folder '{}' holds no run (no series.csv in it or in its subfolders)", campaign));
   return runs;
 }

@@ -14,10 +14,10 @@ namespace cda {
 Table read_series(const std::string& run_dir) {
   std::error_code ec;
   if (!fs::is_directory(run_dir, ec))
-    throw AnalysisError(fmt::format("run folder '{}' does not exist", run_dir));
+    throw InputError(fmt::format("run folder '{}' does not exist", run_dir));
   const std::string path = (fs::path(run_dir) / "series.csv").string();
   if (!fs::exists(path, ec))
-    throw AnalysisError(fmt::format("run folder '{}' has no series.csv", run_dir));
+    throw InputError(fmt::format("run folder '{}' has no series.csv", run_dir));
   return Table::read_csv(path);
 }
 

@@ -20,7 +20,7 @@ std::optional<double> number(const toml::value& root, const std::string& table, 
   const auto& v = t.at(key);
   if (v.is_floating()) return v.as_floating();
   if (v.is_integer()) return static_cast<double>(v.as_integer());
-  throw AnalysisError(fmt::format("'{}': [{}] {} is not a number", file, table, key));
+  throw InputError(fmt::format("'{}': [{}] {} is not a number", file, table, key));
 }
 
 }  // namespace
@@ -30,12 +30,12 @@ SceneInfo read_scene_info(const std::string& run_dir) {
   s.file = (fs::path(run_dir) / "scene.toml").string();
   std::error_code ec;
   if (!fs::exists(s.file, ec))
-    throw AnalysisError(fmt::format("run folder '{}' has no scene.toml", run_dir));
+    throw InputError(fmt::format("run folder '{}' has no scene.toml", run_dir));
   toml::value root;
   try {
     root = toml::parse(s.file);
   } catch (const std::exception& e) {
-    throw AnalysisError(fmt::format("'{}' does not parse as TOML: {}", s.file, e.what()));
+    throw InputError(fmt::format("'{}' does not parse as TOML: {}", s.file, e.what()));
   }
   s.cohesion_number = number(root, "contact", "cohesion_number", s.file);
   s.inertial_number = number(root, "shear", "inertial_number", s.file);
@@ -44,7 +44,7 @@ SceneInfo read_scene_info(const std::string& run_dir) {
 }
 
 double require(const SceneInfo& s, const std::optional<double>& v, const std::string& key) {
-  if (!v) throw AnalysisError(fmt::format("'{}' has no {}", s.file, key));
+  if (!v) throw InputError(fmt::format("'{}' has no {}", s.file, key));
   return *v;
 }
 

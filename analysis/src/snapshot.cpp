@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 #include <vtkCellArray.h>
+#include <vtkLogger.h>
 #include <vtkCellData.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
@@ -61,28 +62,71 @@ ContactSet merge_side_side(const ContactSet& cs) {
 
 namespace {
 
+// VTK's messages while a file is read: counted, the first kept. VTK 9 sends
+// them through vtkLogger (to stderr by default, from the parser, the reader
+// and the pipeline: pages for one damaged file).
+struct Captured {
+  int count = 0;
+  std::string first;
+};
+void capture_message(void* user, const vtkLogger::Message& m) {
+  auto* c = static_cast<Captured*>(user);
+  if (c->count++ == 0 && m.message) c->first = m.message;
+}
+
 vtkSmartPointer<vtkPolyData> read_polydata(const std::string& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
-    throw AnalysisError(fmt::format("snapshot '{}' does not exist", path));
+    throw InputError(fmt::format("snapshot '{}' does not exist", path));
   vtkNew<vtkXMLPolyDataReader> reader;
   if (!reader->CanReadFile(path.c_str()))
-    throw AnalysisError(fmt::format("'{}' is not a VTK XML PolyData file", path));
+    throw InputError(fmt::format("'{}' is not a VTK XML PolyData file", path));
   reader->SetFileName(path.c_str());
+  // VTK reports a damaged file through its output window (pages of
+  // messages, from the parser, the reader and the pipeline): capture them
+  // while reading and keep the first for our own one-line message.
+  Captured capture;
+  const vtkLogger::Verbosity stderr_level = vtkLogger::GetCurrentVerbosityCutoff();
+  vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+  vtkLogger::AddCallback("cdanalysis-read", capture_message, &capture, vtkLogger::VERBOSITY_WARNING);
   reader->Update();
-  if (reader->GetErrorCode() != 0)
-    throw AnalysisError(fmt::format("cannot read '{}' (VTK error code {})", path,
-                                    static_cast<int>(reader->GetErrorCode())));
+  vtkLogger::RemoveCallback("cdanalysis-read");
+  vtkLogger::SetStderrVerbosity(stderr_level);
+  if (reader->GetErrorCode() != 0 || capture.count > 0) {
+    std::string first = capture.first;
+    if (const auto k = first.find("): "); k != std::string::npos) first = first.substr(k + 3);
+    while (!first.empty() && (first.back() == '\n' || first.back() == ' ')) first.pop_back();
+    throw InputError(fmt::format("cannot read '{}': damaged VTK file ({} messages; first: {})", path,
+                                 std::max(capture.count, 1), first.empty() ? "none" : first));
+  }
   vtkSmartPointer<vtkPolyData> pd = reader->GetOutput();
+  // Every point and every numeric array must be finite.
+  if (vtkPoints* pts = pd->GetPoints())
+    for (vtkIdType i = 0; i < pts->GetNumberOfPoints(); ++i) {
+      double x[3];
+      pts->GetPoint(i, x);
+      if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+        throw InputError(fmt::format("'{}': point {} is not finite", path, i));
+    }
+  for (vtkDataSetAttributes* attr : {static_cast<vtkDataSetAttributes*>(pd->GetPointData()),
+                                     static_cast<vtkDataSetAttributes*>(pd->GetCellData())})
+    for (int a = 0; a < attr->GetNumberOfArrays(); ++a)
+      if (vtkDataArray* arr = attr->GetArray(a))
+        for (vtkIdType i = 0; i < arr->GetNumberOfTuples(); ++i)
+          for (int c = 0; c < arr->GetNumberOfComponents(); ++c)
+            if (!std::isfinite(arr->GetComponent(i, c)))
+              throw InputError(fmt::format("'{}': array '{}', tuple {}, component {} is {}", path,
+                                           arr->GetName() ? arr->GetName() : "?", i, c,
+                                           arr->GetComponent(i, c)));
   return pd;
 }
 
 vtkDataArray* need(vtkDataSetAttributes* attr, const char* name, int comps,
                    const std::string& path) {
   vtkDataArray* a = attr->GetArray(name);
-  if (!a) throw AnalysisError(fmt::format("'{}' has no array '{}'", path, name));
+  if (!a) throw InputError(fmt::format("'{}' has no array '{}'", path, name));
   if (a->GetNumberOfComponents() < comps)
-    throw AnalysisError(fmt::format("'{}': array '{}' has {} components, {} expected", path, name,
+    throw InputError(fmt::format("'{}': array '{}' has {} components, {} expected", path, name,
                                     a->GetNumberOfComponents(), comps));
   return a;
 }
@@ -122,7 +166,7 @@ ContactSet read_contacts(const std::string& path) {
     } else {
       pd->GetCellPoints(i, ids);
       if (ids->GetNumberOfIds() != 2)
-        throw AnalysisError(fmt::format("'{}': contact cell {} is not a line of 2 points", path, i));
+        throw InputError(fmt::format("'{}': contact cell {} is not a line of 2 points", path, i));
       double p1[3], p2[3];
       pd->GetPoint(ids->GetId(0), p1);
       pd->GetPoint(ids->GetId(1), p2);
@@ -220,7 +264,7 @@ void write_contacts(const std::string& path, const ContactSet& cs, const Particl
   w->SetInputData(pd);
   w->SetDataModeToAppended();
   w->EncodeAppendedDataOff();
-  if (w->Write() != 1) throw AnalysisError(fmt::format("cannot write '{}'", path));
+  if (w->Write() != 1) throw InputError(fmt::format("cannot write '{}'", path));
 }
 
 void write_particles(const std::string& path, const ParticleSet& ps) {
@@ -256,13 +300,13 @@ void write_particles(const std::string& path, const ParticleSet& ps) {
   w->SetInputData(pd);
   w->SetDataModeToAppended();
   w->EncodeAppendedDataOff();
-  if (w->Write() != 1) throw AnalysisError(fmt::format("cannot write '{}'", path));
+  if (w->Write() != 1) throw InputError(fmt::format("cannot write '{}'", path));
 }
 
 std::vector<std::string> list_snapshots(const std::string& run_dir, const std::string& prefix) {
   std::error_code ec;
   if (!fs::is_directory(run_dir, ec))
-    throw AnalysisError(fmt::format("run folder '{}' does not exist", run_dir));
+    throw InputError(fmt::format("run folder '{}' does not exist", run_dir));
   const std::regex re(prefix + R"(_(\d+)\.vtp)");
   std::vector<std::pair<long, std::string>> found;
   for (const auto& e : fs::directory_iterator(run_dir)) {
@@ -279,11 +323,11 @@ std::vector<std::string> list_snapshots(const std::string& run_dir, const std::s
 std::string snapshot_path(const std::string& run_dir, const std::string& prefix, int k) {
   const auto all = list_snapshots(run_dir, prefix);
   if (all.empty())
-    throw AnalysisError(fmt::format("run folder '{}' has no {}_NNNNN.vtp snapshot", run_dir, prefix));
+    throw InputError(fmt::format("run folder '{}' has no {}_NNNNN.vtp snapshot", run_dir, prefix));
   const long n = static_cast<long>(all.size());
   const long i = k < 0 ? n + k : k;
   if (i < 0 || i >= n)
-    throw AnalysisError(fmt::format("run folder '{}' has {} {} snapshots; snapshot {} does not exist",
+    throw InputError(fmt::format("run folder '{}' has {} {} snapshots; snapshot {} does not exist",
                                     run_dir, n, prefix, k));
   return all[static_cast<std::size_t>(i)];
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -31,9 +32,9 @@ std::vector<std::string> split(const std::string& line) {
 
 Table::Table(std::vector<std::string> names) : names_(std::move(names)), cols_(names_.size()) {}
 
-Table Table::read_csv(const std::string& path) {
+Table Table::read_csv(const std::string& path, bool allow_nan) {
   std::ifstream in(path);
-  if (!in) throw AnalysisError(fmt::format("cannot open '{}'", path));
+  if (!in) throw InputError(fmt::format("cannot open '{}'", path));
   Table t;
   t.source_ = path;
   std::string line;
@@ -42,17 +43,17 @@ Table Table::read_csv(const std::string& path) {
     ++lineno;
     if (!trim(line).empty()) break;
   }
-  if (trim(line).empty()) throw AnalysisError(fmt::format("'{}' is empty (no header row)", path));
+  if (trim(line).empty()) throw InputError(fmt::format("'{}' is empty (no header row)", path));
   t.names_ = split(line);
   for (const auto& n : t.names_)
-    if (n.empty()) throw AnalysisError(fmt::format("'{}': empty column name in the header", path));
+    if (n.empty()) throw InputError(fmt::format("'{}': empty column name in the header", path));
   t.cols_.assign(t.names_.size(), {});
   while (std::getline(in, line)) {
     ++lineno;
     if (trim(line).empty()) continue;
     const auto fields = split(line);
     if (fields.size() != t.names_.size())
-      throw AnalysisError(fmt::format("'{}' line {}: {} fields, the header has {}", path, lineno,
+      throw InputError(fmt::format("'{}' line {}: {} fields, the header has {}", path, lineno,
                                       fields.size(), t.names_.size()));
     for (std::size_t j = 0; j < fields.size(); ++j) {
       const char* s = fields[j].c_str();
@@ -60,12 +61,15 @@ Table Table::read_csv(const std::string& path) {
       errno = 0;
       const double v = std::strtod(s, &end);
       if (fields[j].empty() || *end != '\0')
-        throw AnalysisError(fmt::format("'{}' line {}, column '{}': '{}' is not a number", path,
+        throw InputError(fmt::format("'{}' line {}, column '{}': '{}' is not a number", path,
                                         lineno, t.names_[j], fields[j]));
+      if (!std::isfinite(v) && !(allow_nan && std::isnan(v)))
+        throw InputError(fmt::format("'{}' line {}, column '{}': '{}' is not a finite number", path,
+                                     lineno, t.names_[j], fields[j]));
       t.cols_[j].push_back(v);
     }
   }
-  if (t.rows() == 0) throw AnalysisError(fmt::format("'{}' has a header but no data rows", path));
+  if (t.rows() == 0) throw InputError(fmt::format("'{}' has a header but no data rows", path));
   return t;
 }
 
@@ -78,7 +82,7 @@ const std::vector<double>& Table::column(const std::string& name) const {
   if (it == names_.end()) {
     std::string list;
     for (const auto& n : names_) list += (list.empty() ? "" : ",") + n;
-    throw AnalysisError(
+    throw InputError(
         fmt::format("'{}' has no column '{}' (columns: {})", source_, name, list));
   }
   return cols_[static_cast<std::size_t>(it - names_.begin())];
@@ -86,14 +90,14 @@ const std::vector<double>& Table::column(const std::string& name) const {
 
 void Table::add_row(const std::vector<double>& values) {
   if (values.size() != names_.size())
-    throw AnalysisError(fmt::format("table row of {} values for {} columns", values.size(),
+    throw InputError(fmt::format("table row of {} values for {} columns", values.size(),
                                     names_.size()));
   for (std::size_t j = 0; j < values.size(); ++j) cols_[j].push_back(values[j]);
 }
 
 void Table::add_column(const std::string& name, std::vector<double> values) {
   if (!cols_.empty() && values.size() != rows())
-    throw AnalysisError(fmt::format("column '{}' has {} rows, the table {}", name, values.size(),
+    throw InputError(fmt::format("column '{}' has {} rows, the table {}", name, values.size(),
                                     rows()));
   names_.push_back(name);
   cols_.push_back(std::move(values));
@@ -113,9 +117,9 @@ std::string Table::to_csv() const {
 
 void Table::write_csv(const std::string& path) const {
   std::ofstream out(path);
-  if (!out) throw AnalysisError(fmt::format("cannot write '{}'", path));
+  if (!out) throw InputError(fmt::format("cannot write '{}'", path));
   out << to_csv();
-  if (!out) throw AnalysisError(fmt::format("error while writing '{}'", path));
+  if (!out) throw InputError(fmt::format("error while writing '{}'", path));
 }
 
 }  // namespace cda

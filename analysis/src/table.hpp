@@ -15,10 +15,12 @@ class Table {
   explicit Table(std::vector<std::string> names);
 
   // Reads a CSV file whose first row names the columns. Every later row must
-  // have as many fields, each a number (strtod syntax, so nan/inf are taken).
-  // Throws AnalysisError naming the file for: missing file, no header, no
-  // data row, a short/long row, a non-numeric field (with line and column).
-  static Table read_csv(const std::string& path);
+  // have as many fields, each a finite number (strtod syntax); nan marks a
+  // missing value only in cdanalysis' own tables, read with allow_nan.
+  // Throws InputError naming the file for: missing file, no header, no data
+  // row, a short/long row, a non-numeric or non-finite field (with line and
+  // column).
+  static Table read_csv(const std::string& path, bool allow_nan = false);
 
   bool has(const std::string& name) const;
   // Throws AnalysisError naming the column and the file it was read from.

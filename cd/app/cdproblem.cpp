@@ -8,10 +8,12 @@
 // FILE.cdp: a step dumped by `cdsim --dump-problem` (contact_problem.hpp),
 // solved exactly as the step was (same rows, colouring, law, dofs and,
 // unless overridden, tolerance and cap): the same impulses to the bit.
-// A malformed file is one message naming the file, line and what was wrong,
-// and exit code 2 (as cdsim).
+// Exit codes: 0 solved to the tolerance; 1 not converged (sweep cap) or
+// Lemke failed; 2 bad input (usage, option out of range, malformed file or
+// non-finite number: one message naming the file, line and what was wrong).
 #include <chrono>
 #include <fstream>
+#include <limits>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -103,15 +105,29 @@ int main(int argc, char** argv) {
   cd::NlgsOptions opt;
   bool lemke = false;
   cmd->add_option("file", path, "problem file (.dat: Siconos matrix form; .cdp: a step dumped by cdsim)")->required();
-  cmd->add_option("--tol", opt.tol, "tolerance on the sweep's rms |dr|/mean|r| (the production test)")
+  cmd->add_option("--tol", opt.tol, "tolerance on the sweep's rms |dr|/mean|r| (the production test), in (0, 1]")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            char* end = nullptr;
+            const double x = std::strtod(v.c_str(), &end);
+            return *end == '\0' && x > 0 && x <= 1 ? std::string() : "must be a number in (0, 1]";
+          },
+          "in (0, 1]"))
       ->capture_default_str();
-  cmd->add_option("--max-sweeps", opt.max_sweeps, "sweep cap")->capture_default_str();
+  cmd->add_option("--max-sweeps", opt.max_sweeps, "sweep cap")
+      ->check(CLI::Range(1, 100000000))
+      ->capture_default_str();
   cmd->add_option("--check-every", opt.check_every, "residual checkpoint every K sweeps")
+      ->check(CLI::Range(1, 100000000))
       ->capture_default_str();
   cmd->add_flag("--lemke", lemke, "solve as an LCP with Lemke's method (small problems)");
   std::string out;
   cmd->add_option("--out", out, "(.cdp) write the impulses, one row a line, as hex floats");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // --help: 0; every usage error: bad input
+  }
   try {
     if (path.size() > 4 && path.substr(path.size() - 4) == ".cdp") {
       if (lemke) throw std::runtime_error("--lemke takes a .dat problem (matrix form)");

@@ -257,7 +257,14 @@ Problem read_problem(std::istream& in, const std::string& name) {
     p.mu[k] = rd.number(fmt::format("mu[{}] (of {})", k, p.nc));
     if (p.mu[k] < 0) rd.fail(fmt::format("mu[{}] = {} is negative", k, p.mu[k]));
   }
-  // Anything after mu (some dumps append a solution) is ignored.
+  // Numbers after mu (some dumps append a solution) are ignored; anything
+  // else means the file is not what its header says.
+  for (std::string t(rd.token()); !t.empty(); t = std::string(rd.token())) {
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (*end != '\0' || !std::isfinite(v))
+      rd.fail(fmt::format("unexpected text '{}' after mu (only numbers may follow)", t));
+  }
   return p;
 }
 
