@@ -37,6 +37,11 @@ int main(int argc, char** argv) {
                  "write step STEP's contact problem into the output folder (repeatable): "
                  "problem_STEP.cdp (replayed exactly by cdproblem), .dat (Siconos), .impulses")
       ->check(CLI::PositiveNumber);
+  std::int64_t max_steps = 0;
+  app.add_option("--max-steps", max_steps,
+                 "stop after N steps (a series row and, with checkpoints on, a checkpoint the "
+                 "same command resumes from): to try a scene or a campaign's first steps")
+      ->check(CLI::PositiveNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -63,12 +68,12 @@ int main(int argc, char** argv) {
     cd::check_output_dir(out);
     if (scene.threads > 0) omp_set_num_threads(scene.threads);
 
-    cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps};
+    cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps, max_steps};
     cd::install_stop_handlers();
     const cd::RunSummary s = cd::run(world, scene, opt);
     if (s.first_step > 0)
       fmt::print("cdsim: resumed from {}/checkpoint.bin at step {} of {}\n", out, s.first_step,
-                 s.first_step + s.steps);
+                 s.total_steps);
     const double per_step = s.steps ? s.wall_time / s.steps : 0.0;
     fmt::print(
         "cdsim: {} steps in {:.2f} s ({:.3g} ms/step, {} threads); iterations/step mean {:.1f}, "
@@ -76,6 +81,9 @@ int main(int argc, char** argv) {
         s.steps, s.wall_time, 1e3 * per_step, omp_get_max_threads(), s.mean_iterations,
         s.max_iterations, s.cap_hits, s.max_residual, s.max_overlap);
     fmt::print("cdsim: outputs in {}/\n", out);
+    if (s.stopped_at_max_steps)
+      fmt::print("cdsim: stopped after --max-steps {} (step {} of the scene's {})\n", max_steps,
+                 s.first_step + s.steps, s.total_steps);
     if (s.stop_signal) {
       fmt::print("cdsim: stopped by signal {} after step {}{}\n", s.stop_signal,
                  s.first_step + s.steps,

@@ -271,13 +271,21 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
 
   std::int64_t k_end = nsteps;  // the last step taken (earlier if stopped by a signal)
   for (std::int64_t k = k0 + 1; k <= nsteps; ++k) {
-    w.step();
+    try {
+      w.step();
+    } catch (const std::runtime_error& e) {
+      // A step that cannot go on (e.g. a periodic cell shrunk below what
+      // detection needs): the run stops as a diverged one, its outputs kept.
+      throw RunDiverged(fmt::format("step {} (t = {:.6g} s): {}; series.csv holds the rows before it",
+                                    k, w.time, e.what()));
+    }
     const StepStats& st = w.last();
     if (const std::string bad = non_finite(w); !bad.empty())
       throw RunDiverged(fmt::format("step {} (t = {:.6g} s): non-finite state: {}; series.csv "
                                     "holds the rows before it{}", k, w.time, bad,
                                     every_ckpt ? ", checkpoint.bin (if written) the last good state" : ""));
-    const bool stopping = g_stop != 0;
+    const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps;
+    const bool stopping = g_stop != 0 || at_limit;
     if (stopping) k_end = k;
     if (dumped(k)) {
       std::string text;
@@ -368,6 +376,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
       timed_output([&] { save_checkpoint(ckpt, w, key); });
     if (stopping) {
       sum.stop_signal = g_stop;
+      sum.stopped_at_max_steps = at_limit && !g_stop;
       break;
     }
 
@@ -387,6 +396,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   if (progress) std::fprintf(stderr, "\n");
   sum.first_step = k0;
   sum.steps = k_end - k0;
+  sum.total_steps = nsteps;
   sum.mean_iterations = sum.steps ? double(iter_total) / sum.steps : 0.0;
   sum.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
   sum.kinetic_energy = w.kinetic_energy();

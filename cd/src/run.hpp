@@ -22,6 +22,9 @@ struct RunOptions {
   // cohesive steps) and, after the solve, problem_STEP.impulses (the
   // step's impulses, row order, hex floats).
   std::vector<std::int64_t> dump_steps;
+  // > 0: stop after this many steps of this call (at a step boundary, with
+  // a series row and, if checkpoints are on, a checkpoint to resume from).
+  std::int64_t max_steps = 0;
 };
 
 // A run that produced a non-finite position, velocity, impulse, cell
@@ -38,6 +41,8 @@ void install_stop_handlers();
 
 struct RunSummary {
   int stop_signal = 0;          // > 0: stopped early by this signal
+  bool stopped_at_max_steps = false;
+  std::int64_t total_steps = 0;  // the scene's steps
   std::int64_t first_step = 0;  // > 0: resumed from a checkpoint at this step
   std::int64_t steps = 0;       // steps run by this call
   double mean_iterations = 0;

@@ -1,0 +1,342 @@
+// Fuzzing the three tools' inputs (issue 15): seeded, reproducible random
+// mutations of valid inputs, each run as a user would run it. The contract:
+//   cdsim:      exit 0 with every series value finite, or exit 2 (bad input)
+//               or 3 (diverged) with a message, and no output folder written
+//               for exit 2;
+//   cdanalysis: exit 0, or 1/2 with a "cdanalysis:" message;
+//   cdproblem:  exit 0/1, or 2 with a "cdproblem:" message;
+// never a crash, an abort, a hang or a NaN written. A failing case prints
+// its seed and input, so that it can be replayed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_util.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kBin = CDLAB_BINARY_DIR;
+// Every case runs under a time limit: a hang is a failure, not a stuck suite.
+const std::string kTimeout = "timeout -k 5 60 ";
+
+// A scene as (section, key, value) lines, so that a mutation can change,
+// drop or add one.
+struct Line {
+  std::string section, key, value;
+};
+using SceneLines = std::vector<Line>;
+
+std::string text(const SceneLines& s) {
+  std::string out, section;
+  // Top-level keys first, then each section once, [[array]] entries as given.
+  for (const Line& l : s)
+    if (l.section.empty()) out += l.key + " = " + l.value + "\n";
+  for (const Line& l : s) {
+    if (l.section.empty()) continue;
+    if (l.section.rfind("[[", 0) == 0) {
+      out += l.section + "\n" + l.value + "\n";  // a whole array entry
+      section.clear();
+      continue;
+    }
+    if (l.section != section) out += "[" + (section = l.section) + "]\n";
+    out += l.key + " = " + l.value + "\n";
+  }
+  return out;
+}
+
+// Three valid scenes: a box pile of polygons and disks, a periodic shear
+// under pressure, a cohesive one.
+std::vector<SceneLines> bases() {
+  const SceneLines common = {{"", "name", "\"fuzz\""},
+                             {"time", "dt", "1e-4"},
+                             {"time", "duration", "2e-3"},
+                             {"output", "series_interval", "5e-4"},
+                             {"output", "snapshot_interval", "1e-3"},
+                             {"output", "checkpoint_interval", "1e-3"},
+                             {"contact", "mu", "0.4"},
+                             {"solver", "tol", "1e-4"},
+                             {"solver", "max_iter", "200"}};
+  SceneLines pile = common;
+  pile.insert(pile.end(), {{"gravity", "g", "[0.0, -9.81]"},
+                           {"particles", "n", "40"},
+                           {"particles", "d_mean", "1e-3"},
+                           {"particles", "size_ratio", "1.5"},
+                           {"particles", "nsides", "[0, 6]"},
+                           {"box", "width", "0.012"},
+                           {"box", "height", "0.02"},
+                           {"[[disk]]", "", "pos = [0.006, 0.018]\nradius = 5e-4\nvel = [0.0, -0.1]"},
+                           {"[[wall]]", "", "a = [0.0, 0.01]\nb = [0.004, 0.008]"}});
+  SceneLines shear = common;
+  shear.insert(shear.end(), {{"gravity", "g", "[0.0, 0.0]"},
+                             {"particles", "n", "30"},
+                             {"particles", "d_mean", "1e-3"},
+                             {"particles", "size_ratio", "2.0"},
+                             {"shear", "mode", "\"periodic\""},
+                             {"shear", "width", "0.01"},
+                             {"shear", "height", "0.01"},
+                             {"shear", "pressure", "100.0"},
+                             {"shear", "inertial_number", "0.05"},
+                             {"shear", "dt_tp", "0.05"},
+                             {"shear", "strain", "0.1"}});
+  SceneLines cohesive = shear;
+  cohesive.push_back({"contact", "cohesion_number", "5.0"});
+  cohesive.push_back({"contact", "debond", "0.01"});
+  return {pile, shear, cohesive};
+}
+
+// Values a mutation puts in: extreme, non-finite, wrong types.
+const std::vector<std::string> kValues = {
+    "0",    "-1",     "1",      "0.5",     "1e-300", "1e300",  "-1e300", "1e20",  "1e-20",
+    "inf",  "-inf",   "nan",    "2147483648", "-2147483649", "3.5", "\"x\"", "\"\"", "true",
+    "[]",   "[1.0]",  "[1, 2]", "[nan, 1]", "[1, 2, 3, 4]", "{ a = 1 }", "1979-05-27",
+    // plausible values too, so that a fair share of the mutants run
+    "0.01", "0.2", "2.0", "10", "100.0", "1e-3", "[0.0, 0.0]", "[0, 6]",
+};
+const std::vector<Line> kExtraKeys = {{"contact", "mu_wall", ""},  {"contact", "e_n", ""},
+                                      {"contact", "adhesion", ""}, {"contact", "alert", ""},
+                                      {"contact", "overlap_correction", ""},
+                                      {"solver", "threads", ""},   {"shear", "cell_mass", ""},
+                                      {"shear", "isotropic", ""},  {"shear", "start", ""},
+                                      {"particles", "seed", ""},   {"particles", "region", ""},
+                                      {"contact", "bogus", ""},    {"nosuchsection", "x", ""}};
+
+SceneLines mutate(SceneLines s, std::mt19937_64& g, std::string& what) {
+  const int n = g() % 3 == 0 ? 2 : 1;  // one mutation, or two
+  for (int m = 0; m < n; ++m) {
+    const auto pick = [&](std::size_t k) { return static_cast<std::size_t>(g() % k); };
+    const std::size_t i = pick(s.size());
+    switch (pick(4)) {
+      case 0:  // drop a line
+        what += "drop " + s[i].section + "." + s[i].key + "; ";
+        s.erase(s.begin() + static_cast<long>(i));
+        break;
+      case 1: {  // add a key with a random value
+        Line l = kExtraKeys[pick(kExtraKeys.size())];
+        l.value = kValues[pick(kValues.size())];
+        what += "add " + l.section + "." + l.key + " = " + l.value + "; ";
+        s.push_back(l);
+        break;
+      }
+      default:  // change a value (twice as likely)
+        if (s[i].section.rfind("[[", 0) == 0) {
+          // An array entry: replace the value of its first key.
+          std::string& v = s[i].value;
+          const auto eq = v.find('='), nl = v.find('\n');
+          v = v.substr(0, eq + 2) + kValues[pick(kValues.size())] + v.substr(nl);
+          what += "change " + s[i].section + " to " + v + "; ";
+        } else {
+          s[i].value = kValues[pick(kValues.size())];
+          what += "set " + s[i].section + "." + s[i].key + " = " + s[i].value + "; ";
+        }
+    }
+  }
+  return s;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Every data field of a CSV file is a finite number.
+bool csv_finite(const fs::path& p, std::string& bad) {
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);  // header
+  for (int row = 2; std::getline(in, line); ++row) {
+    std::stringstream ss(line);
+    for (std::string f; std::getline(ss, f, ',');) {
+      char* end = nullptr;
+      const double v = std::strtod(f.c_str(), &end);
+      if (*end != '\0' || !std::isfinite(v)) {
+        bad = "row " + std::to_string(row) + ": '" + f + "'";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST(Fuzz, MutatedScenesRunCleanlyOrAreRefusedCleanly) {
+  const fs::path dir = cdtest::scratch_dir("fuzz", "scenes");
+  const auto base = bases();
+  const int cases = 240;
+  int ran = 0, refused = 0, diverged = 0;
+  for (int c = 0; c < cases; ++c) {
+    std::mt19937_64 g(1000 + c);
+    std::string what;
+    const SceneLines s = mutate(base[c % base.size()], g, what);
+    const std::string scene = text(s);
+    const fs::path sc = dir / "s.toml", out = dir / "out";
+    std::ofstream(sc) << scene;
+    fs::remove_all(out);
+    const cdtest::CmdResult r = cdtest::run_command(kTimeout + kBin + "/cd/cdsim " + sc.string() +
+                                                    " --max-steps 8 -q --threads 1 --out " + out.string());
+    const std::string id = "case " + std::to_string(c) + " (" + what + ")\n" + scene + "\n" + r.out;
+    if (r.code == 0) {
+      ++ran;
+      std::string bad;
+      ASSERT_TRUE(fs::exists(out / "series.csv")) << id;
+      EXPECT_TRUE(csv_finite(out / "series.csv", bad)) << bad << "\n" << id;
+    } else if (r.code == 2) {
+      ++refused;
+      EXPECT_NE(r.out.find("cdsim: "), std::string::npos) << id;
+      EXPECT_FALSE(fs::exists(out)) << "a refused run wrote its folder: " << id;
+    } else if (r.code == 3) {
+      ++diverged;
+      EXPECT_NE(r.out.find("run diverged"), std::string::npos) << id;
+      if (fs::exists(out / "series.csv")) {
+        std::string bad;
+        EXPECT_TRUE(csv_finite(out / "series.csv", bad)) << bad << "\n" << id;
+      }
+    } else {
+      ADD_FAILURE() << "exit " << r.code << " (crash, abort or time limit): " << id;
+    }
+  }
+  std::printf("[ fuzz ] %d scenes: %d ran, %d refused, %d diverged\n", cases, ran, refused, diverged);
+  // The mutations must exercise both paths, or the test tests nothing.
+  EXPECT_GT(ran, cases / 20);
+  EXPECT_GT(refused, cases / 4);
+}
+
+// A damaged checkpoint (bytes flipped, cut short, grown) is refused with
+// exit 2 and the run's files left exactly as they were.
+TEST(Fuzz, DamagedCheckpointsAreRefusedAndNothingIsLost) {
+  const fs::path dir = cdtest::scratch_dir("fuzz", "checkpoints");
+  const std::string scene = text(bases()[1]);
+  const fs::path sc = dir / "s.toml", out = dir / "out";
+  std::ofstream(sc) << scene;
+  const std::string cmd = kTimeout + kBin + "/cd/cdsim " + sc.string() + " -q --threads 1 --out " + out.string();
+  ASSERT_EQ(cdtest::run_command(cmd + " --max-steps 20").code, 0);
+  const std::string ckpt = slurp(out / "checkpoint.bin"), series = slurp(out / "series.csv");
+  ASSERT_GT(ckpt.size(), 64u);
+  int refused = 0, resumed = 0;
+  for (int c = 0; c < 60; ++c) {
+    std::mt19937_64 g(2000 + c);
+    std::string bad = ckpt, what;
+    switch (c % 3) {
+      case 0: {
+        const int flips = 1 + static_cast<int>(g() % 4);
+        for (int k = 0; k < flips; ++k) {
+          const std::size_t at = g() % bad.size();
+          bad[at] = static_cast<char>(bad[at] ^ (1 + g() % 255));
+          what += "flip byte " + std::to_string(at) + "; ";
+        }
+        break;
+      }
+      case 1: {
+        const std::size_t len = g() % bad.size();
+        bad.resize(len);
+        what = "cut to " + std::to_string(len) + " bytes";
+        break;
+      }
+      default:
+        bad += std::string(1 + g() % 64, static_cast<char>(g()));
+        what = "grown";
+    }
+    std::ofstream(out / "checkpoint.bin", std::ios::binary) << bad;
+    std::ofstream(out / "series.csv", std::ios::binary) << series;
+    const cdtest::CmdResult r = cdtest::run_command(cmd + " --max-steps 1");
+    const std::string id = "case " + std::to_string(c) + " (" + what + ")\n" + r.out;
+    if (r.code == 2) {
+      ++refused;
+      EXPECT_NE(r.out.find("checkpoint"), std::string::npos) << id;
+      EXPECT_EQ(slurp(out / "series.csv"), series) << "series.csv changed: " << id;
+      EXPECT_EQ(slurp(out / "checkpoint.bin"), bad) << "checkpoint.bin changed: " << id;
+    } else if (r.code == 0) {
+      ++resumed;  // a flip in a byte that carries no information (padding) may pass the checks
+      std::string b;
+      EXPECT_TRUE(csv_finite(out / "series.csv", b)) << b << "\n" << id;
+    } else {
+      ADD_FAILURE() << "exit " << r.code << ": " << id;
+    }
+  }
+  std::printf("[ fuzz ] 60 damaged checkpoints: %d refused, %d resumed\n", refused, resumed);
+  EXPECT_GE(refused, 55);
+}
+
+// cdanalysis on damaged series and snapshots; cdproblem on damaged problems.
+TEST(Fuzz, DamagedAnalysisInputsAndProblemsAreRefusedCleanly) {
+  const fs::path dir = cdtest::scratch_dir("fuzz", "analysis");
+  // A pile with a series row every step (300 rows), and a dumped shear step.
+  SceneLines pile = bases()[0];
+  for (Line& l : pile) {
+    if (l.key == "duration") l.value = "0.03";
+    if (l.key == "series_interval") l.value = "1e-4";
+  }
+  std::ofstream(dir / "pile.toml") << text(pile);
+  std::ofstream(dir / "shear.toml") << text(bases()[1]);
+  const fs::path run = dir / "run";
+  const std::string cdsim = kTimeout + kBin + "/cd/cdsim ";
+  ASSERT_EQ(cdtest::run_command(cdsim + (dir / "pile.toml").string() + " -q --threads 1 --out " + run.string()).code, 0);
+  ASSERT_EQ(cdtest::run_command(cdsim + (dir / "shear.toml").string() + " -q --threads 1 --out " +
+                                (dir / "shear").string() + " --dump-problem 3 --max-steps 5")
+                .code,
+            0);
+  const std::string series = slurp(run / "series.csv"), cdp = slurp(dir / "shear" / "problem_3.cdp");
+  ASSERT_FALSE(series.empty());
+  ASSERT_FALSE(cdp.empty());
+  // The undamaged series is analysed.
+  ASSERT_EQ(cdtest::run_command(kBin + "/analysis/cdanalysis steady " + run.string() +
+                                " --column kinetic_energy --window 0.01:0.03").code, 0);
+  // Tokens a mutation writes over a field or a token.
+  const std::vector<std::string> junk = {"nan", "inf", "-inf", "x", "", "1e999", "-1", "0", "1e300", "0x1p-1074"};
+  const auto mutate_text = [&](std::string t, std::mt19937_64& g, const std::string& seps) {
+    // Replace one token (between separators) with junk, or cut the text.
+    if (g() % 4 == 0) return t.substr(0, g() % t.size());
+    std::vector<std::size_t> starts = {0};
+    for (std::size_t k = 0; k < t.size(); ++k)
+      if (seps.find(t[k]) != std::string::npos) starts.push_back(k + 1);
+    const std::size_t b = starts[g() % starts.size()];
+    std::size_t e = b;
+    while (e < t.size() && seps.find(t[e]) == std::string::npos) ++e;
+    return t.substr(0, b) + junk[g() % junk.size()] + t.substr(e);
+  };
+  int analysed = 0, problems = 0;
+  for (int c = 0; c < 60; ++c) {
+    std::mt19937_64 g(3000 + c);
+    const std::string bad = mutate_text(series, g, ",\n");
+    std::ofstream(run / "series.csv", std::ios::binary) << bad;
+    const cdtest::CmdResult r = cdtest::run_command(kTimeout + kBin + "/analysis/cdanalysis steady " +
+                                                    run.string() + " --column kinetic_energy --window 0.01:0.03");
+    const std::string id = "series case " + std::to_string(c) + "\n" + r.out;
+    if (r.code == 0) {
+      ++analysed;
+      EXPECT_EQ(r.out.find("nan"), std::string::npos) << id;
+    } else if (r.code == 1 || r.code == 2) {
+      EXPECT_NE(r.out.find("cdanalysis: "), std::string::npos) << id;
+    } else {
+      ADD_FAILURE() << "exit " << r.code << ": " << id;
+    }
+  }
+  for (int c = 0; c < 60; ++c) {
+    std::mt19937_64 g(4000 + c);
+    std::ofstream(dir / "p.cdp", std::ios::binary) << mutate_text(cdp, g, " \n");
+    const cdtest::CmdResult r =
+        cdtest::run_command(kTimeout + kBin + "/cd/cdproblem solve " + (dir / "p.cdp").string());
+    const std::string id = "problem case " + std::to_string(c) + "\n" + r.out;
+    if (r.code == 0 || r.code == 1) {
+      ++problems;
+      EXPECT_EQ(r.out.find("nan"), std::string::npos) << id;
+    } else if (r.code == 2) {
+      EXPECT_NE(r.out.find("cdproblem: "), std::string::npos) << id;
+    } else {
+      ADD_FAILURE() << "exit " << r.code << ": " << id;
+    }
+  }
+  std::printf("[ fuzz ] 60 damaged series (%d analysed), 60 damaged problems (%d solved)\n", analysed,
+              problems);
+}
