@@ -159,6 +159,13 @@ void residuals(const std::vector<ContactRow>& rows, const C& c, int min_parallel
   st.residual_mean = rsum / n / scale;
 }
 
+// A problem without rows: the dofs keep their free velocity, nothing to solve.
+inline SolveStats no_rows(std::vector<BoundaryDof>* dofs) {
+  if (dofs)
+    for (BoundaryDof& d : *dofs) d.v = d.v0;
+  return {};
+}
+
 // The end of a sweep: the convergence test on the sweep's sums (dsum of
 // |dp|^2, psum of |p| over the n rows), the dofs' update, the observer.
 // Returns true when the solve stops (dp_rel < tol and every dof converged,
@@ -181,13 +188,9 @@ template <class L, class C>
 SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
                  const SolverParams& prm, std::vector<BoundaryDof>* dofs,
                  const SweepObserver& observer) {
+  if (rows.empty()) return no_rows(dofs);
   SolveStats st;
   const int n = static_cast<int>(rows.size());
-  if (n == 0) {
-    if (dofs)
-      for (BoundaryDof& d : *dofs) d.v = d.v0;
-    return st;
-  }
 
   const int ncol = static_cast<int>(col.start.size()) - 1;
   std::vector<RowBlock> blocks;
@@ -253,13 +256,9 @@ template <class C, class Update>
 SolveStats solve_units(std::vector<ContactRow>& rows, int units, const C& c,
                        const SolverParams& prm, std::vector<BoundaryDof>* dofs,
                        const SweepObserver& observer, Update&& update) {
+  if (rows.empty()) return no_rows(dofs);
   SolveStats st;
   const int n = static_cast<int>(rows.size());
-  if (n == 0) {
-    if (dofs)
-      for (BoundaryDof& d : *dofs) d.v = d.v0;
-    return st;
-  }
   for (int it = 0;;) {
     const bool backward = (it % 2) == 1;
     double dsum = 0, psum = 0;
