@@ -10,15 +10,18 @@
 // 2. Frozen step problems: the step a World takes from a state, replayed from
 //    the same warm start, solved by
 //      ref   cd::nlgs_solve (coloured sweep, one thread: what the simulator runs)
-//      row   a sequential per-row sweep (copy of nlgs.cpp's row update)
+//      row   a sequential per-row sweep: cd::sweep::solve_units (the
+//            production convergence test and residuals) over the
+//            production row update (cd::sweep::BodyCoupling)
 //      pair  the same sweep with each ss pair updated as one block
 //    to eps_f = 1e-2 .. 1e-5 (same convergence test as nlgs.cpp: rms |dp| /
 //    mean |p| over a sweep). row and pair visit the rows in the same order
 //    (the World's colour order, the second row of a pair moved next to the
 //    first) and alternate forward/backward sweeps as nlgs.cpp does, so they
 //    differ only in the pair update.
-// 3. Dynamic runs: the same states stepped `steps` times by a copy of
-//    World::step with each solver; mean sweeps a step and solve time.
+// 3. Dynamic runs: the same states stepped `steps` times by World::step with
+//    its solve stage replaced by each solver (World::set_solver); mean
+//    sweeps a step and the time of the colour and solve stages.
 // States: settled piles of squares and of hexagons (cdbench::polygon_pile),
 // and the square pile flowing under gravity tilted by `tilt` degrees.
 // Everything on one thread. Writes DIR/frozen.csv, DIR/dynamic.csv and
@@ -46,7 +49,9 @@
 #include <iostream>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -58,6 +63,8 @@
 #include "pile.hpp"
 #include "problem.hpp"
 #include "ss_pair.hpp"
+#include "sweep.hpp"
+#include "world.hpp"
 
 namespace {
 
@@ -252,32 +259,6 @@ bool unit_check(int trials, std::ostream& out) {
 
 // ------------------------------------------------------------------ sweeps
 
-// A row update of nlgs.cpp (Law<true, false>, rotation, both bodies written).
-inline void update_row(cd::ContactRow& r, cd::BodyVel* vel, double& dp2, double& pabs) {
-  cd::BodyVel& A = vel[r.b1];
-  cd::BodyVel& B = vel[r.b2];
-  const double dx = B.vx - A.vx, dy = B.vy - A.vy;
-  const double un = r.nx * dx + r.ny * dy + r.bn - B.w * r.c2t + A.w * r.c1t;
-  const double ut = -r.ny * dx + r.nx * dy + r.bt + B.w * r.c2n - A.w * r.c1n;
-  const cd::Block W{r.wnn, r.wnt, r.wtt};
-  const double bn = un - (r.wnn * r.pn + r.wnt * r.pt);
-  const double bt = ut - (r.wnt * r.pn + r.wtt * r.pt);
-  double pn, pt;
-  cd::solve_coulomb(bn, bt, W, r.mu, 0.0, pn, pt);
-  const double dpn = pn - r.pn, dpt = pt - r.pt;
-  r.pn = pn;
-  r.pt = pt;
-  pabs = std::sqrt(pn * pn + pt * pt);
-  dp2 = dpn * dpn + dpt * dpt;
-  const double px = r.nx * dpn - r.ny * dpt, py = r.ny * dpn + r.nx * dpt;
-  B.vx += B.inv_m * px;
-  B.vy += B.inv_m * py;
-  B.w += B.inv_I * (r.c2n * dpt - r.c2t * dpn);
-  A.vx -= A.inv_m * px;
-  A.vy -= A.inv_m * py;
-  A.w -= A.inv_I * (r.c1n * dpt - r.c1t * dpn);
-}
-
 // Units of a sweep: a row (j < 0) or an ss pair, in the order of their first
 // row; cross blocks of the pairs.
 struct Units {
@@ -351,52 +332,38 @@ double pair_law_residual(const std::vector<cd::ContactRow>& rows,
   return worst / (pmean > 0 ? pmean : 1.0);
 }
 
-// Sequential symmetric Gauss-Seidel over the units; Pair: ss pairs as blocks.
+// Sequential symmetric Gauss-Seidel over the units (cd::sweep::solve_units);
+// Pair: ss pairs as blocks. Single rows, and both rows of a pair when Pair
+// is off, take the production row update (Coulomb, rotation, body 1 written:
+// a driven body has inv_m = inv_I = 0 and is left unchanged).
 template <bool Pair>
 SweepStats sweep_solve(std::vector<cd::ContactRow>& rows, std::vector<cd::BodyVel>& vel,
                        const Units& U, const cd::SolverParams& prm, int alpha_passes = 1) {
   SweepStats out;
-  cd::SolveStats& st = out.st;
-  const int n = static_cast<int>(rows.size());
-  if (n == 0) return out;
-  const int nu = static_cast<int>(U.u.size());
   cd::ContactRow* R = rows.data();
-  cd::BodyVel* V = vel.data();
-  int it = 0;
-  for (;;) {
-    const bool backward = (it % 2) == 1;
-    double dsum = 0, psum = 0;
-    for (int kk = 0; kk < nu; ++kk) {
-      const int k = backward ? nu - 1 - kk : kk;
-      const auto [i, j] = U.u[k];
-      double dp2, pabs;
-      if (j < 0) {
-        update_row(R[i], V, dp2, pabs);
-      } else if constexpr (Pair) {
-        if (cdbench::update_pair(R[i], R[j], U.cross[k], V, dp2, pabs, alpha_passes).fallback)
-          ++out.fallbacks;
-      } else {
-        double d2, p2;
-        update_row(R[backward ? j : i], V, dp2, pabs);
-        update_row(R[backward ? i : j], V, d2, p2);
-        dp2 += d2;
-        pabs += p2;
-      }
-      dsum += dp2;
-      psum += pabs;
-    }
-    ++it;
-    st.p_mean = psum / n;
-    st.dp_rel = std::sqrt(dsum / n) / (st.p_mean > 0 ? st.p_mean : 1.0);
-    st.iterations = it;
-    if (it >= prm.max_iter || st.dp_rel < prm.tol) break;
-  }
-  {
-    cd::ContactProblem cp{rows, {}, vel, {}, cd::Coulomb{}, true};
-    cd::law_residuals(cp, prm, st);
-  }
-  st.cap_hit = st.dp_rel >= prm.tol;
-  out.pair_res_max = pair_law_residual(rows, vel, U, st.p_mean);
+  const cd::sweep::BodyCoupling<true> c{vel.data()};
+  const auto row = [&](cd::ContactRow& r, double& dp2, double& pabs) {
+    c.update<cd::Coulomb, true>(r, dp2, pabs);
+  };
+  out.st = cd::sweep::solve_units(
+      rows, static_cast<int>(U.u.size()), c, prm, nullptr, {},
+      [&](int k, bool backward, double& dp2, double& pabs) {
+        const auto [i, j] = U.u[k];
+        if (j < 0) {
+          row(R[i], dp2, pabs);
+        } else if constexpr (Pair) {
+          if (cdbench::update_pair(R[i], R[j], U.cross[k], c.vel, dp2, pabs, alpha_passes)
+                  .fallback)
+            ++out.fallbacks;
+        } else {
+          double d2, p2;
+          row(R[backward ? j : i], dp2, pabs);
+          row(R[backward ? i : j], d2, p2);
+          dp2 += d2;
+          pabs += p2;
+        }
+      });
+  if (!rows.empty()) out.pair_res_max = pair_law_residual(rows, vel, U, out.st.p_mean);
   return out;
 }
 
@@ -494,117 +461,37 @@ Run run_frozen(const Frozen& f, const std::string& variant, double tol, int max_
 
 // ------------------------------------------------------------ dynamic runs
 
-// World::step for scenes without restitution, adhesion or overlap
-// correction, with the solve replaced (checked bit for bit against World).
-struct Stepper {
-  cd::Bodies B;
-  cd::WorldParams prm;
-  cd::World::WarmStart warm;
-  cd::CellGrid grid;
-  std::vector<cd::ContactRow> rows;
-  std::vector<cd::ContactInfo> info;
-  std::vector<cd::Vec2> xm;
-  std::vector<double> thm;
-
-  explicit Stepper(const cd::World& w) : B(w.bodies), prm(w.params()), warm(w.warm_start()) {
-    if (prm.e_n > 0 || prm.e_t > 0 || prm.adhesion > 0 || prm.overlap_correction != 0)
-      throw std::runtime_error("Stepper: restitution, adhesion or correction not supported");
-  }
-
-  template <class Solve>
-  cd::SolveStats step(Solve&& solve, double& solve_time) {
-    const std::size_t nb = B.size();
-    const double h = 0.5 * prm.dt;
-    xm.resize(nb);
-    thm.resize(nb);
-    for (std::size_t i = 0; i < nb; ++i) {
-      xm[i] = B.pos[i] + h * cd::Vec2(B.vel[i].vx, B.vel[i].vy);
-      thm[i] = B.angle[i] + h * B.vel[i].w;
-    }
-    cd::detect(B, xm, thm, prm.alert, grid, rows, info);
-    for (std::size_t k = 0; k < rows.size(); ++k) {
-      cd::ContactRow& r = rows[k];
-      cd::set_block(r, B.vel[r.b1], B.vel[r.b2], true);
-      r.mu = B.driven[r.b1] ? prm.mu_wall : prm.mu;
-      r.bn = info[k].gap > 0.0 ? info[k].gap / prm.dt : 0.0;
-      r.bt = 0.0;
-      const auto it = std::lower_bound(warm.keys.begin(), warm.keys.end(), info[k].key);
-      if (it != warm.keys.end() && *it == info[k].key) {
-        r.pn = warm.p[it - warm.keys.begin()].first;
-        r.pt = warm.p[it - warm.keys.begin()].second;
-      }
-    }
-    const auto t0 = Clock::now();
-    const cd::Colouring col = cd::colour_rows(rows, B);
-    {
-      std::vector<cd::ContactRow> r(rows.size());
-      std::vector<cd::ContactInfo> f(info.size());
-      for (std::size_t k = 0; k < rows.size(); ++k) {
-        r[k] = rows[col.perm[k]];
-        f[k] = info[col.perm[k]];
-      }
-      rows.swap(r);
-      info.swap(f);
-    }
-    const cd::Vec2 dv = prm.dt * prm.gravity;
-    for (std::size_t i = 0; i < nb; ++i)
-      if (B.is_dynamic(i)) {
-        const cd::Vec2 d = dv + prm.dt * B.vel[i].inv_m * B.force[i];
-        B.vel[i].vx += d.x();
-        B.vel[i].vy += d.y();
-      }
-    cd::apply_impulses(rows, B.vel, true);
-    const cd::SolveStats st = solve(rows, info, col, B.vel, prm.solver);
-    solve_time += since(t0);
-    const std::size_t nr = rows.size();
-    std::vector<std::size_t> idx(nr);
-    for (std::size_t k = 0; k < nr; ++k) idx[k] = k;
-    std::sort(idx.begin(), idx.end(),
-              [&](std::size_t a, std::size_t b) { return info[a].key < info[b].key; });
-    warm.keys.resize(nr);
-    warm.p.resize(nr);
-    for (std::size_t k = 0; k < nr; ++k) {
-      warm.keys[k] = info[idx[k]].key;
-      warm.p[k] = {rows[idx[k]].pn, rows[idx[k]].pt};
-    }
-    for (std::size_t i = 0; i < nb; ++i) {
-      B.pos[i] = xm[i] + h * cd::Vec2(B.vel[i].vx, B.vel[i].vy);
-      B.angle[i] = thm[i] + h * B.vel[i].w;
-    }
-    return st;
-  }
-};
-
-cd::SolveStats solve_variant(const std::string& v, std::vector<cd::ContactRow>& rows,
-                             const std::vector<cd::ContactInfo>& info, const cd::Colouring& col,
-                             std::vector<cd::BodyVel>& vel, const cd::SolverParams& prm) {
-  if (v == "ref") {
-    cd::ContactProblem cp{std::move(rows), col, std::move(vel), {}, cd::Coulomb{}, true};
-    const cd::SolveStats st = cd::nlgs_solve(cp, prm);
-    rows = std::move(cp.rows);
-    vel = std::move(cp.vel);
-    return st;
-  }
-  const Units U = make_units(rows, info, vel);
-  return v == "row"    ? sweep_solve<false>(rows, vel, U, prm).st
-         : v == "pair" ? sweep_solve<true>(rows, vel, U, prm).st
-                       : sweep_solve<true>(rows, vel, U, prm, 4).st;  // "pair4"
+// The solve stage of World::step for variant v (World::set_solver): ref is
+// cd::nlgs_solve, what World::step runs; row, pair and pair4 the unit sweeps,
+// with the ss pairs found from the World's contact info of the step (in the
+// problem's colour order, as the rows). The pair solve covers Coulomb
+// friction with rotation and no boundary dofs.
+cd::World::Solver variant_solver(const std::string& v, const cd::World& w) {
+  return [v, &w](cd::ContactProblem& p, const cd::SolverParams& prm) {
+    if (v == "ref") return cd::nlgs_solve(p, prm);
+    if (!std::holds_alternative<cd::Coulomb>(p.law) || !p.rotation || !p.dofs.empty())
+      throw std::runtime_error("ss_pair: only Coulomb, rotation, no boundary dofs");
+    const Units U = make_units(p.rows, w.infos(), p.vel);
+    return v == "row"    ? sweep_solve<false>(p.rows, p.vel, U, prm).st
+           : v == "pair" ? sweep_solve<true>(p.rows, p.vel, U, prm).st
+                         : sweep_solve<true>(p.rows, p.vel, U, prm, 4).st;  // "pair4"
+  };
 }
 
-// Largest position difference between a Stepper (ref solve) and World::step
-// over a few steps: 0 if the Stepper is a faithful copy.
-double check_stepper(const cd::World& w0, int steps) {
-  cd::World w = w0;
-  Stepper s(w0);
-  double t = 0;
+// Largest position difference between World::step with the ref solver put
+// in by set_solver and World::step itself over a few steps: 0 if replacing
+// the solve stage leaves the step unchanged.
+double check_solver(const cd::World& w0, int steps) {
+  cd::World w = w0, s = w0;
+  s.set_solver(variant_solver("ref", s));
   for (int k = 0; k < steps; ++k) {
     w.step();
-    s.step([](auto&... a) { return solve_variant("ref", a...); }, t);
+    s.step();
   }
   double d = 0;
   for (std::size_t i = 0; i < w.bodies.size(); ++i)
-    d = std::max({d, (w.bodies.pos[i] - s.B.pos[i]).cwiseAbs().maxCoeff(),
-                  std::abs(w.bodies.angle[i] - s.B.angle[i])});
+    d = std::max({d, (w.bodies.pos[i] - s.bodies.pos[i]).cwiseAbs().maxCoeff(),
+                  std::abs(w.bodies.angle[i] - s.bodies.angle[i])});
   return d;
 }
 
@@ -614,25 +501,23 @@ struct Dyn {
 };
 
 Dyn run_dynamic(const cd::World& w0, const std::string& v, int steps) {
-  Stepper s(w0);
+  cd::World w = w0;
+  w.set_solver(variant_solver(v, w));
+  const cd::StageTimes t0 = w.times;
   Dyn d;
   long sum = 0;
   for (int k = 0; k < steps; ++k) {
-    const cd::SolveStats st = s.step(
-        [&](std::vector<cd::ContactRow>& r, const std::vector<cd::ContactInfo>& i,
-            const cd::Colouring& c, std::vector<cd::BodyVel>& vel,
-            const cd::SolverParams& p) { return solve_variant(v, r, i, c, vel, p); },
-        d.solve_time);
+    w.step();
+    const cd::SolveStats& st = w.last().solve;
     sum += st.iterations;
     d.max_iter = std::max(d.max_iter, st.iterations);
     d.caps += st.cap_hit;
   }
+  using cd::Stage;
+  d.solve_time = w.times[Stage::Colour] - t0[Stage::Colour] + w.times[Stage::Solve] -
+                 t0[Stage::Solve];
   d.mean_iter = static_cast<double>(sum) / steps;
-  for (std::size_t i = 0; i < s.B.size(); ++i)
-    if (s.B.is_dynamic(i)) {
-      const cd::BodyVel& V = s.B.vel[i];
-      d.ke += 0.5 * s.B.mass[i] * (V.vx * V.vx + V.vy * V.vy) + 0.5 * s.B.inertia[i] * V.w * V.w;
-    }
+  d.ke = w.kinetic_energy();
   return d;
 }
 
@@ -750,9 +635,9 @@ int main(int argc, char** argv) {
     if (dyn_tol > 0) p.solver.tol = dyn_tol;
     if (dyn_cap > 0) p.solver.max_iter = dyn_cap;
     w.set_params(p);
-    std::cout << fmt::format("{}: Stepper vs World::step over 3 steps, max |dx|, |dtheta| = "
-                             "{:.1e}\n",
-                             name, check_stepper(w, 3));
+    std::cout << fmt::format("{}: ref through World::set_solver vs World::step over 3 steps, "
+                             "max |dx|, |dtheta| = {:.1e}\n",
+                             name, check_solver(w, 3));
     Dyn base;
     for (const std::string& v : variants) {
       const Dyn d = run_dynamic(w, v, steps);

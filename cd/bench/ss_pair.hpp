@@ -44,6 +44,7 @@
 
 #include "bodies.hpp"
 #include "contact.hpp"
+#include "sweep.hpp"
 
 namespace cdbench {
 
@@ -283,12 +284,11 @@ inline PairCase update_pair(cd::ContactRow& r1, cd::ContactRow& r2, const PairCr
   cd::BodyVel& A = vel[r1.b1];
   cd::BodyVel& B = vel[r1.b2];
   const double nx = r1.nx, ny = r1.ny;
-  const double dx = B.vx - A.vx, dy = B.vy - A.vy;
-  const double vn = nx * dx + ny * dy, vt = -ny * dx + nx * dy;
-  const double un1 = vn + r1.bn - B.w * r1.c2t + A.w * r1.c1t;
-  const double ut1 = vt + r1.bt + B.w * r1.c2n - A.w * r1.c1n;
-  const double un2 = vn + r2.bn - B.w * r2.c2t + A.w * r2.c1t;
-  const double ut2 = vt + r2.bt + B.w * r2.c2n - A.w * r2.c1n;
+  // The rows' velocities, offsets included, as the production sweep has them.
+  const cd::sweep::BodyCoupling<true> coupling{vel};
+  double un1, ut1, un2, ut2;
+  coupling.velocity(r1, un1, ut1);
+  coupling.velocity(r2, un2, ut2);
   // Velocities with the pair's own impulses removed (full 4x4 block).
   const double pn1 = r1.pn, pt1 = r1.pt, pn2 = r2.pn, pt2 = r2.pt;
   const double bn1 = un1 - (r1.wnn * pn1 + r1.wnt * pt1 + X.n1n2 * pn2 + X.n1t2 * pt2);

@@ -5,7 +5,8 @@
 // sweep order, the convergence test, the boundary dofs and the residuals are
 // this code for both, so a frozen problem is replayed by the production
 // solver. Studies that visit rows in their own order (cd/bench/ss_pair) use
-// BodyCoupling's update, the sweep's own row update, rather than a copy.
+// BodyCoupling's update, the sweep's own row update, rather than a copy, and
+// solve_units, this sweep's convergence test and residuals in their order.
 //
 // A coupling provides
 //   template <class L, bool Write1>
@@ -158,17 +159,38 @@ void residuals(const std::vector<ContactRow>& rows, const C& c, int min_parallel
   st.residual_mean = rsum / n / scale;
 }
 
+// A problem without rows: the dofs keep their free velocity, nothing to solve.
+inline SolveStats no_rows(std::vector<BoundaryDof>* dofs) {
+  if (dofs)
+    for (BoundaryDof& d : *dofs) d.v = d.v0;
+  return {};
+}
+
+// The end of a sweep: the convergence test on the sweep's sums (dsum of
+// |dp|^2, psum of |p| over the n rows), the dofs' update, the observer.
+// Returns true when the solve stops (dp_rel < tol and every dof converged,
+// or max_iter sweeps).
+inline bool end_sweep(int it, double dsum, double psum, int n, ContactRow* R,
+                      std::vector<BoundaryDof>* dofs, const SolverParams& prm,
+                      const SweepObserver& observer, SolveStats& st) {
+  st.p_mean = psum / n;
+  const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
+  st.dp_rel = std::sqrt(dsum / n) / scale;
+  st.iterations = it;
+  st.dof_rel = 0.0;
+  if (dofs)
+    for (BoundaryDof& d : *dofs) st.dof_rel = std::max(st.dof_rel, update_dof(d, R));
+  if (observer) observer(it, st.dp_rel);
+  return it >= prm.max_iter || (st.dp_rel < prm.tol && st.dof_rel < prm.tol);
+}
+
 template <class L, class C>
 SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
                  const SolverParams& prm, std::vector<BoundaryDof>* dofs,
                  const SweepObserver& observer) {
+  if (rows.empty()) return no_rows(dofs);
   SolveStats st;
   const int n = static_cast<int>(rows.size());
-  if (n == 0) {
-    if (dofs)
-      for (BoundaryDof& d : *dofs) d.v = d.v0;
-    return st;
-  }
 
   const int ncol = static_cast<int>(col.start.size()) - 1;
   std::vector<RowBlock> blocks;
@@ -207,22 +229,12 @@ SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
       }
 #pragma omp single
       {
-        ++it;
         double dsum = 0, psum = 0;
         for (int b = 0; b < nb; ++b) {
           dsum += bs[b].dp2sum;
           psum += bs[b].psum;
         }
-        st.p_mean = psum / n;
-        const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
-        st.dp_rel = std::sqrt(dsum / n) / scale;
-        st.iterations = it;
-        st.dof_rel = 0.0;
-        if (dofs)
-          for (BoundaryDof& d : *dofs) st.dof_rel = std::max(st.dof_rel, update_dof(d, R));
-        if (observer) observer(it, st.dp_rel);
-        if (it >= prm.max_iter) done = true;
-        if (st.dp_rel < prm.tol && st.dof_rel < prm.tol) done = true;
+        done = end_sweep(++it, dsum, psum, n, R, dofs, prm, observer, st);
       }
       // implicit barrier: every thread sees the same 'done'
     }
@@ -231,6 +243,36 @@ SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
   residuals(rows, c, prm.min_parallel, st);
   // Written as "not converged", so that a NaN criterion counts as a cap hit.
   st.cap_hit = !(st.dp_rel < prm.tol && st.dof_rel < prm.tol);
+  return st;
+}
+
+// Sequential symmetric Gauss-Seidel over `units` groups of rows in the
+// caller's order, for studies that visit rows in their own order
+// (cd/bench/ss_pair: a side-side pair as one block): update(k, backward,
+// dp2, pabs) updates unit k (dp2 and pabs summed over its rows, as a row
+// update gives them); units go forward on odd sweeps, backward on even ones,
+// and dp2, pabs are summed in visiting order. The convergence test, the
+// dofs, the observer and the residuals are solve's. One thread.
+template <class C, class Update>
+SolveStats solve_units(std::vector<ContactRow>& rows, int units, const C& c,
+                       const SolverParams& prm, std::vector<BoundaryDof>* dofs,
+                       const SweepObserver& observer, Update&& update) {
+  if (rows.empty()) return no_rows(dofs);
+  SolveStats st;
+  const int n = static_cast<int>(rows.size());
+  for (int it = 0;;) {
+    const bool backward = (it % 2) == 1;
+    double dsum = 0, psum = 0;
+    for (int kk = 0; kk < units; ++kk) {
+      double dp2, pabs;
+      update(backward ? units - 1 - kk : kk, backward, dp2, pabs);
+      dsum += dp2;
+      psum += pabs;
+    }
+    if (end_sweep(++it, dsum, psum, n, rows.data(), dofs, prm, observer, st)) break;
+  }
+  residuals(rows, c, prm.min_parallel, st);
+  st.cap_hit = st.dp_rel >= prm.tol || st.dof_rel >= prm.tol;
   return st;
 }
 
