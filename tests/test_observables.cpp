@@ -1,14 +1,27 @@
 // cd/src/observables.hpp on hand-made networks with known answers (stress,
-// force-bearing, rattlers, packing fraction, fabric).
+// force-bearing, rattlers, packing fraction, fabric), and end to end: the z
+// that cdsim writes in series.csv on a cohesive run is the z cdanalysis
+// computes from the same step's snapshot.
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <numbers>
 #include <random>
+#include <sstream>
 
+#include "analysis/src/coordination.hpp"
+#include "analysis/src/run.hpp"
+#include "analysis/src/snapshot.hpp"
+#include "analysis/src/stress.hpp"
+#include "cli_util.hpp"
 #include "observables.hpp"
 
+namespace fs = std::filesystem;
 using namespace cd::obs;
 constexpr double pi = std::numbers::pi;
 
@@ -223,4 +236,93 @@ TEST(Observables, ThreeDimensionalSimpleCubicLattice) {
   const auto c = coordination<3>(cs, ids);
   EXPECT_EQ(c.force_bearing, 12u);
   EXPECT_EQ(c.z, 3.0);
+}
+
+// ---- end to end ----
+
+namespace {
+
+// series.csv as name -> column of strings (exactly as written).
+std::map<std::string, std::vector<std::string>> read_series_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream hs(line);
+  for (std::string c; std::getline(hs, c, ',');) names.push_back(c);
+  std::map<std::string, std::vector<std::string>> cols;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::size_t k = 0;
+    for (std::string c; std::getline(ls, c, ','); ++k) cols[names.at(k)].push_back(c);
+  }
+  return cols;
+}
+
+// As Series::row writes a value.
+std::string as_written(double v) {
+  return v == std::trunc(v) && std::abs(v) < 9007199254740992.0 ? fmt::format("{:.0f}", v)
+                                                                  : fmt::format("{:.10g}", v);
+}
+
+}  // namespace
+
+// A short cohesive shear run (eta = 10: many contacts pull, some at the
+// pull-off force -f_a) from a small compacted sample, with a series row at
+// every step and a snapshot at the last step: the series' z and
+// non_rattler in the last row are what cdanalysis computes from the
+// snapshot, and so is its stress (the row's interval is that one step).
+TEST(ObservablesEndToEnd, CohesiveRunSeriesZEqualsAnalysisOfTheSnapshot) {
+  const fs::path d = cdtest::scratch_dir("test_observables", "cohesive");
+  const std::string cdsim = std::string(CDLAB_BINARY_DIR "/cd/cdsim ") + CDLAB_SOURCE_DIR + "/configs/";
+  // 120 disks compacted isotropically at p = 100 N/m (1.6 s).
+  const auto prep = cdtest::run_command(
+      cdsim + "shear-prep.toml --quiet --out " + (d / "prep").string() +
+      " --set particles.n=120 --set shear.width=0.0165 --set shear.height=0.0185 --set solver.tol=1e-3");
+  ASSERT_EQ(prep.code, 0) << prep.out;
+  // Then 100 steps of the cohesive protocol at I = 0.1 (dt = dt_tp t_p,
+  // t_p = d sqrt(rho/p)).
+  const int steps = 100;
+  const double dt = 0.05 * 1e-3 * std::sqrt(2.6 / 100.0);
+  const fs::path run = d / "cohesive";
+  const auto r = cdtest::run_command(fmt::format(
+      "{}shear-cohesive.toml --quiet --out {} --set shear.start={} --set shear.strain=0"
+      " --set shear.inertial_number=0.1 --set time.duration={:.17g}"
+      " --set output.series_interval={:.17g} --set output.snapshot_interval={:.17g}",
+      cdsim, run.string(), (d / "prep" / "checkpoint.bin").string(), steps * dt, dt, steps * dt));
+  ASSERT_EQ(r.code, 0) << r.out;
+
+  auto series = read_series_text(run / "series.csv");
+  ASSERT_TRUE(series.count("z")) << "not a shear run";
+  ASSERT_EQ(series["step"].back(), std::to_string(steps));
+  ASSERT_EQ(cda::list_snapshots(run.string(), "contacts").size(), 2u);  // steps 0 and 100
+  const auto contacts = cda::read_contacts(cda::snapshot_path(run.string(), "contacts", -1));
+  const auto particles = cda::read_particles(cda::snapshot_path(run.string(), "particles", -1));
+
+  // The run is cohesive: contacts pull, some at the pull-off force f_a =
+  // eta p d = 1 N/m (the ones the former series rule, p_n + f_a dt > 0,
+  // left out), and the network is a dense one.
+  std::size_t pulling = 0, at_pull_off = 0;
+  for (const auto& c : contacts) {
+    pulling += c.fn < 0;
+    at_pull_off += std::abs(c.fn + 1.0) < 1e-9;
+  }
+  EXPECT_GT(pulling, 5u);
+  EXPECT_GT(at_pull_off, 0u);
+
+  const auto conn = cda::connectivity(contacts, particles);
+  EXPECT_GT(conn.z, 3.0);
+  EXPECT_EQ(series["z"].back(), as_written(conn.z));
+  EXPECT_EQ(series["non_rattler"].back(), as_written(conn.non_floating));
+
+  // Stress: the same sum over the same forces (the normals come back from
+  // the file as angles: equal to round-off). The series divides by the cell
+  // at the step's midpoint, which it does not print: compare ratios.
+  const auto s = cda::contact_stress(contacts, 1.0);
+  const double syy = std::stod(series["syy"].back());
+  EXPECT_NEAR(s.xx / s.yy, std::stod(series["sxx"].back()) / syy, 1e-8);
+  EXPECT_NEAR(s.xy / s.yy, std::stod(series["sxy"].back()) / syy, 1e-8);
+  EXPECT_NEAR(s.yx / s.yy, std::stod(series["syx"].back()) / syy, 1e-8);
+  EXPECT_NEAR(s.q_over_p(), std::stod(series["q_over_p"].back()), 1e-8);
+  if (!HasFailure()) fs::remove_all(d);
 }
