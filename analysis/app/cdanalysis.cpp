@@ -210,6 +210,8 @@ int main(int argc, char** argv) {
       fmt::print("check      q/p {:.4f} vs (sum a)/2 {:.4f} (fft), {:.4f} (tensor, with directions)\n",
                  f.stress.q_over_p(), f.fft.sum_half(), f.tensor.sum_half_vector());
       fmt::print("sliding    {:.4f} of force-bearing contacts\n", f.sliding);
+      fmt::print("fabric     <nn> xx {:.4f}  xy {:.4f}  yy {:.4f}\n", f.fabric[0][0], f.fabric[0][1],
+                 f.fabric[1][1]);
       if (f.sv) print_harmonics("sv", *f.sv);
       if (f.ss) print_harmonics("ss", *f.ss);
       if (f.sv_stress) fmt::print("sv stress  p {:.6g} q {:.6g}\n", f.sv_stress->p(), f.sv_stress->q());

@@ -189,12 +189,12 @@ Anisotropy anisotropy_tensor(const ContactSet& cs) {
 }
 
 double sliding_share(const ContactSet& cs, double mu, double tol, double f_eps) {
-  double sum_abs = 0;
-  for (const auto& c : cs) sum_abs += std::abs(c.fn);
-  if (f_eps < 0) f_eps = cs.empty() ? 0 : 1e-9 * sum_abs / static_cast<double>(cs.size());
+  const auto forces = as_forces(cs);
+  if (f_eps < 0) f_eps = cd::obs::force_threshold<2>(forces);
   std::size_t bearing = 0, sliding = 0;
-  for (const auto& c : cs) {
-    if (std::abs(c.fn) + std::abs(c.ft) <= f_eps) continue;
+  for (std::size_t k = 0; k < cs.size(); ++k) {
+    const auto& c = cs[k];
+    if (!cd::obs::bears_force(forces[k], f_eps)) continue;
     ++bearing;
     const bool slides = mu > 0 ? std::abs(c.ft) >= mu * c.fn * (1 - tol) : c.status == 2;
     if (slides) ++sliding;

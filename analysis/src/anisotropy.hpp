@@ -86,9 +86,10 @@ Anisotropy anisotropy_fft(const ContactSet& cs, int bins = 36);
 // The FFT method also needs most bins occupied (empty ones are interpolated).
 Anisotropy anisotropy_tensor(const ContactSet& cs);
 
-// Contacts that bear force and are sliding: status 2 among contacts with
-// |fn| + |ft| > f_eps (default as in coordination.hpp). With mu > 0 the test
-// is |ft| >= mu fn (1 - tol) instead of the status flag.
+// Contacts that bear force and are sliding: status 2 among the contacts
+// that bear force (cd::obs::bears_force; f_eps < 0: cd::obs::force_threshold
+// of cs). With mu > 0 the test is |ft| >= mu fn (1 - tol) instead of the
+// status flag.
 double sliding_share(const ContactSet& cs, double mu = 0, double tol = 1e-6, double f_eps = -1);
 
 }  // namespace cda

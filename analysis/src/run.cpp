@@ -88,12 +88,18 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume)
   f.file = snapshot_path(run_dir, "contacts", k);
   const auto raw = read_contacts(f.file);
   f.contacts = raw.size();
-  // Fabric over force-bearing physical contacts: an open contact (alert
+  // Fabric over force-bearing physical contacts (cd::obs::bears_force, the
+  // threshold of the whole snapshot, as for z): an open contact (alert
   // distance, or a bond that just broke) carries no force and is no part
   // of the network whose anisotropy is measured.
-  ContactSet cs;
-  for (const auto& c : merge_side_side(raw))
-    if (c.fn != 0 || c.ft != 0) cs.push_back(c);
+  const auto forces = as_forces(raw);
+  const double f_eps = cd::obs::force_threshold<2>(forces);
+  // Points are tested before the side-side points are merged: a pair bears
+  // force when one of its points does, even if their forces cancel.
+  ContactSet bearing;
+  for (std::size_t k = 0; k < raw.size(); ++k)
+    if (cd::obs::bears_force(forces[k], f_eps)) bearing.push_back(raw[k]);
+  const ContactSet cs = merge_side_side(bearing);
   f.physical_contacts = cs.size();
   if (cs.empty()) throw AnalysisError(fmt::format("'{}' has no force-bearing contact", f.file));
   f.fft = anisotropy_fft(cs, bins);
@@ -102,7 +108,8 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume)
   f.has_volume = volume > 0;
   const double V = f.has_volume ? volume : 1.0;
   f.stress = contact_stress(raw, V);
-  f.sliding = sliding_share(cs);
+  f.sliding = sliding_share(cs, 0, 1e-6, f_eps);
+  f.fabric = cd::obs::fabric_tensor<2>(forces, f_eps);
   for (int type : {1, 2}) {
     const auto sub = of_type(cs, type);
     if (sub.empty()) continue;
@@ -115,7 +122,7 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume)
        ("particles" + fs::path(f.file).filename().string().substr(std::string("contacts").size())))
           .string();
   std::error_code ec;
-  if (fs::exists(pfile, ec)) f.connectivity = connectivity(raw, read_particles(pfile));
+  if (fs::exists(pfile, ec)) f.connectivity = connectivity(raw, read_particles(pfile), f_eps);
   return f;
 }
 

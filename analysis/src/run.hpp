@@ -60,6 +60,7 @@ struct RunFabric {
   Stress stress;               // with the given volume (1 if none: stress times V)
   bool has_volume = false;
   double sliding = 0;
+  cd::obs::Tensor<2> fabric{};  // fabric tensor <n n> over the force-bearing physical contacts
   std::optional<Connectivity> connectivity;  // when the particles snapshot exists
   // Per-type partial results (sv, ss), when the set has such contacts.
   std::optional<Anisotropy> sv, ss;

@@ -30,6 +30,14 @@ double Contact::ny() const { return std::sin(theta); }
 double Contact::ln() const { return lx * nx() + ly * ny(); }
 double Contact::lt() const { return -lx * ny() + ly * nx(); }
 
+std::vector<cd::obs::Contact<2>> as_forces(const ContactSet& cs) {
+  std::vector<cd::obs::Contact<2>> out;
+  out.reserve(cs.size());
+  for (const auto& c : cs)
+    out.push_back(cd::obs::contact_2d(c.b1, c.b2, c.nx(), c.ny(), c.fn, c.ft, c.lx, c.ly));
+  return out;
+}
+
 ContactSet of_type(const ContactSet& cs, int type) {
   ContactSet out;
   for (const auto& c : cs)

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cd/src/observables.hpp"
 #include "error.hpp"
 
 namespace cda {
@@ -46,6 +47,10 @@ ContactSet of_type(const ContactSet& cs, int type);
 // first point. Other contacts are copied as they are. Fabric statistics use
 // physical contacts; stress may use either (the sum is the same).
 ContactSet merge_side_side(const ContactSet& cs);
+
+// The contacts as observables.hpp takes them (same order): the stress,
+// force-bearing and coordination definitions shared with cdsim.
+std::vector<cd::obs::Contact<2>> as_forces(const ContactSet& cs);
 
 // Readers. Throw AnalysisError naming the file when it is missing, unreadable,
 // or lacks a required array. The branch vector comes from the cell array

@@ -8,11 +8,8 @@
 
 namespace cda {
 
-double Stress::p() const { return 0.5 * (xx + yy); }
-double Stress::q() const {
-  const double d = 0.5 * (xx - yy), s = 0.5 * (xy + yx);
-  return std::hypot(d, s);
-}
+double Stress::p() const { return cd::obs::mean_2d({{{xx, xy}, {yx, yy}}}); }
+double Stress::q() const { return cd::obs::deviator_2d({{{xx, xy}, {yx, yy}}}); }
 double Stress::q_over_p() const {
   const double pp = p();
   return pp != 0 ? q() / pp : std::numeric_limits<double>::quiet_NaN();
@@ -26,19 +23,12 @@ double Stress::skew() const { return 0.5 * (xy - yx); }
 
 Stress contact_stress(const ContactSet& cs, double volume) {
   if (!(volume > 0)) throw AnalysisError(fmt::format("stress: volume {} is not positive", volume));
+  const auto t = cd::obs::contact_stress<2>(as_forces(cs), volume);
   Stress s;
-  for (const auto& c : cs) {
-    const double nx = c.nx(), ny = c.ny();
-    const double fx = c.fn * nx - c.ft * ny, fy = c.fn * ny + c.ft * nx;
-    s.xx += fx * c.lx;
-    s.xy += fx * c.ly;
-    s.yx += fy * c.lx;
-    s.yy += fy * c.ly;
-  }
-  s.xx /= volume;
-  s.xy /= volume;
-  s.yx /= volume;
-  s.yy /= volume;
+  s.xx = t[0][0];
+  s.xy = t[0][1];
+  s.yx = t[1][0];
+  s.yy = t[1][1];
   return s;
 }
 

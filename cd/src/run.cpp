@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <numbers>
 
 #include <fmt/format.h>
 
@@ -88,81 +87,25 @@ struct Interval {
   }
 };
 
-// Coordination of the force-bearing network: physical contacts (the points
-// of a side-side contact count once) with p_n + adhesion > 0 between a
-// dynamic body and any body; rattlers (dynamic bodies with fewer than 2 such
-// contacts, removed until none is left) are excluded from both counts.
-// Returns z and the fraction of dynamic bodies that are not rattlers.
-std::pair<double, double> coordination(const World& w) {
-  const Bodies& b = w.bodies;
-  const auto& rows = w.rows();
-  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
-  for (const ContactRow& r : rows)
-    if (r.pn + r.adh > 0.0) pairs.emplace_back(std::min(r.b1, r.b2), std::max(r.b1, r.b2));
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  // Adjacency (CSR) and a work list: each body is removed once and each
-  // pair visited twice, O(N + C) (the 2-core of the network is unique, so
-  // the order of removal does not change it).
-  const std::size_t nb = b.size();
-  std::vector<int> deg(nb, 0), start(nb + 1, 0), adj(2 * pairs.size());
-  for (const auto& [i, j] : pairs) {
-    ++deg[i];
-    ++deg[j];
-  }
-  for (std::size_t i = 0; i < nb; ++i) start[i + 1] = start[i] + deg[i];
-  {
-    std::vector<int> fill(start.begin(), start.end() - 1);
-    for (const auto& [i, j] : pairs) {
-      adj[fill[i]++] = j;
-      adj[fill[j]++] = i;
-    }
-  }
-  std::vector<std::uint8_t> out(nb, 0);  // 1: not dynamic, 2: rattler
-  std::vector<int> todo;
-  for (std::size_t i = 0; i < nb; ++i) {
-    out[i] = !b.is_dynamic(i);
-    if (!out[i] && deg[i] < 2) {
-      out[i] = 2;
-      todo.push_back(static_cast<int>(i));
-    }
-  }
-  while (!todo.empty()) {
-    const int i = todo.back();
-    todo.pop_back();
-    for (int k = start[i]; k < start[i + 1]; ++k) {
-      const int o = adj[k];
-      if (out[o]) continue;
-      if (--deg[o] < 2) {
-        out[o] = 2;
-        todo.push_back(o);
-      }
-    }
-  }
-  std::size_t n = 0, nd = 0;
-  long ends = 0;
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    if (!b.is_dynamic(i)) continue;
-    ++nd;
-    if (out[i]) continue;
-    ++n;
-    ends += deg[i];
-  }
-  return {n ? double(ends) / n : 0.0, nd ? double(n) / nd : 0.0};
+// Coordination of the last step's contacts, by obs::coordination (the
+// definitions are in observables.hpp): the particles are the dynamic bodies.
+obs::Coordination coordination(const World& w) {
+  std::vector<std::int32_t> particles;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i)
+    if (w.bodies.is_dynamic(i)) particles.push_back(static_cast<std::int32_t>(i));
+  return obs::coordination<2>(w.contact_forces(), particles);
 }
 
-// Area of the particles in the cell: dynamic bodies, and half of each
-// wall grain (its centre is on the cell's edge).
-double solid_area(const Bodies& b) {
-  double a = 0;
+// Packing fraction, obs::packing_fraction: the particles' areas and half of
+// each wall grain's (its centre is on the cell's edge), over the cell area V.
+double packing_fraction(const Bodies& b, double V) {
+  std::vector<double> area, weight;
   for (std::size_t i = 0; i < b.size(); ++i) {
     if (b.shape[i] == Shape::Segment) continue;
-    const double n = b.nsides[i], R = b.radius[i];
-    const double area = n > 0 ? 0.5 * n * R * R * std::sin(2 * std::numbers::pi / n)
-                              : std::numbers::pi * R * R;
-    a += b.is_dynamic(i) ? area : 0.5 * area;
+    area.push_back(obs::particle_area(b.radius[i], b.nsides[i]));
+    weight.push_back(b.is_dynamic(i) ? 1.0 : 0.5);
   }
-  return a;
+  return obs::packing_fraction(area, weight, V);
 }
 
 // Protocol columns: stress averaged over the steps of the interval.
@@ -191,7 +134,6 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   const std::int64_t nsteps = std::llround(run_duration(s) / dt);
   const bool shear = s.shear_mode != "none";
   const double d_mean = mean_diameter(s);
-  const double area = shear ? solid_area(w.bodies) : 0.0;
   // An interval in steps, >= 1; one longer than the run is the run (no
   // overflow for huge intervals).
   const auto steps_of = [&](double interval) {
@@ -323,11 +265,11 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
           // positive; p = (s1 + s2)/2, q = (s1 - s2)/2 from the symmetric part.
           const Eigen::Matrix2d S = sh.sigma / sh.steps;
           const double sxx = S(0, 0), syy = S(1, 1), sxy = 0.5 * (S(0, 1) + S(1, 0));
-          const double p = 0.5 * (sxx + syy);
-          const double q = std::sqrt(0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy);
+          const obs::Tensor<2> St = {{{S(0, 0), S(0, 1)}, {S(1, 0), S(1, 1)}}};
+          const double p = obs::mean_2d(St), q = obs::deviator_2d(St);
           const double V = w.cell.width * w.cell.height;
           const double gd = w.shear_rate();
-          const auto [z, nonrattler] = coordination(w);
+          const obs::Coordination zc = coordination(w);
           const Eigen::Matrix2d K = w.kinetic_stress();  // at the row's step
           cols.insert(cols.end(), {{"strain", w.cell.strain},
                       {"shear_rate", gd},
@@ -345,9 +287,9 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
                       {"inertial_number", syy + K(1, 1) > 0
                                               ? gd * d_mean * std::sqrt(s.density / (syy + K(1, 1)))
                                               : 0.0},
-                      {"packing_fraction", area / V},
-                      {"z", z},
-                      {"non_rattler", nonrattler},
+                      {"packing_fraction", V > 0 ? packing_fraction(w.bodies, V) : 0.0},
+                      {"z", zc.z},
+                      {"non_rattler", zc.non_rattler},
                       {"cell_width", w.cell.width},
                       {"cell_height", w.cell.height},
                       {"volume_strain_rate",

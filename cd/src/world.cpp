@@ -288,15 +288,24 @@ Eigen::Matrix2d World::kinetic_stress() const {
   return k / V;
 }
 
-Eigen::Matrix2d World::contact_stress(double volume) const {
-  Eigen::Matrix2d s = Eigen::Matrix2d::Zero();
+std::vector<obs::Contact<2>> World::contact_forces() const {
+  std::vector<obs::Contact<2>> cs;
+  cs.reserve(prob_.rows.size());
+  const double dt = prm_.dt;
   for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
     const ContactRow& r = prob_.rows[k];
-    const Vec2 p(r.nx * r.pn - r.ny * r.pt, r.ny * r.pn + r.nx * r.pt);
-    s += p * Vec2(info_[k].lx, info_[k].ly).transpose();
+    cs.push_back(obs::contact_2d(r.b1, r.b2, r.nx, r.ny, r.pn / dt, r.pt / dt, info_[k].lx,
+                                 info_[k].ly));
   }
+  return cs;
+}
+
+Eigen::Matrix2d World::contact_stress(double volume) const {
   const double V = volume > 0.0 ? volume : cell_volume();
-  return s / ((V > 0.0 ? V : 1.0) * prm_.dt);  // no volume: stress times V
+  const auto s = obs::contact_stress<2>(contact_forces(), V > 0.0 ? V : 1.0);  // no volume: stress times V
+  Eigen::Matrix2d m;
+  m << s[0][0], s[0][1], s[1][0], s[1][1];
+  return m;
 }
 
 double World::kinetic_energy() const {

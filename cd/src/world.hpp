@@ -25,6 +25,7 @@
 #include "contact_problem.hpp"
 #include "detect.hpp"
 #include "nlgs.hpp"
+#include "observables.hpp"
 
 namespace cd {
 
@@ -138,10 +139,15 @@ class World {
   // Walls mode: the bodies glued to the top wall (driven, moved together).
   std::vector<std::int32_t> top_wall;
 
-  // Contact stress of the last step (method.md section 10): sigma_ij =
-  // (1/V) sum_c f_i l_j, f the force on body 2, l the branch vector from
-  // body 1; compression positive. V: `volume` if given, else the cell area at
-  // the midpoint (LeesEdwards, Walls); neither: the sum itself (stress times V).
+  // The last step's contacts as forces (impulses / dt) on body 2, with
+  // their normals and branch vectors (midpoint configuration), in row
+  // order: what observables.hpp measures, and what contacts_NNNNN.vtp holds.
+  std::vector<obs::Contact<2>> contact_forces() const;
+  // Contact stress of the last step, obs::contact_stress (method.md section
+  // 10): sigma_ij = (1/V) sum_c f_i l_j, f the force on body 2, l the branch
+  // vector from body 1; compression positive. V: `volume` if given, else the
+  // cell area at the midpoint (LeesEdwards, Walls); neither: the sum itself
+  // (stress times V).
   Eigen::Matrix2d contact_stress(double volume = 0.0) const;
   double cell_volume() const { return cm_.width * cm_.height; }  // midpoint cell area
   // Kinetic stress (1/V) sum m v' v'^T over dynamic bodies, v' the velocity
