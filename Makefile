@@ -8,7 +8,7 @@ SCENE ?= configs/default.toml
 CAMPAIGNS ?= outputs/campaigns
 OUT   ?= outputs/default
 
-# Debian 12 packages the build needs (docs in README, facts in shared/docs/deps.md).
+# Debian 12 packages the build needs (what each is for: README.md, "Two commands").
 DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libvtk9-dev libgtest-dev libtoml11-dev libcli11-dev libfmt-dev \
             libbenchmark-dev gnuplot-nox
