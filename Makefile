@@ -34,14 +34,19 @@ help:
 	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
 
 # Idempotent: asks dpkg which packages are missing and installs only those.
-deps:
-	@missing=$$(for p in $(DEB_PKGS); do \
+# $(call install_missing,TARGET,PACKAGES)
+define install_missing
+	@missing=$$(for p in $(2); do \
 	    dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
-	  echo "make deps: installing $$missing"; \
+	  echo "make $(1): installing $$missing"; \
 	  $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
-	else echo "make deps: all Debian packages present"; fi
+	else echo "make $(1): all Debian packages present"; fi
+endef
+
+deps:
+	$(call install_missing,deps,$(DEB_PKGS))
 
 $(BUILD)/CMakeCache.txt: | deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -70,6 +75,29 @@ scene-doc: build
 	    '(`tests/test_help_scene.cpp` checks that this file is what cdsim prints).' '' \
 	    '<!-- cdsim --help-scene -->'; \
 	  $(BUILD)/cd/cdsim --help-scene; } > $(SCENE_DOC).tmp && mv $(SCENE_DOC).tmp $(SCENE_DOC)
+
+# ---- Figures (docs/figures/; not part of make test) -------------------------
+# The README's picture: the default scene's pile with its force chains,
+# rendered by ParaView's pvbatch from the run's VTK files. Debian's ParaView
+# renders through GLX only, hence xvfb. Its Python package python3-paraview
+# conflicts with python3-vtk9, which libvtk9-dev (the build) depends on:
+# installing it would remove libvtk9-dev, so it is unpacked into the build
+# folder instead (apt-get download + dpkg -x), never installed.
+FIG_PKGS := paraview xvfb xauth
+FIG_RUN := $(BUILD)/figures/default
+PVPY := $(BUILD)/figure-tools/pvpy
+figures: build
+	$(call install_missing,figures,$(FIG_PKGS))
+	@if [ ! -d $(PVPY)/usr/lib/python3/dist-packages/paraview ]; then \
+	  echo "make figures: unpacking python3-paraview into $(PVPY) (not installed: see the Makefile)"; \
+	  mkdir -p $(PVPY) && cd $(dir $(PVPY)) && rm -f python3-paraview_*.deb && \
+	  apt-get download python3-paraview && dpkg -x python3-paraview_*.deb pvpy; fi
+	$(CDSIM) configs/default.toml --out $(FIG_RUN) --quiet --fresh
+	mkdir -p docs/figures
+	PYTHONPATH=$(abspath $(PVPY))/usr/lib/python3/dist-packages \
+	  xvfb-run -a -s "-screen 0 1600x1200x24" pvbatch docs/figures/render.py $(FIG_RUN) docs/figures/force-chains.png
+	@dpkg-query -W -f='$${Status}\n' libvtk9-dev 2>/dev/null | grep -q '^install ok installed' || \
+	  { echo "make figures: libvtk9-dev is no longer installed: run make deps"; exit 1; }
 
 # Timings are comparable only with the machine named: machine.csv (CPU, cores,
 # compiler, flags, load average) is written next to the results.
