@@ -57,7 +57,7 @@ build: deps $(BUILD)/CMakeCache.txt
 run: build
 	$(BUILD)/cd/cdsim $(SCENE) --out $(OUT)
 	@echo ""
-	@echo "Outputs in $(OUT)/: series.csv (time series, columns in README.md), scene.toml"
+	@echo "Outputs in $(OUT)/: series.csv (time series, columns in docs/outputs.md), scene.toml"
 	@echo "(resolved scene), shapes.pvd, particles.pvd, contacts.pvd, walls.pvd (VTK collections)."
 	@echo "Open in ParaView:  paraview $(OUT)/shapes.pvd   (grains as drawn; colour by velocity)"
 
@@ -109,11 +109,11 @@ bench: build
 accuracy-cost: build
 	$(BUILD)/cd/bench/accuracy_cost --out outputs/accuracy-cost $(if $(QUICK),--quick)
 
-# Cohesion against the time step (README, "Cohesion and the time step").
+# Cohesion against the time step (docs/accuracy.md, "Cohesion and the time step").
 tensile: build
 	$(BUILD)/cd/bench/tensile --out outputs/tensile $(if $(QUICK),--quick)
 
-# ---- Campaigns (README, "Shear protocols and campaigns") -------------------
+# ---- Campaigns (docs/shear.md) ----------------------------------------------
 # Each run is a make target whose product is its folder (marked complete by
 # a .done file written after cdsim succeeds), so `make -j` runs campaigns in
 # parallel, finished runs are skipped, and a killed run resumes from its
