@@ -1,6 +1,6 @@
 // Frozen contact problems: the matrix form of the simulator's problem
 // (assemble_problem), and replay of problems dumped by other codes
-// (shared/data/contact-problems, Siconos .dat text format).
+// (tests/data/contact-problems, Siconos .dat text format).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -19,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 using Eigen::VectorXd;
 
-const std::string kData = CDLAB_SHARED_DIR "/data/contact-problems/";
+const std::string kData = CDLAB_TEST_DATA "/contact-problems/";
 
 // ---- assembling the simulator's problem ------------------------------------
 

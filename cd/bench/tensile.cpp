@@ -80,7 +80,7 @@ struct Options {
   std::string out = "outputs/tensile";
   int n = 300;
   std::vector<unsigned> seeds = {1, 2, 3};
-  // dt / t_a; the crossover V dt = 2 delta_a (see README) is at dt = 2 t_a.
+  // dt / t_a; the crossover V dt = 2 delta_a (see docs/accuracy.md) is at dt = 2 t_a.
   std::vector<double> dt = {3e-3, 1e-2, 3e-2, 0.1, 0.3, 1.0, 1.5, 2.5, 4.0};
   double speed = 0.01;    // V, d / t_a
   double debond = 0.01;   // delta_a, d
@@ -458,7 +458,7 @@ int main(int argc, char** argv) {
     for (const auto& [kind, nx] : {std::pair<std::string, int>{"chain", 1}, {"square", 8}}) {
       Run r = pull(lattice(nx, 8), kind, 0, dt, o.tol, o.speed, o, false);
       // Chain: T = f_a, sigma = f_a / d; lattice: sigma = f_a / d. Exact up
-      // to the solver's velocity error eps_f f_a dt / (m V) (see README);
+      // to the solver's velocity error eps_f f_a dt / (m V) (see docs/accuracy.md);
       // beyond V dt = 2 delta_a the ceiling's bonds are not seen, and
       // nothing holds.
       const double err = std::abs(r.sigma_t - 1.0);

@@ -34,7 +34,7 @@ struct Problem {
   Eigen::VectorXd mu;             // nc
 };
 
-// .dat text format (shared/data/contact-problems/README.md): dim, nc, W as a
+// .dat text format (tests/data/contact-problems/README.md): dim, nc, W as a
 // Siconos NumericsMatrix (storage type, rows, columns, then the storage's
 // layout), q, mu. Read: storage 0 (dense, column-major: each text line of the
 // file is one column) and 2 (CSparse compressed-column listing, or triplet).

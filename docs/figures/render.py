@@ -1,0 +1,120 @@
+# Renders the front picture of the README: the grains of a cdsim run and its
+# force chains, every force-bearing contact drawn as a tube from centre to
+# centre, coloured and sized by its normal force f_n.
+#
+#   pvbatch docs/figures/render.py RUN_DIR OUT.png
+#
+# RUN_DIR is a cdsim output folder (shapes.pvd, contacts.pvd, walls.pvd); the
+# last snapshot is drawn. `make figures` runs the default scene and calls
+# this under xvfb-run: Debian's ParaView 5.11 renders through GLX only (no
+# EGL, no OSMesa), so it needs an X server, and its Python package
+# (python3-paraview) conflicts with python3-vtk9, which libvtk9-dev needs, so
+# the Makefile unpacks it beside the build instead of installing it.
+import sys
+
+from paraview.simple import (Calculator, CellDatatoPointData, ColorBy, CreateView,
+                             ExtractSurface, GetColorTransferFunction, GetScalarBar, OpenDataFile,
+                             Render, SaveScreenshot, Show, Threshold, Tube)
+
+run, png = sys.argv[1], sys.argv[2]
+W, H = 1200, 840  # pixels; the default pile is 40 d wide and ~27 d high
+
+
+def last_frame(name):
+    src = OpenDataFile(f"{run}/{name}.pvd")
+    ts = list(getattr(src, "TimestepValues", []) or [])
+    t = ts[-1] if ts else 0.0
+    src.UpdatePipeline(t)
+    return src, t
+
+
+view = CreateView("RenderView")
+view.ViewSize = [W, H]
+view.OrientationAxesVisibility = 0
+view.Background = [1.0, 1.0, 1.0]
+try:  # ParaView >= 5.10 takes the background from the palette unless told
+    view.UseColorPaletteForBackground = 0
+except AttributeError:
+    pass
+
+shapes, t = last_frame("shapes")
+view.ViewTime = t
+grains = Show(shapes, view)
+grains.ColorArrayName = ["POINTS", ""]
+grains.AmbientColor = grains.DiffuseColor = [0.86, 0.88, 0.90]
+grains.Ambient, grains.Diffuse = 1.0, 0.0  # flat: the grains are a backdrop
+grains.SetRepresentationType("Surface With Edges")
+grains.EdgeColor = [0.55, 0.57, 0.60]
+
+walls, _ = last_frame("walls")
+wd = Show(walls, view)
+wd.ColorArrayName = ["POINTS", ""]
+wd.AmbientColor = wd.DiffuseColor = [0.1, 0.1, 0.1]
+wd.LineWidth = 3.0
+
+# Force-bearing contacts only (f_n > 0), as tubes whose radius grows
+# linearly with f_n: from 0.02 mm for the weakest to 0.3 mm (0.3 d_mean)
+# for the strongest.
+contacts, _ = last_frame("contacts")
+data_range = contacts.CellData["fn"].GetRange()
+fmax = data_range[1]
+loaded = Threshold(Input=contacts)
+loaded.Scalars = ["CELLS", "fn"]
+try:  # ParaView 5.10+: lower/upper thresholds
+    loaded.LowerThreshold = 1e-6 * fmax
+    loaded.UpperThreshold = fmax
+except AttributeError:
+    loaded.ThresholdRange = [1e-6 * fmax, fmax]
+# Threshold gives an unstructured grid; Tube needs polydata. Each contact
+# line has its own two points, so point data is the line's f_n exactly.
+points = CellDatatoPointData(Input=ExtractSurface(Input=loaded))
+mN = Calculator(Input=points)  # labels in mN read better than 1e-3 N
+mN.ResultArrayName = "fn_mN"
+mN.Function = "1000*fn"
+tubes = Tube(Input=mN)
+tubes.Scalars = ["POINTS", "fn_mN"]
+tubes.Vectors = [None, ""]
+tubes.VaryRadius = "By Scalar"
+tubes.Radius = 2e-5
+tubes.RadiusFactor = 15.0
+tubes.NumberofSides = 12
+td = Show(tubes, view)
+ColorBy(td, ("POINTS", "fn_mN"))
+lut = GetColorTransferFunction("fn_mN")
+lut.ApplyPreset("Inferno (matplotlib)", True)
+lut.InvertTransferFunction()  # light for weak contacts, dark for the chains
+lut.RescaleTransferFunction(0.0, 1000 * fmax)
+td.SetScalarBarVisibility(view, True)
+bar = GetScalarBar(lut, view)
+bar.Title = "contact normal force f_n (mN)"
+bar.ComponentTitle = ""
+bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
+bar.TitleFontSize = 18
+bar.LabelFontSize = 16
+bar.RangeLabelFormat = "%-#.2f"
+bar.UseCustomLabels = 1
+bar.CustomLabels = [0.5 * k for k in range(1, int(2000 * fmax))]
+bar.LabelFormat = "%-#.1f"
+bar.WindowLocation = "Any Location"
+bar.Orientation = "Horizontal"
+bar.Position = [0.30, 0.02]
+bar.ScalarBarLength = 0.40
+
+# Frame the pile, not the whole box (the box is 70 d high for the initial
+# lattice), with a band at the bottom for the colour bar.
+x0, x1, y0, y1 = shapes.GetDataInformation().GetBounds()[:4]
+aspect = W / H
+half_h = 0.5 * max(y1 - y0, (x1 - x0) / aspect) * 1.04
+bar_band = 0.12 * half_h
+cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1) - bar_band
+view.InteractionMode = "2D"
+view.CameraParallelProjection = 1
+Render(view)  # the first render resets the camera: place it afterwards
+cam = view.GetActiveCamera()
+cam.SetFocalPoint(cx, cy, 0.0)
+cam.SetPosition(cx, cy, 1.0)
+cam.SetViewUp(0.0, 1.0, 0.0)
+cam.SetParallelScale(half_h + bar_band)
+Render(view)
+SaveScreenshot(png, view, ImageResolution=[W, H], CompressionLevel="9")
+print(f"{png}: t = {t:g} s, contacts with f_n > 0 drawn, f_n max {fmax:.3g} N")
