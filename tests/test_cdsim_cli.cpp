@@ -1,5 +1,5 @@
 // cdsim as a user meets it: bad input gets one clear message, a non-zero
-// exit, and nothing written; a good run writes what the README promises.
+// exit, and nothing written; a good run writes what docs/outputs.md promises.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 

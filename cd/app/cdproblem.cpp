@@ -52,7 +52,7 @@ int solve(const std::string& path, const cd::NlgsOptions& opt, bool lemke) {
   }
   Eigen::VectorXd r;
   const cd::NlgsStats st = cd::solve_nlgs(p, r, opt);
-  fmt::print("{:>8} {:>12} {:>14} {:>14}\n", "sweep", "max|dr|/|r|", "residual max",
+  fmt::print("{:>8} {:>12} {:>14} {:>14}\n", "sweep", "rms|dr|/|r|", "residual max",
              "residual mean");
   for (const cd::NlgsCheckpoint& c : st.history)
     fmt::print("{:>8} {:>12.3e} {:>14.3e} {:>14.3e}\n", c.sweep, c.dr_rel, c.residual_max,

@@ -2,13 +2,16 @@
 // array, time, step count, stage timers, warm-start memory), so that a run
 // continued from one is bit-identical to a run never stopped.
 //
-// File format (version 2), little-endian, no padding:
+// File format (version 3), little-endian, no padding:
 //   "CDLABCKP"                      8-byte magic
 //   u32 version
 //   u64 scene key                   opaque to this file (run.cpp: hash of the scene)
-//   i64 steps, f64 time, f64 x 4 stage times (detect, solve, integrate, output)
+//   i64 steps, f64 time
 //   arrays, each: u32 name length, name, u64 count, u32 element size, raw elements
-//     one per Bodies member, then "warm.keys", "warm.p" and "cell" (one CellState)
+//     first the stage timers, one f64 per stage of world.hpp's stage table, in
+//     an array named "times:" + the stage names joined by ':' (a build with
+//     other stages refuses the file); then one per Bodies member, then
+//     "warm.keys", "warm.p" and "cell" (one CellState)
 //   u64 FNV-1a of every byte before it
 // A reader checks every size against the file and the checksum, and names the
 // file in any error.

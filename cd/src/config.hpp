@@ -1,8 +1,8 @@
 // Scene files: TOML in, Scene out. Every parameter is bound once, in one
 // table (config.cpp), to its section.key, its default (the Scene member's
 // initialiser), its unit, its rule and its documentation; parsing, the
-// resolved scene.toml, `cdsim --help-scene` and the README table all come
-// from that table.
+// resolved scene.toml, `cdsim --help-scene` and docs/scene-parameters.md
+// (made from it by `make scene-doc`) all come from that table.
 #pragma once
 #include <stdexcept>
 #include <string>

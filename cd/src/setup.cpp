@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "checkpoint.hpp"
+#include "observables.hpp"
 
 namespace cd {
 
@@ -212,9 +213,7 @@ World build_world(const Scene& s) {
         throw SceneError(fmt::format("shear.start: '{}' holds walls or wall grains (body {}); a "
                                      "periodic run starts from a periodic preparation", s.start, i));
       // The masses come with the sample: they must be the scene's.
-      const double n = B.nsides[i], R = B.radius[i];
-      const double area = n > 0 ? 0.5 * n * R * R * std::sin(2 * std::numbers::pi / n)
-                                : std::numbers::pi * R * R;
+      const double area = obs::particle_area(B.radius[i], B.nsides[i]);
       if (std::abs(B.mass[i] / area - s.density) > 1e-9 * s.density)
         throw SceneError(fmt::format("shear.start: the sample's particles have density {:.6g} "
                                      "kg/m^2 (body {}), particles.density is {:.6g}; set "
