@@ -1,4 +1,4 @@
-// cd/src/observables.hpp on hand-made networks with known answers (stress,
+// cd/src/core/observables.hpp on hand-made networks with known answers (stress,
 // force-bearing, rattlers, packing fraction, fabric), and end to end: the z
 // that cdsim writes in series.csv on a cohesive run is the z cdanalysis
 // computes from the same step's snapshot.

@@ -2,7 +2,7 @@
 // non-rattler particles, fraction of non-floating particles, P_c.
 //
 // The definitions (force-bearing, physical contact, rattler, z, P_c) are
-// cd/src/observables.hpp's, shared with cdsim's series columns z and
+// cd/src/core/observables.hpp's, shared with cdsim's series columns z and
 // non_rattler: this is that function on a snapshot. The particles are the
 // particles snapshot's (the dynamic bodies); walls and other boundary
 // bodies are never rattlers and a contact with one counts for the particle.

@@ -1,5 +1,5 @@
 // Contact and particle snapshots as plain data, read from the simulator's
-// contacts_NNNNN.vtp / particles_NNNNN.vtp (format in cd/src/output.hpp).
+// contacts_NNNNN.vtp / particles_NNNNN.vtp (format in cd/src/2d/output.hpp).
 //
 // Frame convention (method.md §1): n points from body 1 to body 2 and
 // t = n rotated by +90 degrees; f = fn n + ft t is the force exerted by body 1
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "cd/src/observables.hpp"
+#include "cd/src/core/observables.hpp"
 #include "error.hpp"
 
 namespace cda {

@@ -1,6 +1,6 @@
 // Contact stress (method.md §10): sigma_ij = (1/V) sum_c f_i l_j, with f the
 // force on body 2 and l the branch vector 1 -> 2, so compression is positive:
-// cd/src/observables.hpp computes it, for cdsim's series too.
+// cd/src/core/observables.hpp computes it, for cdsim's series too.
 // The kinetic part is not included (it needs velocity fluctuations about the
 // mean flow profile; add it where inertia matters).
 #pragma once

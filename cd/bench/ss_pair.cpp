@@ -63,7 +63,7 @@
 #include "pile.hpp"
 #include "problem.hpp"
 #include "ss_pair.hpp"
-#include "sweep.hpp"
+#include "coupling.hpp"
 #include "world.hpp"
 
 namespace {
@@ -346,7 +346,7 @@ SweepStats sweep_solve(std::vector<cd::ContactRow>& rows, std::vector<cd::BodyVe
     c.update<cd::Coulomb, true>(r, dp2, pabs);
   };
   out.st = cd::sweep::solve_units(
-      rows, static_cast<int>(U.u.size()), c, prm, nullptr, {},
+      rows, static_cast<int>(U.u.size()), c, prm, static_cast<std::vector<cd::BoundaryDof>*>(nullptr), {},
       [&](int k, bool backward, double& dp2, double& pabs) {
         const auto [i, j] = U.u[k];
         if (j < 0) {

@@ -44,7 +44,7 @@
 
 #include "bodies.hpp"
 #include "contact.hpp"
-#include "sweep.hpp"
+#include "coupling.hpp"
 
 namespace cdbench {
 

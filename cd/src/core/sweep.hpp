@@ -1,27 +1,30 @@
 // The NLGS sweep (method.md section 5), written once over a "coupling": how a
-// row sees the impulses of the others. nlgs.cpp couples rows through the
-// velocities of the bodies they touch (the simulator's steps); problem.cpp
-// through the off-diagonal blocks of W (frozen problems in matrix form). The
-// sweep order, the convergence test, the boundary dofs and the residuals are
-// this code for both, so a frozen problem is replayed by the production
-// solver. Studies that visit rows in their own order (cd/bench/ss_pair) use
-// BodyCoupling's update, the sweep's own row update, rather than a copy, and
+// row sees the impulses of the others, and over the row type (2D rows
+// today, 3D rows next). 2d/coupling.hpp couples rows through the velocities
+// of the bodies they touch (the simulator's steps); 2d/problem.cpp through
+// the off-diagonal blocks of W (frozen problems in matrix form). The sweep
+// order, the convergence test, the boundary dofs and the residuals are this
+// code for both, so a frozen problem is replayed by the production solver.
+// Studies that visit rows in their own order (cd/bench/ss_pair) use the
+// coupling's update, the sweep's own row update, rather than a copy, and
 // solve_units, this sweep's convergence test and residuals in their order.
 //
-// A coupling provides
+// Nothing here depends on the dimension. A coupling C provides
 //   template <class L, bool Write1>
-//   void update(ContactRow& r, double& dp2, double& pabs)
+//   void update(Row& r, double& dp2, double& pabs)
 //       one local solve of row r with law L; dp2 = |dp|^2, pabs = |p|.
 //       Write1 = false when body 1 is driven (read, never written).
-//   void velocity(const ContactRow& r, double& un, double& ut) const
-//       the law's relative velocity of row r, offsets included (residuals).
+// and the row type provides, found by argument-dependent lookup,
+//   double row_residual(const C& c, const Row& r)   the law residual of r
+//   double impulse_norm(const Row& r)               |p| of r
+//   double update_dof(Dof& d, Row* rows)            one boundary dof update
+//       (returns its residual; see 2d/nlgs.hpp).
 #pragma once
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "law.hpp"
-#include "nlgs.hpp"
+#include "solver.hpp"
 
 namespace cd::sweep {
 
@@ -41,66 +44,8 @@ inline void push_blocks(std::vector<RowBlock>& out, int begin, int end, bool wri
   for (int b = begin; b < end; b += kBlock) out.push_back({b, std::min(end, b + kBlock), write1});
 }
 
-// Rows coupled through the velocities of their bodies (the simulator).
-template <bool Rot>
-struct BodyCoupling {
-  BodyVel* vel;
-
-  // One row update. Write1 = false when body 1 is driven (a wall): it is
-  // read, never written, so rows of one colour may share a wall without a
-  // data race.
-  template <class L, bool Write1>
-  void update(ContactRow& r, double& dp2, double& pabs) const {
-    BodyVel& A = vel[r.b1];
-    BodyVel& B = vel[r.b2];
-    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
-    double un = r.nx * dx + r.ny * dy + r.bn;
-    if constexpr (Rot) un += -B.w * r.c2t + A.w * r.c1t;
-    double ut = 0.0;
-    if constexpr (L::tangential) {
-      ut = -r.ny * dx + r.nx * dy + r.bt;
-      if constexpr (Rot) ut += B.w * r.c2n - A.w * r.c1n;
-    }
-    double pn, pt;
-    L::solve(r, un, ut, pn, pt);
-    const double dpn = pn - r.pn;
-    const double dpt = L::tangential ? pt - r.pt : 0.0;
-    r.pn = pn;
-    if constexpr (L::tangential) {
-      r.pt = pt;
-      pabs = std::sqrt(pn * pn + pt * pt);
-    } else {
-      pabs = std::abs(pn);
-    }
-    dp2 = dpn * dpn + dpt * dpt;
-    const double px = r.nx * dpn - r.ny * dpt, py = r.ny * dpn + r.nx * dpt;
-    B.vx += B.inv_m * px;
-    B.vy += B.inv_m * py;
-    if constexpr (Rot) B.w += B.inv_I * (r.c2n * dpt - r.c2t * dpn);
-    if constexpr (Write1) {
-      A.vx -= A.inv_m * px;
-      A.vy -= A.inv_m * py;
-      if constexpr (Rot) A.w -= A.inv_I * (r.c1n * dpt - r.c1t * dpn);
-    }
-  }
-
-  void velocity(const ContactRow& r, double& un, double& ut) const {
-    const BodyVel& A = vel[r.b1];
-    const BodyVel& B = vel[r.b2];
-    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
-    un = r.nx * dx + r.ny * dy;
-    ut = -r.ny * dx + r.nx * dy;
-    if constexpr (Rot) {
-      un += -B.w * r.c2t + A.w * r.c1t;
-      ut += B.w * r.c2n - A.w * r.c1n;
-    }
-    un += r.bn;
-    ut += r.bt;
-  }
-};
-
-template <class L, class C>
-void run_block(const RowBlock& k, ContactRow* rows, C& c, BlockStats& s) {
+template <class L, class Row, class C>
+void run_block(const RowBlock& k, Row* rows, C& c, BlockStats& s) {
   double dsum = 0, psum = 0;
   if (k.write1) {
     for (int i = k.begin; i < k.end; ++i) {
@@ -122,8 +67,8 @@ void run_block(const RowBlock& k, ContactRow* rows, C& c, BlockStats& s) {
 }
 
 // Law residual of every row (normalised by mean |p|), read-only.
-template <class C>
-void residuals(const std::vector<ContactRow>& rows, const C& c, int min_parallel, SolveStats& st) {
+template <class Row, class C>
+void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, SolveStats& st) {
   const int n = static_cast<int>(rows.size());
   if (n == 0) {
     st.residual_max = st.residual_mean = 0;
@@ -137,10 +82,7 @@ void residuals(const std::vector<ContactRow>& rows, const C& c, int min_parallel
   for (int b = 0; b < nb; ++b) {
     double rmax = 0, rsum = 0;
     for (int i = blocks[b].begin; i < blocks[b].end; ++i) {
-      const ContactRow& r = rows[i];
-      double un, ut;
-      c.velocity(r, un, ut);
-      const double e = law_residual(un, ut, r.pn, r.pt, r.mu, r.adh, 1.0 / r.wnn);
+      const double e = row_residual(c, rows[i]);
       rmax = std::max(rmax, e);
       rsum += e;
     }
@@ -152,7 +94,7 @@ void residuals(const std::vector<ContactRow>& rows, const C& c, int min_parallel
     rmax = std::max(rmax, s.rmax);
     rsum += s.rsum;
   }
-  for (const ContactRow& r : rows) psum += std::sqrt(r.pn * r.pn + r.pt * r.pt);
+  for (const Row& r : rows) psum += impulse_norm(r);
   st.p_mean = psum / n;
   const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
   st.residual_max = rmax / scale;
@@ -160,9 +102,10 @@ void residuals(const std::vector<ContactRow>& rows, const C& c, int min_parallel
 }
 
 // A problem without rows: the dofs keep their free velocity, nothing to solve.
-inline SolveStats no_rows(std::vector<BoundaryDof>* dofs) {
+template <class Dof>
+SolveStats no_rows(std::vector<Dof>* dofs) {
   if (dofs)
-    for (BoundaryDof& d : *dofs) d.v = d.v0;
+    for (Dof& d : *dofs) d.v = d.v0;
   return {};
 }
 
@@ -170,24 +113,23 @@ inline SolveStats no_rows(std::vector<BoundaryDof>* dofs) {
 // |dp|^2, psum of |p| over the n rows), the dofs' update, the observer.
 // Returns true when the solve stops (dp_rel < tol and every dof converged,
 // or max_iter sweeps).
-inline bool end_sweep(int it, double dsum, double psum, int n, ContactRow* R,
-                      std::vector<BoundaryDof>* dofs, const SolverParams& prm,
-                      const SweepObserver& observer, SolveStats& st) {
+template <class Row, class Dof>
+bool end_sweep(int it, double dsum, double psum, int n, Row* R, std::vector<Dof>* dofs,
+               const SolverParams& prm, const SweepObserver& observer, SolveStats& st) {
   st.p_mean = psum / n;
   const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
   st.dp_rel = std::sqrt(dsum / n) / scale;
   st.iterations = it;
   st.dof_rel = 0.0;
   if (dofs)
-    for (BoundaryDof& d : *dofs) st.dof_rel = std::max(st.dof_rel, update_dof(d, R));
+    for (Dof& d : *dofs) st.dof_rel = std::max(st.dof_rel, update_dof(d, R));
   if (observer) observer(it, st.dp_rel);
   return it >= prm.max_iter || (st.dp_rel < prm.tol && st.dof_rel < prm.tol);
 }
 
-template <class L, class C>
-SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
-                 const SolverParams& prm, std::vector<BoundaryDof>* dofs,
-                 const SweepObserver& observer) {
+template <class L, class Row, class C, class Dof>
+SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const SolverParams& prm,
+                 std::vector<Dof>* dofs, const SweepObserver& observer) {
   if (rows.empty()) return no_rows(dofs);
   SolveStats st;
   const int n = static_cast<int>(rows.size());
@@ -203,7 +145,7 @@ SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
   cb[ncol] = static_cast<int>(blocks.size());
   const int nb = cb[ncol];
   std::vector<BlockStats> bs(nb);
-  ContactRow* R = rows.data();
+  Row* R = rows.data();
   const bool parallel = n >= prm.min_parallel;
   bool done = false;
   int it = 0;
@@ -241,8 +183,7 @@ SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
   }
 
   residuals(rows, c, prm.min_parallel, st);
-  // Written as "not converged", so that a NaN criterion counts as a cap hit.
-  st.cap_hit = !(st.dp_rel < prm.tol && st.dof_rel < prm.tol);
+  st.cap_hit = not_converged(st, prm);
   return st;
 }
 
@@ -253,10 +194,9 @@ SolveStats solve(std::vector<ContactRow>& rows, const Colouring& col, C& c,
 // update gives them); units go forward on odd sweeps, backward on even ones,
 // and dp2, pabs are summed in visiting order. The convergence test, the
 // dofs, the observer and the residuals are solve's. One thread.
-template <class C, class Update>
-SolveStats solve_units(std::vector<ContactRow>& rows, int units, const C& c,
-                       const SolverParams& prm, std::vector<BoundaryDof>* dofs,
-                       const SweepObserver& observer, Update&& update) {
+template <class Row, class C, class Dof, class Update>
+SolveStats solve_units(std::vector<Row>& rows, int units, const C& c, const SolverParams& prm,
+                       std::vector<Dof>* dofs, const SweepObserver& observer, Update&& update) {
   if (rows.empty()) return no_rows(dofs);
   SolveStats st;
   const int n = static_cast<int>(rows.size());
@@ -272,7 +212,7 @@ SolveStats solve_units(std::vector<ContactRow>& rows, int units, const C& c,
     if (end_sweep(++it, dsum, psum, n, rows.data(), dofs, prm, observer, st)) break;
   }
   residuals(rows, c, prm.min_parallel, st);
-  st.cap_hit = st.dp_rel >= prm.tol || st.dof_rel >= prm.tol;
+  st.cap_hit = not_converged(st, prm);
   return st;
 }
 

@@ -6,7 +6,7 @@
 #include <variant>
 
 #include "law.hpp"
-#include "sweep.hpp"
+#include "coupling.hpp"
 
 namespace cd {
 

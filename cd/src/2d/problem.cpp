@@ -21,7 +21,7 @@
 
 #include "law.hpp"
 #include "nlgs.hpp"
-#include "sweep.hpp"
+#include "coupling.hpp"
 
 namespace cd {
 
@@ -730,7 +730,7 @@ NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& op
     s = std::visit(
         [&](auto law) {
           using L = decltype(law);
-          return sweep::solve<L>(rows, col, c, prm, nullptr, [&](int it, double dp) {
+          return sweep::solve<L>(rows, col, c, prm, static_cast<std::vector<BoundaryDof>*>(nullptr), [&](int it, double dp) {
             if (it % every == 0) record(it, dp);
           });
         },

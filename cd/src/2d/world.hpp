@@ -26,6 +26,7 @@
 #include "detect.hpp"
 #include "nlgs.hpp"
 #include "observables.hpp"
+#include "stages.hpp"
 
 namespace cd {
 
@@ -75,20 +76,6 @@ struct CellState {
   double offset = 0.0;               // Lees-Edwards offset of the images above, in [0, width)
   double hdot = 0.0, wdot = 0.0;     // rates of height and width
   double strain = 0.0;               // integral of the shear rate
-};
-
-// The stages of a step, in the order they run, and `output` (timed by the
-// run loop). Their names are the series columns t_<name> and the
-// checkpoint's record of the timers.
-enum class Stage : int { Predict, Detect, Build, Colour, Solve, Integrate, Observe, Output };
-inline constexpr int kStages = 8;
-inline constexpr std::array<const char*, kStages> kStageNames = {
-    "predict", "detect", "build", "colour", "solve", "integrate", "observe", "output"};
-
-struct StageTimes {  // wall-clock seconds, accumulated, per stage
-  std::array<double, kStages> t{};
-  double& operator[](Stage s) { return t[static_cast<int>(s)]; }
-  double operator[](Stage s) const { return t[static_cast<int>(s)]; }
 };
 
 struct StepStats {

@@ -28,6 +28,7 @@
 #include "bodies.hpp"
 #include "contact.hpp"
 #include "law.hpp"
+#include "solver.hpp"
 
 namespace cd {
 
@@ -43,15 +44,6 @@ struct BoundaryDof {
   double scale = 1.0;  // impulse scale of the convergence test (|imposed impulse|)
   std::vector<std::int32_t> rows;
   std::vector<double> an, at;
-};
-
-// Colouring: rows are permuted so that colour c is [start[c], start[c+1]);
-// inside a colour the rows whose body 1 is driven come first, up to split[c].
-// The last colour may be an overflow colour, solved on one thread.
-struct Colouring {
-  std::vector<std::int32_t> start, split;
-  bool overflow = false;
-  std::vector<std::int32_t> perm;  // new index -> old index
 };
 
 struct ContactProblem {

@@ -17,32 +17,9 @@
 #include "contact.hpp"
 #include "contact_problem.hpp"
 #include "parallel.hpp"
+#include "solver.hpp"
 
 namespace cd {
-
-struct SolverParams {
-  double tol = 1e-4;       // eps_f on rms |dp| / mean |p| over a sweep (LMGC90's "Quad" norm)
-  int max_iter = 2000;     // iteration cap
-  // Below this many rows the sweep runs on one thread: a colour of a few
-  // dozen rows costs less than the barrier that ends it (measured: a
-  // 600-row pile ran 3x slower on 2 threads than on 1). Loops over bodies
-  // (predict, integrate, detection) use half of it (kMinParallelBodies).
-  int min_parallel = kMinParallelRows;
-};
-
-struct SolveStats {
-  int iterations = 0;
-  bool cap_hit = false;
-  double dp_rel = 0;         // last sweep's rms |dp| / mean |p| (the convergence test)
-  double residual_max = 0;   // law residual, max over contacts / mean |p|
-  double residual_mean = 0;  // law residual, mean over contacts / mean |p|
-  double p_mean = 0;         // mean |p| (impulse scale)
-  double dof_rel = 0;        // last sweep's largest dof residual / (inv_mass scale) (update_dof)
-};
-
-// Called after every sweep with the sweep count and its dp_rel, on one
-// thread, between sweeps (cdproblem's history); may be empty.
-using SweepObserver = std::function<void(int sweep, double dp_rel)>;
 
 // Solves the problem in place (impulses, body velocities, dofs), starting
 // from the impulses held in the rows, which must already be applied to the

@@ -1,43 +1,16 @@
-// Run outputs in one folder: the resolved scene, the time series, and VTK
-// snapshots (particles, contacts, walls) with one .pvd collection each.
-// Every file is written to a temporary name and renamed into place, so a
-// reader (or a killed run) never sees a half-written file.
+// VTK snapshots of a 2D run (particles, contacts, walls, shapes) with one
+// .pvd collection each; the folder checks, atomic writes and series.csv are
+// core/files.hpp. Every file is written to a temporary name and renamed into
+// place, so a reader (or a killed run) never sees a half-written file.
 #pragma once
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "files.hpp"
 #include "world.hpp"
 
 namespace cd {
-
-struct OutputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-// Throws OutputError naming the folder if it cannot be created or written.
-// Creates nothing: it checks the nearest existing ancestor.
-void check_output_dir(const std::string& dir);
-
-// Writes `text` to `path` atomically (temporary file, then rename).
-void write_file_atomic(const std::string& path, const std::string& text);
-
-// series.csv: one row per output interval, columns named by the first row.
-class Series {
- public:
-  explicit Series(const std::string& path);
-  // Continues a file that already holds the header `names` and earlier rows
-  // (a restart): nothing is truncated and no header is written again.
-  Series(const std::string& path, std::vector<std::string> names)
-      : path_(path), names_(std::move(names)) {}
-  void row(const std::vector<std::pair<std::string, double>>& cols);
-  void flush();
-
- private:
-  std::string path_;
-  std::vector<std::string> names_;
-  std::string buf_;
-};
 
 // VTK snapshots through VTK's XML writers (binary, zlib-compressed):
 //   particles_NNNNN.vtp  points, one per particle: id, radius, velocity, omega, angle,

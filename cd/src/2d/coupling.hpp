@@ -1,0 +1,85 @@
+// The 2D couplings' shared pieces for the sweep (core/sweep.hpp): rows
+// coupled through the velocities of their bodies (the simulator), and what
+// the sweep asks of a 2D row (its law residual, its impulse norm).
+#pragma once
+#include <cmath>
+
+#include "contact.hpp"
+#include "law.hpp"
+#include "nlgs.hpp"
+#include "sweep.hpp"
+
+namespace cd {
+
+// The law residual of a row (law.hpp) at the velocity its coupling gives.
+template <class C>
+double row_residual(const C& c, const ContactRow& r) {
+  double un, ut;
+  c.velocity(r, un, ut);
+  return law_residual(un, ut, r.pn, r.pt, r.mu, r.adh, 1.0 / r.wnn);
+}
+
+inline double impulse_norm(const ContactRow& r) { return std::sqrt(r.pn * r.pn + r.pt * r.pt); }
+
+namespace sweep {
+
+// Rows coupled through the velocities of their bodies (the simulator).
+template <bool Rot>
+struct BodyCoupling {
+  BodyVel* vel;
+
+  // One row update. Write1 = false when body 1 is driven (a wall): it is
+  // read, never written, so rows of one colour may share a wall without a
+  // data race.
+  template <class L, bool Write1>
+  void update(ContactRow& r, double& dp2, double& pabs) const {
+    BodyVel& A = vel[r.b1];
+    BodyVel& B = vel[r.b2];
+    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
+    double un = r.nx * dx + r.ny * dy + r.bn;
+    if constexpr (Rot) un += -B.w * r.c2t + A.w * r.c1t;
+    double ut = 0.0;
+    if constexpr (L::tangential) {
+      ut = -r.ny * dx + r.nx * dy + r.bt;
+      if constexpr (Rot) ut += B.w * r.c2n - A.w * r.c1n;
+    }
+    double pn, pt;
+    L::solve(r, un, ut, pn, pt);
+    const double dpn = pn - r.pn;
+    const double dpt = L::tangential ? pt - r.pt : 0.0;
+    r.pn = pn;
+    if constexpr (L::tangential) {
+      r.pt = pt;
+      pabs = std::sqrt(pn * pn + pt * pt);
+    } else {
+      pabs = std::abs(pn);
+    }
+    dp2 = dpn * dpn + dpt * dpt;
+    const double px = r.nx * dpn - r.ny * dpt, py = r.ny * dpn + r.nx * dpt;
+    B.vx += B.inv_m * px;
+    B.vy += B.inv_m * py;
+    if constexpr (Rot) B.w += B.inv_I * (r.c2n * dpt - r.c2t * dpn);
+    if constexpr (Write1) {
+      A.vx -= A.inv_m * px;
+      A.vy -= A.inv_m * py;
+      if constexpr (Rot) A.w -= A.inv_I * (r.c1n * dpt - r.c1t * dpn);
+    }
+  }
+
+  void velocity(const ContactRow& r, double& un, double& ut) const {
+    const BodyVel& A = vel[r.b1];
+    const BodyVel& B = vel[r.b2];
+    const double dx = B.vx - A.vx, dy = B.vy - A.vy;
+    un = r.nx * dx + r.ny * dy;
+    ut = -r.ny * dx + r.nx * dy;
+    if constexpr (Rot) {
+      un += -B.w * r.c2t + A.w * r.c1t;
+      ut += B.w * r.c2n - A.w * r.c1n;
+    }
+    un += r.bn;
+    ut += r.bt;
+  }
+};
+
+}  // namespace sweep
+}  // namespace cd
