@@ -36,7 +36,7 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 
 void compare(const Scene& x, const Scene& y, bool same) {
   const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, adhesion, debond, tol,
-               max_iter, threads, n, d_mean, size_ratio, size_dist, density, seed, nsides, region,
+               max_iter, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
                box_width, box_height, disks, walls, series_interval, snapshot_interval,
                checkpoint_interval, quiet, shear_mode, cell_width, cell_height, pressure,
                inertial_number, cell_mass, isotropic, strain, dt_tp, start, cohesion_number] = x;
@@ -45,6 +45,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
   CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(adhesion); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(threads);
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
+  CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
   CHECK_FIELD(box_height); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
   CHECK_FIELD(checkpoint_interval); CHECK_FIELD(quiet);
@@ -78,10 +79,14 @@ Scene nondefault() {
   s.tol = 1e-6;
   s.max_iter = 500;
   s.threads = 2;
-  s.n = 300;
+  s.n = 3;
   s.d_mean = 2e-3;
   s.size_ratio = 1.5;
   s.size_dist = "uniform";
+  // read from tests/data/config/diameters.txt (the file wins over a list);
+  // the path is made absolute when read
+  s.diameters = {1e-3, 2.5e-3, 4e-3};
+  s.diameters_file = std::string(CDLAB_SOURCE_DIR) + "/tests/data/config/diameters.txt";
   s.density = 7.8;
   s.seed = 4294967295u;
   s.nsides = {0.0, 6.0};
@@ -352,9 +357,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 41 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 43 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 41u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 43u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

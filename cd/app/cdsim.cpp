@@ -77,9 +77,18 @@ int main(int argc, char** argv) {
     const double per_step = s.steps ? s.wall_time / s.steps : 0.0;
     fmt::print(
         "cdsim: {} steps in {:.2f} s ({:.3g} ms/step, {} threads); iterations/step mean {:.1f}, "
-        "max {}, cap hit {} times; law residual max {:.2e}; overlap max {:.2e} d\n",
+        "max {}, cap hit {} times; law residual max {:.2e}; overlap max {:.2e} d ({:.2e} of the "
+        "smaller grain's diameter)\n",
         s.steps, s.wall_time, 1e3 * per_step, omp_get_max_threads(), s.mean_iterations,
-        s.max_iterations, s.cap_hits, s.max_residual, s.max_overlap);
+        s.max_iterations, s.cap_hits, s.max_residual, s.max_overlap, s.max_overlap_small);
+    // The overlap users read: relative to the smaller grain of the pair.
+    constexpr double kOverlapWarn = 0.01;
+    if (s.max_overlap_small > kOverlapWarn)
+      fmt::print(stderr,
+                 "cdsim: warning: the largest overlap reached {:.3g} of the smaller grain's "
+                 "diameter (> {}): see the series' max_overlap_small column; a smaller time step "
+                 "or tolerance reduces it\n",
+                 s.max_overlap_small, kOverlapWarn);
     fmt::print("cdsim: outputs in {}/\n", out);
     if (s.stopped_at_max_steps)
       fmt::print("cdsim: stopped after --max-steps {} (step {} of the scene's {})\n", max_steps,

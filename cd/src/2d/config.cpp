@@ -69,6 +69,12 @@ Rule side_list() {
             return !r.empty() && std::all_of(r.begin(), r.end(), valid_sides);
           }};
 }
+Rule positive_list() {
+  return {"a list of numbers > 0", [](const Val& v) {
+            const auto& r = std::get<std::vector<double>>(v);
+            return std::all_of(r.begin(), r.end(), [](double x) { return x > 0; });
+          }};
+}
 Rule shear_mode() {
   return {"\"none\", \"periodic\" or \"walls\"", [](const Val& v) {
             const auto& m = std::get<std::string>(v);
@@ -117,6 +123,8 @@ const std::vector<Param<Scene>>& scene_params() {
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
       {"particles", "size_ratio", &Scene::size_ratio, "", ge(1), "d_max / d_min"},
       {"particles", "size_dist", &Scene::size_dist, "", size_dist(), "diameter distribution: uniform in d, or uniform_area (equal area per size class)"},
+      {"particles", "diameters", &Scene::diameters, "m", positive_list(), "explicit diameters of the generated particles, placed in an order shuffled by particles.seed; particles.n is then their count (0 or that count), and d_mean, size_ratio, size_dist are not used; []: draw them from the size law"},
+      {"particles", "diameters_file", &Scene::diameters_file, "", any(), "a text file of diameters (m; whitespace-separated, # comments; relative to the scene file's folder) read into particles.diameters; \"\": none"},
       {"particles", "density", &Scene::density, "kg/m^2", gt(0), "mass per unit area (2600 kg/m^3 x 1 mm = 2.6)"},
       {"particles", "seed", &Scene::seed, "", any(), "random seed of sizes and positions"},
       {"particles", "nsides", &Scene::nsides, "", side_list(), "shapes of the generated particles, drawn uniformly from the list: 0 disk, n >= 3 regular n-gon (sizes are then circumscribed diameters)"},
@@ -425,6 +433,46 @@ Scene read_scene(const toml::value& root, const std::string& path) {
     else out.add(v, name, fmt::format("{}: expected a [{}] table, got {}", name, name, type_name(v)));
   }
   out.throw_if_any();
+
+  // Explicit diameters: from the file (it wins over a list, so that a
+  // resolved scene.toml, which holds both, reads back the same), then n.
+  if (!s.diameters_file.empty()) {
+    namespace fs = std::filesystem;
+    fs::path f(s.diameters_file);
+    if (f.is_relative()) f = fs::absolute(fs::path(path).parent_path() / f).lexically_normal();
+    // Kept absolute, so that the resolved scene.toml (in the output folder)
+    // names the same file.
+    s.diameters_file = f.string();
+    std::ifstream in(f);
+    if (!in) {
+      out.add(child(child(root, "particles"), "diameters_file"), "diameters_file",
+              fmt::format("particles.diameters_file: cannot read '{}'", f.string()));
+      out.throw_if_any();
+    }
+    std::vector<double> d;
+    std::string line;
+    for (int ln = 1; std::getline(in, line); ++ln) {
+      std::istringstream ls(line.substr(0, line.find('#')));
+      for (std::string tok; ls >> tok;) {
+        char* end = nullptr;
+        const double x = std::strtod(tok.c_str(), &end);
+        if (*end != '\0' || !std::isfinite(x) || !(x > 0))
+          throw ConfigError(fmt::format("{}:{}: '{}' is not a diameter (a finite number > 0)",
+                                        f.string(), ln, tok));
+        d.push_back(x);
+      }
+    }
+    if (d.empty()) throw ConfigError(fmt::format("{}: no diameter in the file", f.string()));
+    s.diameters = std::move(d);
+  }
+  if (!s.diameters.empty()) {
+    const auto count = static_cast<int>(s.diameters.size());
+    if (s.n == 0) s.n = count;
+    else if (s.n != count)
+      out.add(child(root, "particles"), "particles",
+              fmt::format("particles.n = {} but particles.diameters holds {} diameters: give n = 0 "
+                          "or n = {}", s.n, count, count));
+  }
 
   // Rules that involve two keys.
   if ((s.box_width > 0) != (s.box_height > 0))

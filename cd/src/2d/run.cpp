@@ -71,7 +71,7 @@ struct Interval {
   int iter_max = 0;
   int cap_hits = 0;
   double res_max = 0, res_mean_sum = 0;
-  double ov_max = 0;
+  double ov_max = 0, ov_small = 0;
   double corr_work = 0;
   StageTimes t0;
 
@@ -83,6 +83,7 @@ struct Interval {
     res_max = std::max(res_max, s.solve.residual_max);
     res_mean_sum += s.solve.residual_mean;
     ov_max = std::max(ov_max, s.max_overlap);
+    ov_small = std::max(ov_small, s.max_overlap_small);
     corr_work += s.correction_work;
   }
 };
@@ -241,6 +242,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     sum.cap_hits += st.solve.cap_hit;
     sum.max_residual = std::max(sum.max_residual, st.solve.residual_max);
     sum.max_overlap = std::max(sum.max_overlap, st.max_overlap);
+    sum.max_overlap_small = std::max(sum.max_overlap_small, st.max_overlap_small);
 
     if (k % every_row == 0 || k == nsteps || stopping) {
       timed_output([&] {
@@ -256,6 +258,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
                     {"cap_hit", double(iv.cap_hits)},
                     {"max_overlap", iv.ov_max},
                     {"mean_overlap", st.mean_overlap},
+                    {"max_overlap_small", iv.ov_small},
                     {"kinetic_energy", w.kinetic_energy()},
                     {"correction_work", iv.corr_work}};
         for (int s = 0; s < kStages; ++s)

@@ -49,7 +49,8 @@ struct RunSummary {
   int max_iterations = 0;
   std::int64_t cap_hits = 0;
   double max_residual = 0;
-  double max_overlap = 0;
+  double max_overlap = 0;        // largest overlap / mean diameter
+  double max_overlap_small = 0;  // largest overlap / the smaller grain's diameter
   double wall_time = 0;
   double kinetic_energy = 0;
 };

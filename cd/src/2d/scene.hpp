@@ -62,6 +62,11 @@ struct Scene {
   double d_mean = 1e-3;      // mean diameter (m)
   double size_ratio = 2.0;   // d_max / d_min
   std::string size_dist = "uniform_area";  // "uniform" | "uniform_area"
+  // explicit diameters of the generated particles (then n = their count, and
+  // d_mean, size_ratio, size_dist are not used); read from diameters_file
+  // (one per line or whitespace-separated, '#' comments) when that is given
+  std::vector<double> diameters;
+  std::string diameters_file;
   double density = 2.6;      // mass per unit area (kg/m^2): 2600 kg/m^3 x 1 mm
   unsigned seed = 1;
   // shapes drawn uniformly from this list: 0 disk, 3..60 regular polygon

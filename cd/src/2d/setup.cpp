@@ -43,6 +43,16 @@ std::string body_name(const Scene& s, int i, int first_generated) {
 }  // namespace
 
 std::vector<double> generated_diameters(const Scene& s) {
+  if (!s.diameters.empty()) {
+    // The given diameters, in an order shuffled by the seed (Fisher-Yates
+    // with the platform-independent uniform01), so that a sorted list does
+    // not place the large grains in the bottom rows.
+    std::vector<double> d = s.diameters;
+    std::mt19937_64 g(s.seed);
+    for (std::size_t i = d.size(); i > 1; --i)
+      std::swap(d[i - 1], d[static_cast<std::size_t>(uniform01(g) * i)]);
+    return d;
+  }
   double a, b;
   diameter_range(s, a, b);
   std::mt19937_64 g(s.seed);
@@ -61,7 +71,10 @@ double mean_diameter(const Scene& s) {
     sum += 2 * d.radius;
     ++n;
   }
-  if (s.n > 0) {
+  if (!s.diameters.empty()) {
+    for (const double d : s.diameters) sum += d;
+    n += static_cast<int>(s.diameters.size());
+  } else if (s.n > 0) {
     sum += s.n * s.d_mean;
     n += s.n;
   }
@@ -101,8 +114,13 @@ void check_shear(const Scene& s) {
            "\"periodic\" or \"walls\"");
     return;
   }
-  if (s.cell_width <= 0 || s.cell_height <= 0)
-    fail(fmt::format("shear.mode = \"{}\" needs shear.width > 0 and shear.height > 0", s.shear_mode));
+  // 0 x 0: a periodic cell sized for the generated particles (with_auto_cell)
+  // or the start sample's cell.
+  const bool auto_cell = s.shear_mode == "periodic" && s.cell_width == 0 && s.cell_height == 0 &&
+                         (s.n > 0 || !s.start.empty());
+  if (!auto_cell && (s.cell_width <= 0 || s.cell_height <= 0))
+    fail(fmt::format("shear.mode = \"{}\" needs shear.width > 0 and shear.height > 0 (periodic: "
+                     "or both 0, for a cell sized for the particles)", s.shear_mode));
   if (s.gravity[0] != 0 || s.gravity[1] != 0)
     fail("shear protocols run without gravity: set [gravity] g = [0.0, 0.0]");
   if (s.box_width > 0 || !s.walls.empty()) fail("shear protocols take no [box] and no [[wall]]");
@@ -151,7 +169,23 @@ void check_derived(const Scene& s) {
 
 }  // namespace
 
-WorldParams world_params(const Scene& s) {
+// A periodic cell given as 0 x 0 for generated particles: the smallest
+// square that holds them on the generator's loose lattice (pitch 1.02 d_max),
+// computed from the actual size law, whatever the size ratio.
+Scene with_auto_cell(const Scene& s) {
+  if (s.shear_mode != "periodic" || s.cell_width != 0 || s.cell_height != 0 || !s.start.empty() ||
+      s.n <= 0)
+    return s;
+  const std::vector<double> d = generated_diameters(s);
+  const double pitch = 1.02 * *std::max_element(d.begin(), d.end());
+  const double k = std::ceil(std::sqrt(static_cast<double>(s.n)));
+  Scene c = s;
+  c.cell_width = c.cell_height = pitch * k * (1 + 1e-9);  // floor(side / pitch) = k
+  return c;
+}
+
+WorldParams world_params(const Scene& s0) {
+  const Scene s = with_auto_cell(s0);
   check_shear(s);
   check_derived(s);
   WorldParams p;
@@ -181,7 +215,8 @@ WorldParams world_params(const Scene& s) {
   return p;
 }
 
-World build_world(const Scene& s) {
+World build_world(const Scene& s0) {
+  const Scene s = with_auto_cell(s0);
   WorldParams wp = world_params(s);
   World w(wp);
   Bodies& B = w.bodies;

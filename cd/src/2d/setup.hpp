@@ -26,6 +26,11 @@ double pressure_time(const Scene& s);
 double time_step(const Scene& s);
 double run_duration(const Scene& s);
 
+// The scene with a periodic cell given as 0 x 0 (for generated particles)
+// replaced by the smallest square that holds them on the generator's loose
+// lattice, from the actual size law; any other scene unchanged.
+Scene with_auto_cell(const Scene& s);
+
 // Builds the world; throws SceneError naming the bodies at fault.
 World build_world(const Scene& s);
 

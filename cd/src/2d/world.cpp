@@ -1,5 +1,7 @@
 #include "world.hpp"
 
+#include <limits>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -209,7 +211,13 @@ void World::observe() {
   const std::size_t nr = prob_.rows.size();
   last_.contacts = static_cast<int>(nr);
   int active = 0, nover = 0;
-  double omax = 0, osum = 0;
+  double omax = 0, osum = 0, omax_small = 0;
+  // The diameter a user compares an overlap with: the smaller grain's of the
+  // pair (a wall segment has none: the grain's).
+  const auto diameter = [&](std::int32_t i) {
+    return bodies.shape[i] == Shape::Segment ? std::numeric_limits<double>::infinity()
+                                             : 2.0 * bodies.radius[i];
+  };
   for (std::size_t k = 0; k < nr; ++k) {
     if (prob_.rows[k].pn + prob_.rows[k].adh > 0.0) ++active;
     const double ov = -info_[k].gap;
@@ -217,8 +225,11 @@ void World::observe() {
       ++nover;
       osum += ov;
       omax = std::max(omax, ov);
+      const double d = std::min(diameter(prob_.rows[k].b1), diameter(prob_.rows[k].b2));
+      if (std::isfinite(d)) omax_small = std::max(omax_small, ov / d);
     }
   }
+  last_.max_overlap_small = omax_small;
   last_.active = active;
   // Work of the overlap correction: a row with bias b_n < 0 holds u_n >= -b_n,
   // and p_n (-b_n) bounds the energy that bias puts in.
