@@ -419,7 +419,7 @@ int main(int argc, char** argv) {
   std::vector<double> targets{1e-4};
   std::vector<int> threads{1};
   int check = 10;
-  double time_limit = 20, lm = 1e-10;
+  double time_limit = 20, lm = 1e-3;
   long max_iters = 200000;
   std::string csv;
   bool campaign = true;
