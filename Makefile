@@ -14,7 +14,7 @@ DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libbenchmark-dev gnuplot-nox
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build run test bench regress accuracy-cost tensile clean help analyze-inertial analyze-cohesive analyze-angularity scene-doc figures
+.PHONY: all deps build run test bench regress accuracy-cost tensile clean help analyze-inertial analyze-cohesive analyze-angularity scene-doc figures frozen-shear
 
 all: build
 
@@ -29,6 +29,7 @@ help:
 	@echo "make figures        regenerate docs/figures/ (installs ParaView's pvbatch and xvfb if missing; not part of make test)"
 	@echo "make campaign-inertial|campaign-cohesive|campaign-angularity [N=200 STRAIN=2 P=100 ...]"
 	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
+	@echo "make frozen-shear   steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into $(FROZEN)/ [FS_N=1000]"
 	@echo "make regress        re-run the reference campaign, refit mu(I), compare with tests/data/regress/"
 	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity"
 	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
@@ -168,7 +169,7 @@ $(CAMPAIGNS)/prep/ns_%/.done: | build
 	$(CDSIM) configs/shear-prep.toml --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_interval=1 \
 	  --set output.snapshot_interval=0 \
 	  --set particles.n=$(N) --set particles.nsides=[$*] --set shear.pressure=$(P) \
-	  --set shear.width=$(cell_side) --set shear.height=$(cell_side)
+	  --set shear.width=$(cell_side) --set shear.height=$(cell_side) $(PREP_SET)
 	touch $@
 
 shear_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) \
@@ -188,6 +189,54 @@ $(CAMPAIGNS)/cohesive/eta_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
 
 $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done
 	$(call shear_run,$(ANGULAR_I),$*)
+	touch $@
+
+# ---- Frozen dense-shear problems (issue 14, item 2; tests/data/frozen-shear) --
+# Steady bi-periodic shear of N disks (ns_0) and hexagons (ns_6) at p = P,
+# the campaign protocol (prep, then shear at imposed p and I), and the contact
+# problems of a few steps dumped with --dump-problem (.cdp: exact replay by
+# cdproblem / cd/bench/solvers). I = 1e-2 is sheared from the compacted sample
+# for FS_STRAIN (steady beyond strain 0.1: mu*, nu and z without trend, see the
+# README of tests/data/frozen-shear); I = 1e-3 is
+# sheared for FS_QS_STRAIN only (20 000 steps per unit strain at dt = 0.05 t_p
+# would take hours on 2 cores), from the compacted sample: NOT steady, the
+# start of the shear. (Starting it from the I = 1e-2 sample fails the start
+# check: two grains across the Lees-Edwards boundary overlap by 0.08 d > 0.05 d;
+# shear.start resets the strain, probably with it the images' offset: not
+# investigated here.) The steps dumped are
+# the last one and the one FS_GAP steps before. N = 1000 is committed
+# (tests/data/frozen-shear); make frozen-shear FS_N=10000 regenerates larger
+# ones into $(FROZEN)/N_10000 (hours). The shear runs keep the campaign's
+# solver settings (tol 1e-4, cap 2000): the dumped problems are theirs.
+FROZEN ?= outputs/frozen-shear
+FS_N ?= 1000
+FS_SHAPES ?= 0 6
+FS_STRAIN ?= 0.5
+FS_QS_STRAIN ?= 0.02
+FS_GAP ?= 50
+# The compaction only has to give a jammed sample to shear: at the campaign's
+# 1e-4 the hexagons' prep sits at the 2000-sweep cap on most steps.
+FS_PREP_SET ?= --set solver.tol=1e-3
+.PHONY: frozen-shear frozen-shear-runs
+frozen-shear: build
+	$(MAKE) --no-print-directory -j $(JOBS) CAMPAIGNS=$(FROZEN)/N_$(FS_N) N=$(FS_N) \
+	  PREP_SET="$(FS_PREP_SET)" frozen-shear-runs
+	@ls -l $(FROZEN)/N_$(FS_N)/frozen/*/*/problem_*.cdp
+frozen-shear-runs: $(foreach s,$(FS_SHAPES),$(CAMPAIGNS)/frozen/ns_$(s)/I_0.001/.done)
+# steps of a strain at I with the campaign's dt: strain / (I dt_tp)
+fs_steps = $(shell awk 'BEGIN { printf "%d", $(2) / ($(1) * $(call dt_tp,$(1))) + 0.5 }')
+frozen_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --fresh \
+	  --set shear.start='"$(3)"' --set shear.pressure=$(P) \
+	  --set shear.inertial_number=$(1) --set shear.strain=$(2) --set shear.dt_tp=$(call dt_tp,$(1)) \
+	  --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=0 \
+	  --dump-problem $(shell echo $$(( $(call fs_steps,$(1),$(2)) - $(FS_GAP) ))) \
+	  --dump-problem $(call fs_steps,$(1),$(2))
+.PRECIOUS: $(CAMPAIGNS)/frozen/ns_%/I_0.01/.done
+$(CAMPAIGNS)/frozen/ns_%/I_0.01/.done: $(CAMPAIGNS)/prep/ns_%/.done
+	$(call frozen_run,0.01,$(FS_STRAIN),$(CAMPAIGNS)/prep/ns_$*/checkpoint.bin)
+	touch $@
+$(CAMPAIGNS)/frozen/ns_%/I_0.001/.done: $(CAMPAIGNS)/prep/ns_%/.done
+	$(call frozen_run,0.001,$(FS_QS_STRAIN),$(CAMPAIGNS)/prep/ns_$*/checkpoint.bin)
 	touch $@
 
 # Campaign analyses: the report of outputs/campaigns/<name> (made by the
