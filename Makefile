@@ -11,7 +11,7 @@ OUT   ?= outputs/default
 # Debian 12 packages the build needs (what each is for: README.md, "Two commands").
 DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libvtk9-dev libgtest-dev libtoml11-dev libcli11-dev libfmt-dev \
-            libbenchmark-dev gnuplot-nox
+            libbenchmark-dev gnuplot-nox libfclib-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: all deps build run test bench regress accuracy-cost tensile clean help analyze-inertial analyze-cohesive analyze-angularity scene-doc figures frozen-shear

@@ -1,6 +1,7 @@
 // cdproblem: replays a frozen contact problem with the production solver.
 //   cdproblem solve FILE.dat [--tol 1e-6] [--max-sweeps N] [--check-every K] [--lemke]
 //   cdproblem solve FILE.cdp [--tol T] [--max-sweeps N] [--out IMPULSES.txt]
+//   cdproblem solve FILE.hdf5 [--tol 1e-6] [--max-sweeps N] [--check-every K] [--lemke --facets E]
 // FILE.dat: Siconos' text format (W, q, mu), solved by the simulator's sweep
 // through the blocks of W (problem.hpp); prints the problem size, the sweep's
 // change and the law residual every K sweeps, Siconos' error and the time;
@@ -8,6 +9,9 @@
 // FILE.cdp: a step dumped by `cdsim --dump-problem` (contact_problem.hpp),
 // solved exactly as the step was (same rows, colouring, law, dofs and,
 // unless overridden, tolerance and cap): the same impulses to the bit.
+// FILE.hdf5: an FCLib 3D problem (local, or global condensed to W, q),
+// solved by the 3D NLGS with the exact local solver (3d/problem3.hpp); with
+// --lemke, the polyhedral-cone LCP with E face pairs (3d/lemke3.hpp).
 // Exit codes: 0 solved to the tolerance; 1 not converged (sweep cap) or
 // Lemke failed; 2 bad input (usage, option out of range, malformed file or
 // non-finite number: one message naming the file, line and what was wrong).
@@ -20,8 +24,10 @@
 #include <fmt/format.h>
 
 #include "lemke.hpp"
+#include "lemke3.hpp"
 #include "nlgs.hpp"
 #include "problem.hpp"
+#include "problem3.hpp"
 
 namespace {
 
@@ -66,6 +72,52 @@ int solve(const std::string& path, const cd::NlgsOptions& opt, bool lemke) {
   return st.converged ? 0 : 1;
 }
 
+// Lemke's tableau for the polyhedral LCP is (2e + 2) nc unknowns square.
+constexpr int kLemke3MaxUnknowns = 4000;
+
+void print_history(const cd::NlgsStats& st) {
+  fmt::print("{:>8} {:>12} {:>14} {:>14}\n", "sweep", "rms|dr|/|r|", "residual max",
+             "residual mean");
+  for (const cd::NlgsCheckpoint& c : st.history)
+    fmt::print("{:>8} {:>12.3e} {:>14.3e} {:>14.3e}\n", c.sweep, c.dr_rel, c.residual_max,
+               c.residual_mean);
+}
+
+int solve3(const std::string& path, const cd::NlgsOptions& opt, bool lemke, int facets) {
+  const cd::Fclib3 f = cd::read_fclib(path);
+  const cd::Problem3& p = f.problem;
+  fmt::print("{}: dim 3, {} contacts ({}), W {}x{} with {} entries, mu {:.4g} to {:.4g}\n", path,
+             p.nc, f.global ? fmt::format("global, {} body dofs, condensed", f.bodies_dofs) : "local",
+             p.W.rows(), p.W.cols(), p.W.nonZeros(), p.nc ? p.mu.minCoeff() : 0.0,
+             p.nc ? p.mu.maxCoeff() : 0.0);
+  if (f.r_ref.size())
+    fmt::print("stored solution: Siconos error {:.3e}\n", cd::siconos_error(p, f.r_ref));
+  if (lemke) {
+    if ((2 * facets + 2) * p.nc > kLemke3MaxUnknowns)
+      throw std::runtime_error(fmt::format(
+          "{} contacts with {} face pairs: {} LCP unknowns, Lemke's dense tableau is meant for "
+          "<= {}", p.nc, facets, (2 * facets + 2) * p.nc, kLemke3MaxUnknowns));
+    const cd::Lemke3Result L = cd::solve_lemke(p, facets);
+    const cd::Residual res = cd::problem_residual(p, L.r);
+    fmt::print(
+        "lemke ({} face pairs): {}, {} pivots, LCP error {:.3e}, round-cone residual max {:.3e} "
+        "mean {:.3e}, Siconos error {:.3e}, time {:.3g} s\n",
+        facets, cd::to_string(L.status), L.pivots, L.lcp_error, res.max, res.mean,
+        cd::siconos_error(p, L.r), L.time);
+    return L.status == cd::LemkeStatus::Solved ? 0 : 1;
+  }
+  Eigen::VectorXd r;
+  const cd::NlgsStats st = cd::solve_nlgs(p, r, opt);
+  print_history(st);
+  fmt::print(
+      "nlgs: {} after {} sweeps (rms |dr|/|r| {:.3e}), residual max {:.3e} mean {:.3e} "
+      "(mean |r| {:.3e}), Siconos error {:.3e}, time {:.3g} s ({:.3g} ms/sweep)\n",
+      st.converged ? "converged" : "NOT converged (sweep cap)", st.sweeps, st.dr_rel,
+      st.residual.max, st.residual.mean, st.residual.r_mean, st.siconos_error, st.time,
+      st.sweeps ? 1e3 * st.time / st.sweeps : 0.0);
+  return st.converged ? 0 : 1;
+}
+
 // A dumped step: the production solve of its rows, with the step's own
 // tolerance and cap unless given. Writes the impulses (row order, hex
 // floats: exact) to `out` if given.
@@ -98,13 +150,13 @@ int solve_step(const std::string& path, double tol, int max_sweeps, const std::s
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"cdproblem: solve frozen 2D frictional contact problems (.dat, .cdp)"};
+  CLI::App app{"cdproblem: solve frozen frictional contact problems (2D .dat, .cdp; 3D FCLib .hdf5)"};
   app.require_subcommand(1);
   CLI::App* cmd = app.add_subcommand("solve", "solve one problem file with NLGS (or Lemke)");
   std::string path;
   cd::NlgsOptions opt;
   bool lemke = false;
-  cmd->add_option("file", path, "problem file (.dat: Siconos matrix form; .cdp: a step dumped by cdsim)")->required();
+  cmd->add_option("file", path, "problem file (.dat: Siconos matrix form; .cdp: a step dumped by cdsim; .hdf5: FCLib 3D)")->required();
   cmd->add_option("--tol", opt.tol, "tolerance on the sweep's rms |dr|/mean|r| (the production test), in (0, 1]")
       ->check(CLI::Validator(
           [](std::string& v) {
@@ -121,6 +173,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100000000))
       ->capture_default_str();
   cmd->add_flag("--lemke", lemke, "solve as an LCP with Lemke's method (small problems)");
+  int facets = 4;
+  cmd->add_option("--facets", facets, "(.hdf5 with --lemke) face pairs e of the polyhedral cone")
+      ->check(CLI::Range(2, 64))
+      ->capture_default_str();
   std::string out;
   cmd->add_option("--out", out, "(.cdp) write the impulses, one row a line, as hex floats");
   try {
@@ -134,6 +190,7 @@ int main(int argc, char** argv) {
       const bool tol_given = cmd->count("--tol") > 0, cap_given = cmd->count("--max-sweeps") > 0;
       return solve_step(path, tol_given ? opt.tol : 0.0, cap_given ? opt.max_sweeps : 0, out);
     }
+    if (path.size() > 5 && path.substr(path.size() - 5) == ".hdf5") return solve3(path, opt, lemke, facets);
     return solve(path, opt, lemke);
   } catch (const std::exception& e) {
     std::cerr << "cdproblem: error: " << e.what() << "\n";

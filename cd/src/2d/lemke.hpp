@@ -32,30 +32,14 @@
 // semi-definite Lemke's method processes it (the references above); ray
 // termination is reported, never hidden.
 //
-// Pivoting: covering vector of ones and artificial variable z0; the ratio test
-// is lexicographic on the rows of [B^-1 q, B^-1] (ties are common: the
-// friction rows have q = 0), with z0 leaving first whenever it ties. The
-// dense tableau is n x (2n + 1) with n = 4 nc: meant for up to ~100 contacts.
-// At the end the basic variables are recomputed by one LU solve with the
-// final basis, which removes the round-off the pivots accumulated.
+// Pivoting: core/lcp.hpp (shared with the 3D polyhedral-cone LCP).
 #pragma once
 #include <Eigen/Core>
 
+#include "lcp.hpp"
 #include "problem.hpp"
 
 namespace cd {
-
-enum class LemkeStatus { Solved, RayTermination, IterationCap };
-const char* to_string(LemkeStatus s);
-
-struct LcpSolution {
-  LemkeStatus status = LemkeStatus::Solved;
-  int pivots = 0;
-  Eigen::VectorXd z, w;  // on ray termination or cap: the last basic point
-};
-
-// Lemke's method on LCP(M, q); max_pivots <= 0 means 50 n + 100.
-LcpSolution solve_lcp_lemke(const Eigen::MatrixXd& M, const Eigen::VectorXd& q, int max_pivots = 0);
 
 // The LCP above for a 2D problem (unknowns ordered per contact).
 void friction_lcp(const Problem& p, Eigen::MatrixXd& M, Eigen::VectorXd& q);

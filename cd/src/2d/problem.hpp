@@ -23,6 +23,7 @@
 #include "bodies.hpp"
 #include "contact.hpp"
 #include "contact_problem.hpp"
+#include "frozen.hpp"
 
 namespace cd {
 
@@ -75,33 +76,7 @@ Problem to_matrix(const ContactProblem& p);
 // Law residual of (r, u = W r + q): cd::law_residual per contact with
 // rho = 1/W_nn, max and mean over contacts, both divided by the mean impulse
 // norm mean_k |r_k| (1 if that is 0, i.e. absolute).
-struct Residual {
-  double max = 0, mean = 0;
-  double r_mean = 0;  // mean_k |r_k|, the scale used
-};
 Residual problem_residual(const Problem& p, const Eigen::VectorXd& r);
-
-struct NlgsOptions {
-  double tol = 1e-6;     // the production test: rms |dr| / mean |r| over a sweep < tol
-  int max_sweeps = 10000;
-  int check_every = 10;  // law residual into the history every k sweeps (and at the end)
-  int min_parallel = 0;  // > 0: the sweep's parallel threshold (0: the production default)
-};
-
-struct NlgsCheckpoint {
-  int sweep;
-  double dr_rel, residual_max, residual_mean;
-};
-
-struct NlgsStats {
-  int sweeps = 0;
-  bool converged = false;  // dr_rel < tol before the sweep cap
-  double dr_rel = 0;       // last sweep's rms |dr| / mean |r|
-  Residual residual;       // at the end (recomputed from r)
-  double siconos_error = 0;  // Siconos' fc2d error at the end (siconos_error)
-  double time = 0;         // wall-clock seconds of the solve (setup included)
-  std::vector<NlgsCheckpoint> history;
-};
 
 // The production NLGS (sweep.hpp: the sweep, local solver, convergence test
 // and residual of every cdsim step) on the matrix form: rows coupled through

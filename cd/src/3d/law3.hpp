@@ -1,0 +1,261 @@
+// 3D contact laws and their exact local solver (method.md section 13).
+//
+// One contact, others frozen: u = W r + q, W the 3x3 Delassus block
+// (symmetric positive definite), frame (n, t1, t2), r the impulse. The law,
+// with adhesion impulse a >= 0 and s = r + a e_n the shifted impulse:
+//     0 <= s_n  _|_  u_n >= 0
+//     s in K = { |D^-1 s_t| <= s_n },   D = diag(mu_a, mu_b)
+//     u_t != 0  =>  s_t = -s_n D (D u_t) / |D u_t|      (maximal dissipation)
+// mu_a = mu_b = mu is the round Coulomb cone |s_t| <= mu s_n with s_t
+// opposite to u_t; mu_a != mu_b the orthotropic (elliptic) cone, whose
+// sliding impulse is NOT opposite to u_t but normal to the ellipse.
+//
+// Why a change of variables: with T = diag(1, mu_a, mu_b), s = T p and
+// v = T u turn any of these cones into the unit round cone |p_t| <= p_n
+// with p_t opposite to v_t, and v = (T W T) p + T b. So one solver, for the
+// unit cone, serves round and orthotropic laws; adhesion is the shift
+// b = q - a W e_n (u = W s + b). A zero coefficient makes T singular: that
+// axis carries no friction (r = 0 along it) and the problem is solved in the
+// remaining plane (mu_a = mu_b = 0: frictionless).
+//
+// The solve enumerates open (s = 0 if b_n >= 0), stick (s = -W^-1 b in K)
+// and sliding. Sliding, on the unit cone: p = p_n (1, d), d = (cos f, sin f),
+// u_n = 0 gives p_n(d) = -b_n / (W_nn + W_nt.d), and v_t(d) = p_n (W_tn +
+// W_tt d) + b_t must be -alpha d, alpha >= 0. Multiplied by the positive
+// denominator, d x v_t(d) = 0 is
+//     h(f) = (W_nn + W_nt.d) (d x b_t) - b_n d x (W_tn + W_tt d) = 0,
+// a trigonometric polynomial of degree 2 in f (the quartic in tan(f/2) of
+// the enumerative solvers: Bonnefon/De Saxce; Siconos' fc3d "unitary
+// enumerative"): at most 4 roots. They are bracketed by sampling h at 96
+// angles, and each bracket refined by safeguarded Newton (bisection when
+// Newton leaves the bracket) to round-off; local minima of |h| between
+// samples are tried with Newton as well, so that a pair of close roots
+// (near tangency) is not lost. Rejected: the complex companion matrix of the
+// quartic (roots off the unit circle by round-off must then be accepted by a
+// tolerance, and a vanishing leading coefficient needs its own case).
+// Every root with p_n >= 0 and alpha >= 0 is a solution; the one with the
+// smallest law residual is returned (several exist only for large mu).
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <Eigen/Core>
+#include <Eigen/Cholesky>
+
+namespace cd {
+
+using Mat3 = Eigen::Matrix3d;
+using Vec3 = Eigen::Vector3d;
+
+// Friction coefficients along the frame's t1 and t2 (mu_a = mu_b: round).
+struct Cone3 {
+  double mu_a = 0, mu_b = 0;
+  static Cone3 round(double mu) { return {mu, mu}; }
+  bool is_round() const { return mu_a == mu_b; }
+};
+
+enum class Branch3 { Open, Stick, Slide, Fallback };
+
+namespace law3_detail {
+
+// Projection onto the cone |x_t| <= mu x_n (mu >= 0).
+inline Vec3 project_cone(const Vec3& x, double mu) {
+  const double xt = std::hypot(x[1], x[2]);
+  if (xt <= mu * x[0]) return x;
+  if (mu * xt <= -x[0]) return Vec3::Zero();
+  const double yn = (mu * xt + x[0]) / (mu * mu + 1.0);
+  const double f = mu * yn / xt;
+  return {yn, f * x[1], f * x[2]};
+}
+
+// Sliding on the unit cone: returns the number of valid candidates and the
+// best one in p (shifted, scaled impulse). Wn = W_nn, wt = W_tn, Wt = W_tt.
+inline bool slide_unit(const Mat3& W, const Vec3& b, Vec3& p) {
+  const double wnn = W(0, 0), bn = b[0];
+  const Eigen::Vector2d wt(W(1, 0), W(2, 0)), bt(b[1], b[2]);
+  const Eigen::Matrix2d Wt = W.bottomRightCorner<2, 2>();
+  auto cross = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    return x[0] * y[1] - x[1] * y[0];
+  };
+  auto h = [&](double f, double* dh) {
+    const Eigen::Vector2d d(std::cos(f), std::sin(f)), dd(-d[1], d[0]);
+    const double den = wnn + wt.dot(d);
+    const Eigen::Vector2d g = wt + Wt * d;
+    if (dh)
+      *dh = wt.dot(dd) * cross(d, bt) + den * cross(dd, bt) -
+            bn * (cross(dd, g) + cross(d, Wt * dd));
+    return den * cross(d, bt) - bn * cross(d, g);
+  };
+  // Candidate evaluation: the full law at angle f.
+  double best = std::numeric_limits<double>::infinity();
+  bool found = false;
+  auto consider = [&](double f) {
+    const Eigen::Vector2d d(std::cos(f), std::sin(f));
+    const double den = wnn + wt.dot(d);
+    if (!(den > 0.0)) return;
+    const double pn = -bn / den;
+    if (pn < 0.0) return;
+    const Vec3 q(pn, pn * d[0], pn * d[1]);
+    const Vec3 v = W * q + b;
+    const double alpha = -(d[0] * v[1] + d[1] * v[2]);
+    const double scale = b.norm() + W.norm() * q.norm();
+    if (alpha < -1e-12 * scale) return;
+    // Misalignment of v_t with -d, and u_n: what the root's accuracy leaves.
+    const double err = std::abs(cross(d, v.tail<2>())) + std::abs(v[0]);
+    if (err < best) {
+      best = err;
+      p = q;
+      found = true;
+    }
+  };
+  // Safeguarded Newton in [a, c] with h(a), h(c) of opposite signs.
+  auto refine = [&](double a, double ha, double c) {
+    double x = 0.5 * (a + c);
+    for (int it = 0; it < 100; ++it) {
+      double dh;
+      const double hx = h(x, &dh);
+      if (hx == 0.0) break;
+      if ((hx > 0) == (ha > 0)) a = x, ha = hx;
+      else c = x;
+      double xn = x - hx / dh;
+      if (!(xn > std::min(a, c) && xn < std::max(a, c))) xn = 0.5 * (a + c);
+      if (std::abs(xn - x) <= 1e-15 * (1.0 + std::abs(x))) {
+        x = xn;
+        break;
+      }
+      x = xn;
+    }
+    consider(x);
+  };
+  constexpr int kN = 96;
+  constexpr double step = 2.0 * std::numbers::pi / kN;
+  std::array<double, kN + 1> hs;
+  for (int i = 0; i <= kN; ++i) hs[i] = h(i * step, nullptr);
+  for (int i = 0; i < kN; ++i) {
+    if (hs[i] == 0.0) consider(i * step);
+    else if ((hs[i] > 0) != (hs[i + 1] > 0) && hs[i + 1] != 0.0)
+      refine(i * step, hs[i], (i + 1) * step);
+  }
+  // Near-tangent pairs: local minima of |h| without a sign change.
+  for (int i = 0; i < kN; ++i) {
+    const double hm = std::abs(hs[(i + kN - 1) % kN]), h0 = std::abs(hs[i]), hp = std::abs(hs[i + 1]);
+    if (h0 < hm && h0 < hp) {
+      double x = i * step;
+      for (int it = 0; it < 50; ++it) {
+        double dh;
+        const double hx = h(x, &dh);
+        if (dh == 0.0) break;
+        const double xn = x - hx / dh;
+        if (std::abs(xn - x) > step) break;
+        x = xn;
+      }
+      consider(x);
+    }
+  }
+  return found;
+}
+
+// One tangential axis with friction mu (the other carries none): the 2D
+// enumeration on the (n, t) block of W and b. Returns s = (s_n, s_t).
+inline Branch3 solve_plane(double wnn, double wnt, double wtt, double bn, double bt, double mu,
+                           double& sn, double& st) {
+  const double det = wnn * wtt - wnt * wnt;
+  const double gt = (-bt * wnn + bn * wnt) / det, gn = -(bn + wnt * gt) / wnn;
+  if (gn >= 0.0 && std::abs(gt) <= mu * gn) {
+    sn = gn;
+    st = gt;
+    return Branch3::Stick;
+  }
+  const double s0 = gt >= 0.0 ? 1.0 : -1.0;
+  for (double s : {s0, -s0}) {
+    const double den = wnn + s * mu * wnt;
+    if (den <= 0.0) continue;
+    const double qn = -bn / den, qt = s * mu * qn;
+    if (qn >= 0.0 && s * (bt + wnt * qn + wtt * qt) <= 0.0) {
+      sn = qn;
+      st = qt;
+      return Branch3::Slide;
+    }
+  }
+  sn = std::max(gn, 0.0);
+  st = std::clamp(gt, -mu * sn, mu * sn);
+  return Branch3::Fallback;
+}
+
+}  // namespace law3_detail
+
+// The exact local solve: r (3) from W (3x3 SPD), q, the cone and the
+// adhesion impulse a >= 0. Returns the branch taken.
+inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double a, Vec3& r) {
+  using namespace law3_detail;
+  const Vec3 b = q - a * W.col(0);  // u = W s + b, s = r + a e_n
+  Vec3 s = Vec3::Zero();
+  Branch3 br = Branch3::Open;
+  if (b[0] >= 0.0) {
+    // open: s = 0 leaves u_n = b_n >= 0
+  } else if (c.mu_a == 0.0 && c.mu_b == 0.0) {
+    s[0] = -b[0] / W(0, 0);
+    br = Branch3::Slide;  // frictionless: slides freely
+  } else if (c.mu_a == 0.0 || c.mu_b == 0.0) {
+    const int k = c.mu_a == 0.0 ? 2 : 1;  // the axis with friction
+    br = solve_plane(W(0, 0), W(0, k), W(k, k), b[0], b[k], std::max(c.mu_a, c.mu_b), s[0], s[k]);
+  } else {
+    const Vec3 g = -W.ldlt().solve(b);
+    if (g[0] >= 0.0 && std::hypot(g[1] / c.mu_a, g[2] / c.mu_b) <= g[0]) {
+      s = g;
+      br = Branch3::Stick;
+    } else {
+      const Vec3 T(1.0, c.mu_a, c.mu_b);
+      const Mat3 Wt = T.asDiagonal() * W * T.asDiagonal();
+      const Vec3 bt = T.cwiseProduct(b);
+      Vec3 p;
+      if (slide_unit(Wt, bt, p)) {
+        s = T.cwiseProduct(p);
+        br = Branch3::Slide;
+      } else {  // not seen for W SPD; kept so that the sweep never stalls
+        s[0] = std::max(g[0], 0.0);
+        const double gt = std::hypot(g[1] / c.mu_a, g[2] / c.mu_b);
+        const double f = gt > s[0] ? s[0] / gt : 1.0;
+        s[1] = f * g[1];
+        s[2] = f * g[2];
+        br = Branch3::Fallback;
+      }
+    }
+  }
+  r = s;
+  r[0] -= a;
+  return br;
+}
+
+// Natural-map residual of the law at (u, r), in impulse units, with De
+// Saxce's modified velocity, written in the cone's own metric (the unit
+// cone after the change of variables above):
+//     p = T^-1 s,  v = T u,  e = T (p - P_K1(p - rho (v + |v_t| e_n)))
+// and |e| returned; zero exactly when (u, r) satisfies the law. For a round
+// cone this is the Siconos fc3d natural map up to the scaling of r_t by mu
+// (siconos_error3 in problem3.hpp is Siconos' own, unscaled). An axis with
+// mu = 0 must carry no impulse: its |r_t| is added.
+inline double law_residual3(const Vec3& u, const Vec3& r, const Cone3& c, double a, double rho) {
+  const Vec3 s(r[0] + a, r[1], r[2]);
+  const Vec3 T(1.0, c.mu_a, c.mu_b);
+  Vec3 p(s[0], c.mu_a > 0 ? s[1] / c.mu_a : 0.0, c.mu_b > 0 ? s[2] / c.mu_b : 0.0);
+  const Vec3 v = T.cwiseProduct(u);
+  Vec3 x = p - rho * Vec3(v[0] + std::hypot(v[1], v[2]), v[1], v[2]);
+  const Vec3 e = T.cwiseProduct(p - law3_detail::project_cone(x, 1.0));
+  double e2 = e.squaredNorm();
+  if (c.mu_a == 0) e2 += s[1] * s[1];
+  if (c.mu_b == 0) e2 += s[2] * s[2];
+  return std::sqrt(e2);
+}
+
+// Siconos' per-contact fc3d error term (round cone, rho = 1, no adhesion):
+// |r - P_Kmu(r - (u_n + mu |u_t|, u_t))|^2.
+inline double siconos_term3(const Vec3& u, const Vec3& r, double mu) {
+  const Vec3 x = r - Vec3(u[0] + mu * std::hypot(u[1], u[2]), u[1], u[2]);
+  return (r - law3_detail::project_cone(x, mu)).squaredNorm();
+}
+
+}  // namespace cd

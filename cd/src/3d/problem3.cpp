@@ -1,0 +1,327 @@
+#include "problem3.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <variant>
+#include <vector>
+
+#include <Eigen/SparseCholesky>
+#include <fmt/format.h>
+#include <hdf5.h>
+
+// fclib.h has no extern "C" guard of its own.
+extern "C" {
+#include <fclib.h>
+}
+
+#include "colour_blocks.hpp"
+#include "sweep.hpp"
+
+namespace cd {
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double>;
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+// An fclib_matrix as an Eigen matrix. Triplet storage (nz >= 0): the data
+// and Siconos' reader use p for column indices and i for row indices (the
+// header's comment says the opposite); nz = -1 compressed columns, nz = -2
+// compressed rows. Indices are checked against the size.
+SpMat to_eigen(const fclib_matrix* m, const std::string& what, const std::string& path) {
+  if (!m) throw std::runtime_error(fmt::format("{}: {} is missing", path, what));
+  Triplets t;
+  auto add = [&](long long i, long long j, double v) {
+    if (i < 0 || i >= m->m || j < 0 || j >= m->n)
+      throw std::runtime_error(fmt::format("{}: {} ({}x{}) has an entry at ({}, {})", path, what,
+                                           m->m, m->n, i, j));
+    if (!std::isfinite(v))
+      throw std::runtime_error(fmt::format("{}: {} has a non-finite entry at ({}, {})", path, what, i, j));
+    t.emplace_back(static_cast<int>(i), static_cast<int>(j), v);
+  };
+  if (m->nz >= 0) {
+    for (int k = 0; k < m->nz; ++k) add(m->i[k], m->p[k], m->x[k]);
+  } else if (m->nz == -1 || m->nz == -2) {
+    const int outer = m->nz == -1 ? m->n : m->m;
+    for (int o = 0; o < outer; ++o)
+      for (int k = m->p[o]; k < m->p[o + 1]; ++k)
+        if (m->nz == -1) add(m->i[k], o, m->x[k]);
+        else add(o, m->i[k], m->x[k]);
+  } else {
+    throw std::runtime_error(fmt::format("{}: {} has unknown storage nz = {}", path, what, m->nz));
+  }
+  SpMat A(m->m, m->n);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+bool has_group(hid_t f, const char* name) { return H5Lexists(f, name, H5P_DEFAULT) > 0; }
+
+void check_shape(const Problem3& p) {
+  const Eigen::Index n = 3 * static_cast<Eigen::Index>(p.nc);
+  if (p.W.rows() != n || p.W.cols() != n || p.q.size() != n || p.mu.size() != p.nc ||
+      (p.mu_b.size() != 0 && p.mu_b.size() != p.nc))
+    throw std::invalid_argument(fmt::format(
+        "3D problem shape: nc {}, W {}x{}, q {}, mu {}, mu_b {} (expected W {}x{}, q {}, mu {})",
+        p.nc, p.W.rows(), p.W.cols(), p.q.size(), p.mu.size(), p.mu_b.size(), n, n, n, p.nc));
+}
+
+// ---- rows and their coupling through the 3x3 blocks of W -----------------
+
+struct Row3 {
+  Mat3 S;      // symmetric part of W_kk: the local solver's block
+  Vec3 b;      // q_k
+  Vec3 r;      // impulse
+  Cone3 cone;
+  double adh;  // adhesion impulse (0 for FCLib problems)
+};
+
+// No boundary dofs in a frozen problem; the sweep's interface asks for a type.
+struct NoDof {
+  double v = 0, v0 = 0;
+};
+double update_dof(NoDof&, Row3*) { return 0.0; }
+
+struct MatrixCoupling3 {
+  const Row3* base = nullptr;
+  std::vector<std::int32_t> start, col;  // block row i: [start[i], start[i+1])
+  std::vector<Mat3> blk;
+
+  Vec3 velocity(const Row3& r) const {
+    const std::size_t i = &r - base;
+    Vec3 u = r.b;
+    for (std::int32_t k = start[i]; k < start[i + 1]; ++k) u.noalias() += blk[k] * base[col[k]].r;
+    return u;
+  }
+
+  template <class L, bool Write1>
+  void update(Row3& r, double& dp2, double& pabs) const {
+    const Vec3 bl = velocity(r) - r.S * r.r;  // the law sees u = S r' + bl
+    Vec3 rn;
+    L::solve(r, bl, rn);
+    dp2 = (rn - r.r).squaredNorm();
+    pabs = rn.norm();
+    r.r = rn;
+  }
+};
+
+double row_residual(const MatrixCoupling3& c, const Row3& r) {
+  return law_residual3(c.velocity(r), r.r, r.cone, r.adh, 1.0 / r.S(0, 0));
+}
+double impulse_norm(const Row3& r) { return r.r.norm(); }
+
+// The laws, chosen once per problem (no friction test inside the sweep).
+struct Frictionless3 {
+  static void solve(const Row3& r, const Vec3& b, Vec3& out) {
+    out = Vec3(std::max(-r.adh, -b[0] / r.S(0, 0)), 0.0, 0.0);
+  }
+};
+struct Coulomb3 {
+  static void solve(const Row3& r, const Vec3& b, Vec3& out) {
+    solve_local3(r.S, b, r.cone, r.adh, out);
+  }
+};
+
+}  // namespace
+
+Fclib3 read_fclib(const std::string& path) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported here, not printed by HDF5
+  if (H5Fis_hdf5(path.c_str()) <= 0)
+    throw std::runtime_error(fmt::format("{}: not an HDF5 file (or cannot be opened)", path));
+  bool local = false, global = false, solution = false;
+  {
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) throw std::runtime_error(fmt::format("{}: cannot open as HDF5", path));
+    local = has_group(f, "/fclib_local");
+    global = has_group(f, "/fclib_global");
+    solution = has_group(f, "/solution");
+    H5Fclose(f);
+  }
+  Fclib3 out;
+  Problem3& p = out.problem;
+  if (local) {
+    std::unique_ptr<fclib_local, void (*)(fclib_local*)> L(fclib_read_local(path.c_str()),
+                                                           fclib_delete_local);
+    if (!L) throw std::runtime_error(fmt::format("{}: fclib_read_local failed", path));
+    if (L->spacedim != 3)
+      throw std::runtime_error(fmt::format("{}: space dimension {}, expected 3", path, L->spacedim));
+    if (L->V || L->R) throw std::runtime_error(fmt::format("{}: mixed problem (V, R): not supported", path));
+    p.W = to_eigen(L->W, "W", path);
+    if (p.W.rows() != p.W.cols() || p.W.rows() % 3)
+      throw std::runtime_error(fmt::format("{}: W is {}x{}", path, p.W.rows(), p.W.cols()));
+    p.nc = static_cast<int>(p.W.rows() / 3);
+    p.q = Eigen::Map<const Eigen::VectorXd>(L->q, 3 * p.nc);
+    p.mu = Eigen::Map<const Eigen::VectorXd>(L->mu, p.nc);
+  } else if (global) {
+    std::unique_ptr<fclib_global, void (*)(fclib_global*)> G(fclib_read_global(path.c_str()),
+                                                             fclib_delete_global);
+    if (!G) throw std::runtime_error(fmt::format("{}: fclib_read_global failed", path));
+    if (G->spacedim != 3)
+      throw std::runtime_error(fmt::format("{}: space dimension {}, expected 3", path, G->spacedim));
+    if (G->G) throw std::runtime_error(fmt::format("{}: equality constraints (G): not supported", path));
+    const SpMat M = to_eigen(G->M, "M", path), H = to_eigen(G->H, "H", path);
+    if (M.rows() != M.cols() || H.rows() != M.rows() || H.cols() % 3)
+      throw std::runtime_error(fmt::format("{}: M {}x{}, H {}x{}", path, M.rows(), M.cols(), H.rows(), H.cols()));
+    p.nc = static_cast<int>(H.cols() / 3);
+    out.global = true;
+    out.bodies_dofs = static_cast<int>(M.rows());
+    // W = H^T M^-1 H, q = H^T M^-1 f + w (FCLib: M v = H r + f, u = H^T v + w).
+    Eigen::SimplicialLDLT<SpMat> chol(M);
+    if (chol.info() != Eigen::Success || chol.vectorD().minCoeff() <= 0)
+      throw std::runtime_error(fmt::format("{}: M is not symmetric positive definite", path));
+    const SpMat X = chol.solve(H);
+    p.W = SpMat(H.transpose() * X);
+    p.W.prune(0.0);
+    p.W.makeCompressed();
+    const Eigen::VectorXd f = Eigen::Map<const Eigen::VectorXd>(G->f, M.rows());
+    p.q = H.transpose() * chol.solve(f) + Eigen::Map<const Eigen::VectorXd>(G->w, 3 * p.nc);
+    p.mu = Eigen::Map<const Eigen::VectorXd>(G->mu, p.nc);
+  } else {
+    throw std::runtime_error(fmt::format("{}: no fclib_local or fclib_global group", path));
+  }
+  if (!p.q.allFinite() || !p.mu.allFinite() || (p.nc && p.mu.minCoeff() < 0))
+    throw std::runtime_error(fmt::format("{}: q or mu not finite, or mu < 0", path));
+  if (solution) {
+    fclib_solution* s = fclib_read_solution(path.c_str());
+    if (s && s->r) out.r_ref = Eigen::Map<const Eigen::VectorXd>(s->r, 3 * p.nc);
+    if (s) fclib_delete_solutions(s, 1);
+  }
+  return out;
+}
+
+Residual problem_residual(const Problem3& p, const Eigen::VectorXd& r) {
+  check_shape(p);
+  Residual res;
+  if (p.nc == 0) return res;
+  const Eigen::VectorXd u = p.W * r + p.q;
+  double rmax = 0, rsum = 0, psum = 0;
+  for (int k = 0; k < p.nc; ++k) {
+    const Vec3 rk = r.segment<3>(3 * k);
+    const double e = law_residual3(u.segment<3>(3 * k), rk, p.cone(k), 0.0, 1.0 / p.W.coeff(3 * k, 3 * k));
+    rmax = std::max(rmax, e);
+    rsum += e;
+    psum += rk.norm();
+  }
+  res.r_mean = psum / p.nc;
+  const double scale = res.r_mean > 0 ? res.r_mean : 1.0;
+  res.max = rmax / scale;
+  res.mean = rsum / p.nc / scale;
+  return res;
+}
+
+double siconos_error(const Problem3& p, const Eigen::VectorXd& r) {
+  check_shape(p);
+  const Eigen::VectorXd u = p.W * r + p.q;
+  double e2 = 0;
+  for (int k = 0; k < p.nc; ++k)
+    e2 += siconos_term3(u.segment<3>(3 * k), r.segment<3>(3 * k), p.mu[k]);
+  const double nq = p.q.norm();
+  return nq > std::numeric_limits<double>::epsilon() ? std::sqrt(e2) / nq : std::sqrt(e2);
+}
+
+NlgsStats solve_nlgs(const Problem3& p, Eigen::VectorXd& r, const NlgsOptions& opt) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  check_shape(p);
+  const int nc = p.nc;
+  if (r.size() != 3 * nc) r = Eigen::VectorXd::Zero(3 * nc);
+  NlgsStats st;
+
+  // Block rows of W: for contact a, the 3x3 blocks W_ab (W column-major:
+  // entry (i, j) goes to block (i/3, j/3)).
+  std::vector<std::vector<std::pair<std::int32_t, Mat3>>> brow(nc);
+  for (int j = 0; j < 3 * nc; ++j)
+    for (SpMat::InnerIterator it(p.W, j); it; ++it) {
+      const int a = static_cast<int>(it.row()) / 3, b = j / 3;
+      auto& v = brow[a];
+      auto f = std::find_if(v.begin(), v.end(), [&](const auto& e) { return e.first == b; });
+      if (f == v.end()) {
+        v.push_back({b, Mat3::Zero()});
+        f = v.end() - 1;
+      }
+      f->second(it.row() % 3, j % 3) += it.value();
+    }
+  std::vector<std::vector<std::int32_t>> adj(nc);
+  for (int a = 0; a < nc; ++a)
+    for (const auto& e : brow[a])
+      if (e.first != a) {
+        adj[a].push_back(e.first);
+        adj[e.first].push_back(a);
+      }
+  const Colouring col = colour_blocks(nc, adj);
+  std::vector<std::int32_t> inv(nc);
+  for (int i = 0; i < nc; ++i) inv[col.perm[i]] = i;
+
+  // As in 2D: the row holds the symmetric part S of W_kk (a condensed W is
+  // symmetric only to round-off) and the law sees b = u_k - S r_k with u_k
+  // from the true blocks, so a fixed point satisfies u = W r + q exactly.
+  std::vector<Row3> rows(nc);
+  bool friction = false;
+  for (int i = 0; i < nc; ++i) {
+    const int k = col.perm[i];
+    Mat3 Wkk = Mat3::Zero();
+    for (const auto& e : brow[k])
+      if (e.first == k) Wkk = e.second;
+    Row3& w = rows[i];
+    w.S = 0.5 * (Wkk + Wkk.transpose());
+    if (!(w.S(0, 0) > 0.0) || (p.mu[k] > 0 && w.S.llt().info() != Eigen::Success))
+      throw std::invalid_argument(
+          fmt::format("contact {}: diagonal block W_kk not positive definite (W_nn = {})", k, w.S(0, 0)));
+    w.b = p.q.segment<3>(3 * k);
+    w.r = r.segment<3>(3 * k);
+    w.cone = p.cone(k);
+    w.adh = 0.0;
+    friction = friction || w.cone.mu_a > 0 || w.cone.mu_b > 0;
+  }
+  MatrixCoupling3 c;
+  c.base = rows.data();
+  c.start.assign(nc + 1, 0);
+  for (int i = 0; i < nc; ++i) c.start[i + 1] = c.start[i] + static_cast<int>(brow[col.perm[i]].size());
+  c.col.resize(c.start[nc]);
+  c.blk.resize(c.start[nc]);
+  for (int i = 0; i < nc; ++i) {
+    auto& v = brow[col.perm[i]];
+    std::sort(v.begin(), v.end(), [&](const auto& x, const auto& y) { return inv[x.first] < inv[y.first]; });
+    for (std::size_t m = 0; m < v.size(); ++m) {
+      c.col[c.start[i] + m] = inv[v[m].first];
+      c.blk[c.start[i] + m] = v[m].second;
+    }
+  }
+
+  SolverParams prm;
+  prm.tol = opt.tol;
+  prm.max_iter = opt.max_sweeps;
+  if (opt.min_parallel > 0) prm.min_parallel = opt.min_parallel;
+  const int every = std::max(1, opt.check_every);
+  auto record = [&](int sweep, double dp_rel) {
+    SolveStats s;
+    sweep::residuals(rows, c, INT_MAX, s);
+    st.history.push_back({sweep, dp_rel, s.residual_max, s.residual_mean});
+  };
+  auto observer = [&](int it, double dp) {
+    if (it % every == 0) record(it, dp);
+  };
+  SolveStats s;
+  std::vector<NoDof>* nodofs = nullptr;
+  if (nc > 0)
+    s = friction ? sweep::solve<Coulomb3>(rows, col, c, prm, nodofs, observer)
+                 : sweep::solve<Frictionless3>(rows, col, c, prm, nodofs, observer);
+  st.sweeps = s.iterations;
+  st.converged = nc == 0 || !s.cap_hit;
+  st.dr_rel = s.dp_rel;
+  for (int i = 0; i < nc; ++i) r.segment<3>(3 * col.perm[i]) = rows[i].r;
+  if (nc > 0 && (st.history.empty() || st.history.back().sweep != st.sweeps))
+    record(st.sweeps, st.dr_rel);
+  st.residual = problem_residual(p, r);
+  st.siconos_error = siconos_error(p, r);
+  st.time = std::chrono::duration<double>(clock::now() - t0).count();
+  return st;
+}
+
+}  // namespace cd

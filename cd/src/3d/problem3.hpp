@@ -1,0 +1,62 @@
+// A 3D frictional contact problem as plain data (Siconos/FCLib "local"
+// layout, method.md section 13): find (u, r) with u = W r + q and the 3D
+// Signorini-Coulomb law (law3.hpp) at every contact; per contact the
+// normal component first, then the two tangential ones. W = H^T M^-1 H
+// (3nc x 3nc), r an impulse.
+//
+// Frozen problems come from FCLib .hdf5 files (tests/data/contact-problems):
+// a local problem gives W, q, mu directly; a global one (M v = H r + f,
+// u = H^T v + w) is condensed, W = H^T M^-1 H and q = H^T M^-1 f + w, with a
+// sparse Cholesky factorisation of M. They are solved by the NLGS sweep of
+// core/sweep.hpp (the 2D engine's skeleton) with 3D rows coupled through the
+// 3x3 blocks of W and the exact local solver, or by the polyhedral-cone LCP
+// (lemke3.hpp).
+#pragma once
+#include <string>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "frozen.hpp"
+#include "law3.hpp"
+
+namespace cd {
+
+struct Problem3 {
+  int nc = 0;
+  Eigen::SparseMatrix<double> W;  // 3nc x 3nc, column-major, compressed
+  Eigen::VectorXd q;              // 3nc
+  Eigen::VectorXd mu;             // nc: mu_a (round cone: the coefficient)
+  Eigen::VectorXd mu_b;           // nc, or empty: round cones (mu_b = mu)
+  Cone3 cone(int k) const { return {mu[k], mu_b.size() ? mu_b[k] : mu[k]}; }
+};
+
+struct Fclib3 {
+  Problem3 problem;
+  bool global = false;   // read from fclib_global (condensed) or fclib_local
+  int bodies_dofs = 0;   // global: size of M
+  Eigen::VectorXd r_ref; // the file's stored solution r, if any (else empty)
+};
+
+// Reads an FCLib .hdf5 problem of space dimension 3. Throws
+// std::runtime_error naming the file and what was wrong (not HDF5, no
+// fclib_local/fclib_global group, dimension 2, equality constraints G, bad
+// matrix indices, M not positive definite).
+Fclib3 read_fclib(const std::string& path);
+
+// Law residual (law_residual3 with rho = 1/W_nn), max and mean over contacts
+// divided by the mean |r_k|.
+Residual problem_residual(const Problem3& p, const Eigen::VectorXd& r);
+
+// Siconos' fc3d error (fc3d_compute_error): sqrt(sum_k |r_k - P_K(r_k -
+// u~_k)|^2) / ||q||, u~ = (u_n + mu |u_t|, u_t), rho = 1 (absolute if
+// ||q|| ~ 0). Round cones only (uses mu).
+double siconos_error(const Problem3& p, const Eigen::VectorXd& r);
+
+// NLGS with core/sweep.hpp: rows in the greedy colouring of W's block
+// pattern, the exact local solver on the symmetric part of each diagonal
+// block, starting from r (zero if its size is not 3nc). Throws
+// std::invalid_argument if a diagonal block is not positive definite.
+NlgsStats solve_nlgs(const Problem3& p, Eigen::VectorXd& r, const NlgsOptions& opt = {});
+
+}  // namespace cd
