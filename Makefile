@@ -133,10 +133,14 @@ COHESIVE_TOL ?= 1e-3
 ANGULAR_NS ?= 0 3 4 5 6 8 10 20 60
 ANGULAR_I ?= 0.01
 CDSIM := $(BUILD)/cd/cdsim
-# Loose square cell for N grains (lattice pitch 1.47 mm for d_mean = 1 mm,
-# size ratio 2), and the time step in t_p = d sqrt(rho/p): at most 0.05 t_p,
-# and at most 0.005 d of relative sliding per step (dt <= 0.005 t_p / I).
-cell_side = $(shell awk 'BEGIN { printf "%.6g", 1.5e-3 * int(sqrt($(N)) + 1) }')
+# The size law of the samples (docs/scenes.md): d_max/d_min and the
+# distribution (uniform_area: equal area per size class, the seeds' choice;
+# uniform: uniform in d). The preparation's cell is sized by cdsim from the
+# actual size law (shear.width = shear.height = 0), so any ratio works as is.
+SIZE_RATIO ?= 2
+SIZE_DIST  ?= uniform_area
+# The time step in t_p = d sqrt(rho/p): at most 0.05 t_p, and at most
+# 0.005 d of relative sliding per step (dt <= 0.005 t_p / I).
 dt_tp = $(shell awk 'BEGIN { x = 0.005 / $(1); printf "%.4g", x < 0.05 ? x : 0.05 }')
 # 100 series rows per unit strain: 0.01 / shear rate = 0.01 t_p / I.
 series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt(2.6 / $(P)) / $(1) }')
@@ -169,7 +173,8 @@ $(CAMPAIGNS)/prep/ns_%/.done: | build
 	$(CDSIM) configs/shear-prep.toml --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_interval=1 \
 	  --set output.snapshot_interval=0 \
 	  --set particles.n=$(N) --set particles.nsides=[$*] --set shear.pressure=$(P) \
-	  --set shear.width=$(cell_side) --set shear.height=$(cell_side) $(PREP_SET)
+	  --set particles.size_ratio=$(SIZE_RATIO) --set particles.size_dist=$(SIZE_DIST) \
+	  --set shear.width=0 --set shear.height=0 $(PREP_SET)
 	touch $@
 
 shear_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) \

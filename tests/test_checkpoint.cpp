@@ -313,9 +313,11 @@ TEST(CdsimRestart, KilledRunResumesBitIdentical) {
       sum[s] += std::stod(row.at(std::string("t_") + cd::kStageNames[s]));
   // Every stage of the step (output is also timed after the last row: the
   // final snapshot and checkpoint are written after it).
-  for (int s = 0; s < cd::kStages; ++s)
-    if (cd::Stage(s) != cd::Stage::Output)
+  for (int s = 0; s < cd::kStages; ++s) {
+    if (cd::Stage(s) != cd::Stage::Output) {
       EXPECT_NEAR(sum[s], wb.times.t[s], 1e-6 * wb.times.t[s]) << cd::kStageNames[s];
+    }
+  }
   std::cout << "killed after step " << killed_at << "; " << b.out;
   if (!HasFailure()) fs::remove_all(d);
 }
