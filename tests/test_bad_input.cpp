@@ -272,3 +272,49 @@ TEST(BadInput, CdproblemRefusesBadOptionsAndTrailingText) {
     EXPECT_EQ(r.code, 2) << opt << "\n" << r.out;
   }
 }
+
+// Continuation (issue 19): a run may start from a sheared run's checkpoint.
+// The Lees-Edwards offset and the cell rates are carried, the mean flow is
+// replaced by the new rate's profile, and the first rows overlap no more than
+// the old run did (resetting the offset, as before, overlapped grains across
+// the sheared boundary by up to a diameter, now refused at 0.05 d).
+TEST(Continuation, AShearRunStartsFromAnotherAtANewRate) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "continuation");
+  const std::string common =
+      "[gravity]\ng = [0.0, 0.0]\n[solver]\ntol = 1e-4\n[particles]\nd_mean = 1e-3\ndensity = 2.6\n";
+  const fs::path prep = write(dir, "prep.toml",
+      "name = \"prep\"\n" + common + "n = 60\n[shear]\nmode = \"periodic\"\nwidth = 0.0\nheight = 0.0\n"
+      "pressure = 100.0\nisotropic = true\ndt_tp = 0.05\n[time]\nduration = 0.02\n[output]\n"
+      "series_interval = 1e-3\ncheckpoint_interval = 0.02\n");
+  ASSERT_EQ(cdsim(prep.string() + " -q --out " + (dir / "prep").string()).code, 0);
+  const auto shear = [&](const std::string& name, const std::string& start, double I) {
+    const fs::path sc = write(dir, name + ".toml",
+        "name = \"" + name + "\"\n" + common + "n = 0\n[shear]\nmode = \"periodic\"\nwidth = 0.0\n"
+        "height = 0.0\npressure = 100.0\ninertial_number = " + std::to_string(I) + "\nstrain = 0.3\n"
+        "dt_tp = 0.05\nstart = \"" + start + "\"\n[output]\nseries_interval = 1e-5\ncheckpoint_interval = 1.0\n");
+    return cdsim(sc.string() + " -q --out " + (dir / name).string());
+  };
+  const cdtest::CmdResult a = shear("a", (dir / "prep" / "checkpoint.bin").string(), 0.1);
+  ASSERT_EQ(a.code, 0) << a.out;
+  const cdtest::CmdResult b = shear("b", (dir / "a" / "checkpoint.bin").string(), 0.05);
+  ASSERT_EQ(b.code, 0) << b.out;
+  const auto ra = csv(dir / "a" / "series.csv"), rb = csv(dir / "b" / "series.csv");
+  const auto col = [](const std::vector<std::vector<std::string>>& t, const std::string& name) {
+    std::size_t c = 0;
+    while (c < t[0].size() && t[0][c] != name) ++c;
+    EXPECT_LT(c, t[0].size()) << name;
+    std::vector<double> v;
+    for (std::size_t r = 1; r < t.size(); ++r) v.push_back(std::stod(t[r][c]));
+    return v;
+  };
+  const auto oa = col(ra, "max_overlap"), ob = col(rb, "max_overlap");
+  const double a_max = *std::max_element(oa.begin(), oa.end());
+  // The first rows of b: no overlap beyond what a had.
+  for (std::size_t k = 0; k < std::min<std::size_t>(5, ob.size()); ++k) EXPECT_LE(ob[k], a_max) << k;
+  // The new rate applies from the first step (shear rate = I / t_p).
+  const double tp = 1e-3 * std::sqrt(2.6 / 100.0);
+  EXPECT_NEAR(col(rb, "shear_rate").front(), 0.05 / tp, 1e-9 / tp);
+  // The cell continues: b's first height is a's last (within one step's change).
+  const double ha = col(ra, "cell_height").back(), hb = col(rb, "cell_height").front();
+  EXPECT_NEAR(hb, ha, 1e-3 * ha);
+}

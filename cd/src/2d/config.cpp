@@ -144,7 +144,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"shear", "isotropic", &Scene::isotropic, "", any(), "compaction: the width is a degree of freedom too, at sigma_xx = pressure (periodic, inertial_number = 0)"},
       {"shear", "strain", &Scene::strain, "", ge(0), "run until this shear strain (overrides time.duration); 0: use time.duration"},
       {"shear", "dt_tp", &Scene::dt_tp, "t_p", ge(0), "time step in units of t_p = d sqrt(rho/p) (overrides time.dt); 0: use time.dt"},
-      {"shear", "start", &Scene::start, "", any(), "checkpoint.bin of a preparation run (same particles) to start from, with the cell it reached; \"\": generate particles"},
+      {"shear", "start", &Scene::start, "", any(), "checkpoint.bin to start from (same particles): of a preparation run (the cell it reached, from rest) or of a shear run (continued: its Lees-Edwards offset and cell rates kept, its mean flow replaced by this run's rate; strain counted from 0); \"\": generate particles"},
   };
   return t;
 }

@@ -255,14 +255,36 @@ World build_world(const Scene& s0) {
                                      "particles.density to the preparation's",
                                      B.mass[i] / area, i, s.density));
     }
-    w.cell.offset = w.cell.hdot = w.cell.wdot = w.cell.strain = 0.0;
+    // A sheared sample (strain > 0) is continued: its Lees-Edwards offset
+    // and cell rates are kept (the images stay where the grains see them:
+    // resetting the offset would overlap grains across the sheared
+    // boundary), and its mean flow a + g y (least squares over the
+    // particles) is replaced by the new run's profile. A compacted sample
+    // starts from rest as before. Either way the strain counts from 0.
+    const bool sheared = w.cell.strain != 0.0;
+    if (!sheared) w.cell.offset = w.cell.hdot = w.cell.wdot = 0.0;
+    w.cell.strain = 0.0;
     w.set_warm_start(prep.warm_start());
     const double gd = wp.cell.shear_rate;
+    double a = 0, g = 0;  // the sample's mean flow vx = a + g y
+    if (sheared) {
+      double sy = 0, sv = 0, syy = 0, syv = 0, m = 0;
+      for (std::size_t i = 0; i < B.size(); ++i)
+        if (B.is_dynamic(i)) {
+          const double y = B.pos[i].y(), v = B.vel[i].vx;
+          sy += y, sv += v, syy += y * y, syv += y * v, m += 1;
+        }
+      const double den = m * syy - sy * sy;
+      g = den > 0 ? (m * syv - sy * sv) / den : 0.0;
+      a = m > 0 ? (sv - g * sy) / m : 0.0;
+    }
     double dsum = 0;
     int nd = 0;
     for (std::size_t i = 0; i < B.size(); ++i)
       if (B.is_dynamic(i)) {
-        B.vel[i].vx += gd * (B.pos[i].y() - 0.5 * w.cell.height);
+        const double y = B.pos[i].y();
+        if (sheared) B.vel[i].vx -= a + g * y;
+        B.vel[i].vx += gd * (y - 0.5 * w.cell.height);
         dsum += 2 * B.radius[i];
         ++nd;
       }
@@ -370,7 +392,7 @@ World build_world(const Scene& s0) {
   std::vector<ContactRow> rows;
   std::vector<ContactInfo> info;
   CellGrid grid;
-  PeriodicCell cell{shear, shear && !walls, w.cell.width, w.cell.height, 0.0};
+  PeriodicCell cell{shear, shear && !walls, w.cell.width, w.cell.height, w.cell.offset};
   try {
     detect(B, B.pos, B.angle, 0.0, grid, rows, info, shear ? &cell : nullptr);
   } catch (const std::runtime_error& e) {
