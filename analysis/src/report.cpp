@@ -351,7 +351,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       html_runs += fmt::format("<p>{}</p>\n", html_escape(e.what()));
     }
     runs_csv += fmt::format("{},\"{}\",{}", k, run, status);
-    for (const double v : cost) runs_csv += "," + or_na(v, "{:.17g}");
+    for (const double v : cost) runs_csv += "," + or_na(v, "{}");  // shortest exact text
     runs_csv += "," + (pt.cost ? fmt::format("{}", pt.cost->threads) : std::string("n/a")) + "\n";
     pt.status = status;
     points.push_back(pt);
