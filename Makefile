@@ -146,7 +146,13 @@ dt_tp = $(shell awk 'BEGIN { x = 0.005 / $(1); printf "%.4g", x < 0.05 ? x : 0.0
 series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt(2.6 / $(P)) / $(1) }')
 # A contact snapshot every 0.2 strain (fabric, cdanalysis fabric / report).
 snapshot_dt = $(shell awk 'BEGIN { printf "%.6g", 0.2e-3 * sqrt(2.6 / $(P)) / $(1) }')
-CAMPAIGN_SET = --set output.quiet=true --set output.checkpoint_interval=0.05
+# Checkpoints every CKPT_STRAIN of shear strain and at most every CKPT_WALL
+# seconds of wall clock (at the next series row), so that a kill loses little
+# (docs/shear.md). Preparations have no strain: the wall clock alone.
+CKPT_STRAIN ?= 0.1
+CKPT_WALL ?= 300
+CAMPAIGN_SET = --set output.quiet=true --set output.checkpoint_strain=$(CKPT_STRAIN) \
+	  --set output.checkpoint_wall=$(CKPT_WALL)
 
 inertial_runs   := $(foreach i,$(INERTIAL_I),$(CAMPAIGNS)/inertial/I_$(i))
 cohesive_runs   := $(foreach e,$(COHESIVE_ETA),$(foreach i,$(COHESIVE_I),$(CAMPAIGNS)/cohesive/eta_$(e)_I_$(i)))
@@ -170,7 +176,7 @@ campaign-prep-of:
 
 # Compacted samples: disks (ns_0) or n-gons, N grains, isotropic at P.
 $(CAMPAIGNS)/prep/ns_%/.done: | build
-	$(CDSIM) configs/shear-prep.toml --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_interval=1 \
+	$(CDSIM) configs/shear-prep.toml --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_strain=0 \
 	  --set output.snapshot_interval=0 \
 	  --set particles.n=$(N) --set particles.nsides=[$*] --set shear.pressure=$(P) \
 	  --set particles.size_ratio=$(SIZE_RATIO) --set particles.size_dist=$(SIZE_DIST) \

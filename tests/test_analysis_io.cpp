@@ -13,10 +13,12 @@
 #include <numbers>
 #include <random>
 
+#include "analysis/src/cost.hpp"
 #include "analysis/src/report.hpp"
 #include "analysis/src/run.hpp"
 #include "analysis/src/snapshot.hpp"
 #include "cli_util.hpp"
+#include "run.hpp"  // cdsim's summary.toml writer (cd/src/2d/run.hpp)
 
 namespace fs = std::filesystem;
 using namespace cda;
@@ -212,6 +214,101 @@ TEST(AnalysisIo, ReportOfACampaign) {
     EXPECT_TRUE(fs::exists(d / "out" / "run000_polar_P.png"));
   }
   EXPECT_NE(message([&] { campaign_runs((d / "out").string()); }).find("holds no run"), std::string::npos);
+}
+
+// A run's summary.toml as cdsim writes it (cd::summary_toml).
+void write_summary(const fs::path& dir, double wall, double steps, double sweeps_mean, double cap_share) {
+  cd::RunSummary s;
+  s.status = "done";
+  s.last_step = static_cast<std::int64_t>(steps);
+  s.total_steps = s.last_step;
+  s.threads = 2;
+  s.totals.wall = wall;
+  s.totals.cpu = 2 * wall;
+  s.totals.sweeps = sweeps_mean * steps;
+  s.totals.cap_steps = cap_share * steps;
+  s.totals.sessions = 1;
+  write(dir / "summary.toml", cd::summary_toml(s));
+}
+
+// A tiny inertial campaign: four points, three with their cost in
+// summary.toml, one without (older cdsim, or killed before its first
+// session ended), and one more whose summary is damaged. Every table has
+// the cost columns beside the physics; a missing or damaged summary reads
+// n/a (nan in the numeric tables) and never stops the report; the total is
+// over the runs that have one.
+TEST(AnalysisIo, ReportShowsTheCostOfEachPoint) {
+  const auto d = scratch("report_cost");
+  const double I[] = {1e-3, 1e-2, 0.1, 0.3, 0.03};
+  for (int k = 0; k < 5; ++k)
+    make_run(d / fmt::format("I_{}", I[k]), 0.28 + 0.34 / (1 + 0.05 / I[k]), I[k], 20 + k);
+  write_summary(d / "I_0.001", 100.5, 4000, 250.25, 0.375);
+  write_summary(d / "I_0.01", 20.25, 2000, 120, 0.02);
+  write_summary(d / "I_0.1", 5, 400, 60.5, 0);
+  write(d / "I_0.03" / "summary.toml", "wall_time = \"soon\"\n");  // damaged
+  EXPECT_EQ(read_run_cost((d / "I_0.3").string()), std::nullopt);
+  const auto c = read_run_cost((d / "I_0.01").string());
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->wall_time, 20.25);
+  EXPECT_EQ(c->cpu_time, 40.5);
+  EXPECT_EQ(c->steps, 2000);
+  EXPECT_EQ(c->sweeps_per_step, 120);
+  EXPECT_EQ(c->cap_share, 0.02);
+  EXPECT_EQ(c->threads, 2);
+  EXPECT_NE(message([&] { read_run_cost((d / "I_0.03").string()); }).find("is not a number"), std::string::npos);
+
+  const auto s = write_report(d.string(), (d / "out").string());
+  EXPECT_EQ(s.runs, 5u);
+  EXPECT_EQ(s.steady, 5u);
+  EXPECT_EQ(s.costed, 3u);
+  EXPECT_DOUBLE_EQ(s.wall_time, 100.5 + 20.25 + 5);
+  EXPECT_DOUBLE_EQ(s.cpu_time, 2 * (100.5 + 20.25 + 5));
+  EXPECT_TRUE(std::any_of(s.problems.begin(), s.problems.end(),
+                          [](const std::string& p) { return p.find("summary.toml") != std::string::npos; }));
+
+  // steady.csv and fabric.csv: the cost columns, nan without a summary.
+  // Runs are sorted by folder name: I_0.001, I_0.01, I_0.03, I_0.1, I_0.3.
+  for (const char* f : {"steady.csv", "fabric.csv"}) {
+    SCOPED_TRACE(f);
+    const auto t = Table::read_csv((d / "out" / f).string(), true);
+    ASSERT_EQ(t.rows(), 5u);
+    const std::vector<double> wall = {100.5, 20.25, NAN, 5, NAN}, steps = {4000, 2000, NAN, 400, NAN},
+                              sweeps = {250.25, 120, NAN, 60.5, NAN}, cap = {0.375, 0.02, NAN, 0, NAN};
+    for (std::size_t i = 0; i < 5; ++i) {
+      const auto eq = [&](const char* col, double want) {
+        const double got = t.column(col)[i];
+        if (std::isnan(want)) EXPECT_TRUE(std::isnan(got)) << col << " row " << i;
+        else EXPECT_EQ(got, want) << col << " row " << i;
+      };
+      eq("wall_time", wall[i]);
+      eq("steps", steps[i]);
+      eq("sweeps_per_step", sweeps[i]);
+      eq("cap_share", cap[i]);
+    }
+  }
+  // runs.csv and index.html say n/a; the page gives the campaign's total.
+  std::ifstream runs(d / "out" / "runs.csv");
+  const std::string rtext((std::istreambuf_iterator<char>(runs)), {});
+  EXPECT_NE(rtext.find("run,folder,status,wall_time,cpu_time,steps,sweeps_per_step,cap_share,threads\n"),
+            std::string::npos) << rtext;
+  EXPECT_NE(rtext.find("I_0.3\",ok,n/a,n/a,n/a,n/a,n/a,n/a\n"), std::string::npos) << rtext;
+  EXPECT_NE(rtext.find("I_0.01\",ok,20.25,40.5,2000,120,0.02,2\n"), std::string::npos) << rtext;
+  std::ifstream html(d / "out" / "index.html");
+  const std::string h((std::istreambuf_iterator<char>(html)), {});
+  EXPECT_NE(h.find("125.8 s of wall time"), std::string::npos) << h;
+  EXPECT_NE(h.find("2 without one are not counted"), std::string::npos) << h;
+  EXPECT_NE(h.find("<td>37.5 %</td>"), std::string::npos) << h;
+  EXPECT_NE(h.find("<td>n/a</td>"), std::string::npos) << h;
+  // Cost against I: the three points with a cost, by measured I.
+  EXPECT_TRUE(s.cost_plot);
+  const auto ci = Table::read_csv((d / "out" / "cost_I.csv").string());
+  ASSERT_EQ(ci.rows(), 3u);
+  EXPECT_EQ(ci.column("wall_time")[0], 100.5);
+  EXPECT_NEAR(ci.column("I")[0], 1e-3, 1e-4);
+  if (std::system("gnuplot --version > /dev/null 2>&1") == 0) {
+    EXPECT_TRUE(s.plots_ok);
+    EXPECT_TRUE(fs::exists(d / "out" / "cost_I.png"));
+  }
 }
 
 TEST(AnalysisIo, CommandLineExitsNonZeroNamingTheFile) {

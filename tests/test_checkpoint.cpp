@@ -10,11 +10,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstring>
 #include <array>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -29,6 +32,8 @@
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataReader.h>
+
+#include <fmt/format.h>
 
 #include "checkpoint.hpp"
 #include "cli_util.hpp"
@@ -126,8 +131,30 @@ TEST(Checkpoint, DamagedFilesAreNamedAndLeaveTheWorldUnchanged) {
   expect_error(flipped, "corrupt");
   expect_error("not a checkpoint at all", "not a cdlab checkpoint");
   std::string v2 = good;
-  v2[8] = 9;  // version field (this build reads 2)
+  v2[8] = 9;  // version field (this build reads 4)
   expect_error(v2, "version 9");
+  // Version 3 (no run totals): refused for a resume, with a clear message.
+  std::string v3 = good;
+  v3[8] = 3;
+  cd::RunTotals t;
+  t.sessions = 7;
+  spit(f, v3);
+  try {
+    cd::load_checkpoint(f.string(), x, &t);
+    ADD_FAILURE() << "a version 3 checkpoint was resumed";
+  } catch (const cd::CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("format version 3, which holds no run totals"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(t.sessions, 7.0);
+  EXPECT_EQ(x.steps, 0);
+
+  // The totals round-trip.
+  cd::RunTotals in{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2};
+  cd::save_checkpoint(f.string(), w, 1, in);
+  cd::RunTotals out;
+  cd::load_checkpoint(f.string(), x, &out);
+  EXPECT_EQ(std::memcmp(&in, &out, sizeof in), 0);
   EXPECT_THROW(cd::load_checkpoint((d / "missing.bin").string(), x), cd::CheckpointError);
 }
 
@@ -322,6 +349,162 @@ TEST(CdsimRestart, KilledRunResumesBitIdentical) {
   if (!HasFailure()) fs::remove_all(d);
 }
 
+// ---- a campaign run killed at half its length ---------------------------------
+
+// Spawns `args` (output to /dev/null) and kills it with SIGKILL as soon as
+// `ready()` holds. Returns false if the run ended first.
+bool run_and_kill_when(std::vector<std::string> args, const std::function<bool()>& ready) {
+  std::vector<char*> argv;
+  for (auto& s : args) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  int status = 0;
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(300)) {
+    if (waitpid(pid, &status, WNOHANG) == pid) return false;
+    if (ready()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, &status, 0);
+  return WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL;
+}
+
+// summary.toml as key -> value text.
+std::map<std::string, std::string> summary_fields(const fs::path& p) {
+  std::ifstream in(p);
+  std::map<std::string, std::string> f;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    const auto eq = line.find(" = ");
+    if (eq == std::string::npos) continue;
+    std::string v = line.substr(eq + 3);
+    if (const auto h = v.find(" #"); h != std::string::npos) v.erase(h);
+    while (!v.empty() && v.back() == ' ') v.pop_back();
+    f[line.substr(0, eq)] = v;
+  }
+  return f;
+}
+
+// The run's cost in summary.toml against its series: steps are the last
+// row's step, the mean sweeps the step-weighted mean of the iterations
+// column (10 significant digits), the cap steps the sum of cap_hit, the
+// largest residual and overlap the columns' maxima.
+void expect_summary_matches_series(const fs::path& run) {
+  const auto f = summary_fields(run / "summary.toml");
+  const auto rows = series_cells(run / "series.csv");
+  ASSERT_FALSE(rows.empty());
+  double prev = 0, sweeps = 0, cap = 0, res = 0, ov = 0, it_max = 0;
+  for (const auto& r : rows) {
+    const double step = std::stod(r.at("step"));
+    sweeps += std::stod(r.at("iterations")) * (step - prev);
+    prev = step;
+    cap += std::stod(r.at("cap_hit"));
+    res = std::max(res, std::stod(r.at("residual")));
+    ov = std::max(ov, std::stod(r.at("max_overlap")));
+    it_max = std::max(it_max, std::stod(r.at("iterations_max")));
+  }
+  EXPECT_EQ(std::stod(f.at("steps")), prev) << run;
+  EXPECT_NEAR(std::stod(f.at("sweeps_mean")), sweeps / prev, 1e-9 * sweeps / prev) << run;
+  EXPECT_EQ(std::stod(f.at("sweeps_max")), it_max) << run;
+  EXPECT_EQ(std::stod(f.at("cap_steps")), cap) << run;
+  EXPECT_DOUBLE_EQ(std::stod(f.at("cap_share")), cap / prev) << run;
+  EXPECT_NEAR(std::stod(f.at("residual_max")), res, 1e-9 * res) << run;
+  EXPECT_NEAR(std::stod(f.at("overlap_max")), ov, 1e-9 * ov + 1e-300) << run;
+  EXPECT_GT(std::stod(f.at("wall_time")), 0.0) << run;
+  EXPECT_GT(std::stod(f.at("cpu_time")), 0.0) << run;
+  EXPECT_GE(std::stod(f.at("threads")), 1.0) << run;
+  EXPECT_EQ(f.at("status"), "\"done\"") << run;
+  EXPECT_TRUE(f.count("cdlab_version") && f.at("cdlab_version").size() > 2) << run;
+  EXPECT_EQ(f.at("load_start").front(), '[') << run;
+}
+
+// A campaign's shear run, small: configs/shear-inertial.toml with 80 grains
+// (generated loose in the cell, so no preparation is needed), sheared to
+// gamma = 1 at I = 0.01 (2000 steps, a series row every 0.01 of strain as in
+// the campaigns), with the campaign's checkpoint keys (Makefile,
+// CAMPAIGN_SET: every 0.1 of strain, and every 300 s of wall clock), at the
+// cohesive campaigns' tolerance 1e-3 to keep it to about a second.
+std::vector<std::string> campaign_run(const fs::path& out, const std::string& ckpt) {
+  std::vector<std::string> a = {kCdsim, std::string(CDLAB_SOURCE_DIR) + "/configs/shear-inertial.toml",
+                                "--quiet", "--out", out.string(), "--threads", "1"};
+  for (const char* set : {"particles.n=80", "shear.start=\"\"", "shear.width=0.0135",
+                          "shear.height=0.0135", "shear.strain=1", "solver.tol=1e-3",
+                          "output.series_interval=1.612452e-4",  // 0.01 strain: 20 steps
+                          "output.snapshot_interval=1.612452e-3"})  // 0.1 strain
+    a.insert(a.end(), {"--set", set});
+  std::stringstream s(ckpt);
+  for (std::string set; s >> set;) a.insert(a.end(), {"--set", set});
+  return a;
+}
+
+std::string joined(const std::vector<std::string>& a) {
+  std::string s;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    s += (i ? " '" : "'") + a[i] + "'";
+  return s;
+}
+
+// The README's promise, tested: a campaign run killed (SIGKILL) at about
+// half its length resumes from a checkpoint written after at least 40 % of
+// it and ends bit-identical to a run never stopped (series but the t_*
+// columns, snapshots). Once with strain checkpoints, once with wall-clock
+// ones at every series row (a wall-clock trigger changes no result), and the
+// summaries of the resumed runs cover both sessions.
+TEST(CdsimRestart, CampaignRunKilledAtHalfResumesBitIdentical) {
+  const fs::path d = temp_dir("half");
+  const std::string strain = "output.checkpoint_strain=0.1 output.checkpoint_wall=300";
+  const Result a = cdtest::run_command(joined(campaign_run(d / "A", strain)));
+  ASSERT_EQ(a.code, 0) << a.out;
+  EXPECT_EQ(a.out.find("warning: output.checkpoint"), std::string::npos) << a.out;
+  const auto steps_a = row_steps(d / "A" / "series.csv");
+  ASSERT_EQ(steps_a.size(), 100u);
+  const long n = steps_a.back();
+  ASSERT_EQ(n, 2000);
+  expect_summary_matches_series(d / "A");
+
+  for (const auto& [name, ckpt] : {std::pair<std::string, std::string>{"B", strain},
+                                   {"C", "output.checkpoint_wall=1e-9"}}) {
+    SCOPED_TRACE(name + ": " + ckpt);
+    const fs::path run = d / name;
+    // Killed once the series shows more than 45 % of its rows.
+    ASSERT_TRUE(run_and_kill_when(campaign_run(run, ckpt), [&] {
+      std::ifstream f(run / "series.csv");
+      return std::count(std::istreambuf_iterator<char>(f), {}, '\n') > 1 + 45;
+    })) << "the run ended before it could be killed";
+    ASSERT_TRUE(fs::exists(run / "checkpoint.bin"));
+    cd::World w{cd::WorldParams{}};
+    cd::RunTotals t;
+    cd::load_checkpoint((run / "checkpoint.bin").string(), w, &t);
+    EXPECT_GE(w.steps, 0.4 * n) << "the last checkpoint before the kill";
+    EXPECT_LT(w.steps, n);
+    EXPECT_EQ(t.sessions, 1.0);
+    EXPECT_GT(t.wall, 0.0);
+    EXPECT_EQ(w.steps % 20, 0) << "checkpoints fall on series rows";
+    std::cout << name << ": killed with " << row_steps(run / "series.csv").back()
+              << " steps in series.csv, checkpoint at step " << w.steps << " of " << n << "\n";
+
+    const Result r = cdtest::run_command(joined(campaign_run(run, ckpt)));
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("resumed from"), std::string::npos) << r.out;
+    expect_same_outputs(d / "A", run);
+    expect_summary_matches_series(run);
+    const auto fa = summary_fields(d / "A" / "summary.toml"), fr = summary_fields(run / "summary.toml");
+    EXPECT_EQ(fr.at("sessions"), "2");
+    for (const char* k : {"steps", "sweeps_mean", "sweeps_max", "cap_steps", "residual_final",
+                          "residual_max", "overlap_max"})
+      EXPECT_EQ(fa.at(k), fr.at(k)) << k;
+  }
+  if (!HasFailure()) fs::remove_all(d);
+}
+
 // A small scene for the refusal cases.
 const std::string kTiny = R"(name = "tiny"
 [time]
@@ -388,6 +571,64 @@ TEST(CdsimRestart, DamagedOrForeignCheckpointIsRefusedUnlessFresh) {
   EXPECT_NE(r.out.find("not a cdlab checkpoint"), std::string::npos) << r.out;
   EXPECT_EQ(cdsim(scene.string() + out + " --fresh").code, 0);
   EXPECT_NE(slurp(ckpt), "garbage");
+  if (!HasFailure()) fs::remove_all(d);
+}
+
+TEST(CdsimRestart, CheckpointKeysAreCheckedAndLongIntervalsWarned) {
+  const fs::path d = temp_dir("keys");
+  const fs::path scene = d / "s.toml";
+  spit(scene, kTiny);
+  const std::string out = " --quiet --out " + (d / "out").string();
+  // An interval as long as the run: a warning, and the checkpoint at the end.
+  Result r = cdsim(scene.string() + out + " --set output.checkpoint_interval=0.05");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("warning: output.checkpoint_interval = 0.05 s is 20 steps"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no checkpoint before the end"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(d / "out" / "checkpoint.bin"));
+  r = cdsim(scene.string() + out + " --fresh");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
+  // A strain interval needs a shear rate: refused, nothing written.
+  r = cdsim(scene.string() + " --quiet --out " + (d / "strain").string() +
+            " --set output.checkpoint_strain=0.1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("output.checkpoint_strain > 0 needs a shear rate"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(d / "strain"));
+  // The wall-clock key alone turns checkpoints on (one at the end at least);
+  // a run resumed with other checkpoint keys is the same scene.
+  r = cdsim(scene.string() + " --quiet --out " + (d / "wall").string() + " --set output.checkpoint_interval=0"
+            " --set output.checkpoint_wall=3600");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(fs::exists(d / "wall" / "checkpoint.bin"));
+  r = cdsim(scene.string() + " --quiet --out " + (d / "wall").string() + " --set output.checkpoint_wall=1");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("resumed from"), std::string::npos) << r.out;
+  if (!HasFailure()) fs::remove_all(d);
+}
+
+TEST(CdsimSummary, CapShareIsShownAndWarnedAbove1Percent) {
+  const fs::path d = temp_dir("cap");
+  const fs::path scene = d / "s.toml";
+  spit(scene, kTiny);
+  // One sweep a step cannot converge a contact problem: every step with
+  // contacts stops at the cap.
+  Result r = cdsim(scene.string() + " --quiet --out " + (d / "out").string() +
+                   " --set solver.max_iter=1 --set solver.tol=1e-12");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto f = summary_fields(d / "out" / "summary.toml");
+  const double share = std::stod(f.at("cap_share"));
+  EXPECT_GT(share, 0.01);
+  EXPECT_NE(r.out.find(fmt::format("({:.1f} % of steps)", 100 * share)), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("warning: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("stopped at the sweep cap (solver.max_iter = 1)"), std::string::npos) << r.out;
+  expect_summary_matches_series(d / "out");
+  // The default solver converges: no warning, share 0.
+  r = cdsim(scene.string() + " --quiet --fresh --out " + (d / "out").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("(0.0 % of steps)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
+  EXPECT_EQ(summary_fields(d / "out" / "summary.toml").at("cap_share"), "0.0");
+  expect_summary_matches_series(d / "out");
   if (!HasFailure()) fs::remove_all(d);
 }
 

@@ -38,7 +38,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
   const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, adhesion, debond, tol,
                max_iter, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
                box_width, box_height, disks, walls, series_interval, snapshot_interval,
-               checkpoint_interval, quiet, shear_mode, cell_width, cell_height, pressure,
+               checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, pressure,
                inertial_number, cell_mass, isotropic, strain, dt_tp, start, cohesion_number] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
@@ -48,7 +48,8 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
   CHECK_FIELD(box_height); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
-  CHECK_FIELD(checkpoint_interval); CHECK_FIELD(quiet);
+  CHECK_FIELD(checkpoint_interval); CHECK_FIELD(checkpoint_strain); CHECK_FIELD(checkpoint_wall);
+  CHECK_FIELD(quiet);
   CHECK_FIELD(shear_mode); CHECK_FIELD(cell_width); CHECK_FIELD(cell_height); CHECK_FIELD(pressure);
   CHECK_FIELD(inertial_number); CHECK_FIELD(cell_mass); CHECK_FIELD(isotropic); CHECK_FIELD(strain);
   CHECK_FIELD(dt_tp); CHECK_FIELD(start); CHECK_FIELD(cohesion_number);
@@ -96,6 +97,8 @@ Scene nondefault() {
   s.series_interval = 1e-3;
   s.snapshot_interval = 0.0;
   s.checkpoint_interval = 0.05;
+  s.checkpoint_strain = 0.1;
+  s.checkpoint_wall = 300.5;
   s.quiet = true;
   s.shear_mode = "walls";
   s.cell_width = 0.05;
@@ -233,6 +236,8 @@ TEST(Errors, ValueOutOfRange) {
       {"[output]\nseries_interval = 0", "x.toml:2:1: output.series_interval = 0: must be > 0"},
       {"[output]\nsnapshot_interval = -1", "x.toml:2:1: output.snapshot_interval = -1: must be >= 0"},
       {"[output]\ncheckpoint_interval = -1", "x.toml:2:1: output.checkpoint_interval = -1: must be >= 0"},
+      {"[output]\ncheckpoint_strain = -0.1", "x.toml:2:1: output.checkpoint_strain = -0.1: must be >= 0"},
+      {"[output]\ncheckpoint_wall = -5", "x.toml:2:1: output.checkpoint_wall = -5: must be >= 0"},
       {"name = \"\"", "x.toml:1:1: name = \"\": must be non-empty"},
       {"[solver]\ntol = 2.0", "x.toml:2:1: solver.tol = 2: must be in (0, 1]"},
       {"[particles]\nn = 200000000", "x.toml:2:1: particles.n = 200000000: must be in [0, 100000000]"},
@@ -357,9 +362,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 43 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 45 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 43u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 45u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

@@ -365,6 +365,12 @@ int main(int argc, char** argv) {
       const auto s = write_report(campaign, dir, bins);
       fmt::print("report in {}: {} runs, {} steady, {} with fabric{}\n", dir, s.runs, s.steady, s.fabric,
                  s.plots_ok ? "" : " (some plots failed: see the .gp.log files)");
+      if (s.costed)
+        fmt::print("cost: {:.1f} s wall time ({:.2f} h), {:.1f} s CPU time over {} runs{}\n", s.wall_time,
+                   s.wall_time / 3600, s.cpu_time, s.costed,
+                   s.costed < s.runs ? fmt::format(" ({} without summary.toml: n/a)", s.runs - s.costed) : "");
+      else
+        fmt::print("cost: n/a (no run has a summary.toml)\n");
       for (const auto& p : s.problems) fmt::print(stderr, "problem: {}\n", p);
       fmt::print("open {}/index.html\n", dir);
     }

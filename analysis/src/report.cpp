@@ -9,6 +9,8 @@
 #include <fstream>
 #include <numbers>
 
+#include "cost.hpp"
+
 namespace fs = std::filesystem;
 
 namespace cda {
@@ -37,6 +39,50 @@ std::string html_escape(const std::string& s) {
     else o += c;
   }
   return o;
+}
+
+// The cost columns of every table, and their values (nan without a summary).
+const std::vector<std::string> kCostColumns = {"wall_time", "cpu_time", "steps", "sweeps_per_step",
+                                               "cap_share"};
+std::vector<double> cost_values(const std::optional<RunCost>& c) {
+  if (!c) return std::vector<double>(kCostColumns.size(), std::nan(""));
+  return {c->wall_time, c->cpu_time, c->steps, c->sweeps_per_step, c->cap_share};
+}
+
+// A value for a text table: "n/a" when not measured.
+std::string or_na(double v, const char* spec = "{:.4g}") {
+  return std::isfinite(v) ? fmt::format(fmt::runtime(spec), v) : "n/a";
+}
+std::string or_na(double v, double err) {
+  return std::isfinite(v) ? (std::isfinite(err) ? fmt::format("{:.4g} ± {:.2g}", v, err)
+                                                : fmt::format("{:.4g}", v))
+                          : "n/a";
+}
+
+// One row of the report's table of points: physics and cost side by side.
+struct Point {
+  std::string name, status;
+  double I = std::nan(""), I_err = std::nan(""), mu = std::nan(""), mu_err = std::nan("");
+  double phi = std::nan(""), phi_err = std::nan(""), z = std::nan(""), z_err = std::nan("");
+  std::optional<RunCost> cost;
+};
+
+// Wall time and sweeps per step against the measured I (log-log), the
+// points of an inertial campaign: dir/cost_I.{png,svg}, data in cost_I.csv.
+bool plot_cost_I(const std::string& dir, const std::vector<Point>& points) {
+  Table t({"I", "wall_time", "sweeps_per_step", "cap_share", "steps"});
+  for (const Point& p : points)
+    if (p.cost && std::isfinite(p.I) && p.I > 0)
+      t.add_row({p.I, p.cost->wall_time, p.cost->sweeps_per_step, p.cost->cap_share, p.cost->steps});
+  t.write_csv((fs::path(dir) / "cost_I.csv").string());
+  const std::string body =
+      "set datafile separator ','\nset logscale x\nset logscale y\nset logscale y2\n"
+      "set xlabel 'I (measured)'\nset ylabel 'wall time (s)'\nset y2label 'NLGS sweeps per step'\n"
+      "set ytics nomirror\nset y2tics\nset key top right\nset grid\n"
+      "plot 'cost_I.csv' every ::1 using 1:2 with linespoints pt 7 lc rgb '#1f3b73' title 'wall time', \\\n"
+      "     'cost_I.csv' every ::1 using 1:3 axes x1y2 with linespoints pt 5 lc rgb '#b03a2e' "
+      "title 'sweeps per step'\n";
+  return plot_both(dir, "cost_I", body);
 }
 
 }  // namespace
@@ -199,11 +245,18 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     names.push_back(q + "_err");
   }
   names.insert(names.end(), {"window_begin", "window_end", "tau_int", "n_eff"});
+  names.insert(names.end(), kCostColumns.begin(), kCostColumns.end());
   Table steady(names);
-  Table fabric({"run", "a_c", "theta_c", "a_ln", "a_lt", "a_fn", "a_ft", "sum_half", "q_over_p",
-                "a_c_tensor", "a_ln_tensor", "a_lt_tensor", "a_fn_tensor", "a_ft_tensor",
-                "sliding", "z", "non_floating"});
-  std::string runs_csv = "run,folder,status\n";
+  std::vector<std::string> fabric_names = {
+      "run", "a_c", "theta_c", "a_ln", "a_lt", "a_fn", "a_ft", "sum_half", "q_over_p",
+      "a_c_tensor", "a_ln_tensor", "a_lt_tensor", "a_fn_tensor", "a_ft_tensor",
+      "sliding", "z", "non_floating"};
+  fabric_names.insert(fabric_names.end(), kCostColumns.begin(), kCostColumns.end());
+  Table fabric(fabric_names);
+  std::string runs_csv = "run,folder,status";
+  for (const auto& c : kCostColumns) runs_csv += "," + c;
+  runs_csv += ",threads\n";
+  std::vector<Point> points;
   std::string html_runs;
   std::vector<double> I, mu, mu_err;
   for (std::size_t k = 0; k < runs.size(); ++k) {
@@ -212,6 +265,19 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     std::string status = "ok";
     std::string stem = fmt::format("run{:03d}", k);
     html_runs += fmt::format("<h3>{} ({})</h3>\n", html_escape(name), stem);
+    Point pt;
+    pt.name = name;
+    try {
+      pt.cost = read_run_cost(run);
+    } catch (const AnalysisError& e) {
+      sum.problems.push_back(e.what());  // the cost columns say n/a
+    }
+    if (pt.cost) {
+      ++sum.costed;
+      sum.wall_time += pt.cost->wall_time;
+      sum.cpu_time += pt.cost->cpu_time;
+    }
+    const std::vector<double> cost = cost_values(pt.cost);
     try {
       const auto series = read_series(run);
       const std::string xc = default_x_column(series);
@@ -239,7 +305,10 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
           }
         }
         row.insert(row.end(), {w.x_begin, w.x_end, tau, neff});
+        row.insert(row.end(), cost.begin(), cost.end());
         steady.add_row(row);
+        pt.mu = row[1], pt.mu_err = row[2], pt.I = row[3], pt.I_err = row[4];
+        pt.phi = row[5], pt.phi_err = row[6], pt.z = row[7], pt.z_err = row[8];
         ++sum.steady;
         if (series.has("q_over_p") && series.has("inertial_number")) {
           I.push_back(row[3]);
@@ -258,11 +327,14 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
           const auto f = run_fabric(run, -1, bins, -1);
           const auto& a = f.fft;
           const auto& b = f.tensor;
-          fabric.add_row({static_cast<double>(k), a.c.a(), a.c.theta(), a.ln.a(), a.lt.a(), a.fn.a(),
-                          a.ft.a(), a.sum_half(), f.stress.q_over_p(), b.c.a(), b.ln.a(), b.lt.a(),
-                          b.fn.a(), b.ft.a(), f.sliding,
-                          f.connectivity ? f.connectivity->z : std::nan(""),
-                          f.connectivity ? f.connectivity->non_floating : std::nan("")});
+          std::vector<double> frow = {
+              static_cast<double>(k), a.c.a(), a.c.theta(), a.ln.a(), a.lt.a(), a.fn.a(),
+              a.ft.a(), a.sum_half(), f.stress.q_over_p(), b.c.a(), b.ln.a(), b.lt.a(),
+              b.fn.a(), b.ft.a(), f.sliding,
+              f.connectivity ? f.connectivity->z : std::nan(""),
+              f.connectivity ? f.connectivity->non_floating : std::nan("")};
+          frow.insert(frow.end(), cost.begin(), cost.end());
+          fabric.add_row(frow);
           ++sum.fabric;
           sum.plots_ok = plot_polar(out_dir, stem + "_polar", f) && sum.plots_ok;
           html_runs += fmt::format("<p>last snapshot {}</p>\n", html_escape(f.file));
@@ -278,7 +350,11 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       sum.problems.push_back(e.what());
       html_runs += fmt::format("<p>{}</p>\n", html_escape(e.what()));
     }
-    runs_csv += fmt::format("{},\"{}\",{}\n", k, run, status);
+    runs_csv += fmt::format("{},\"{}\",{}", k, run, status);
+    for (const double v : cost) runs_csv += "," + or_na(v, "{}");  // shortest exact text
+    runs_csv += "," + (pt.cost ? fmt::format("{}", pt.cost->threads) : std::string("n/a")) + "\n";
+    pt.status = status;
+    points.push_back(pt);
   }
   write_text((fs::path(out_dir) / "runs.csv").string(), runs_csv);
   steady.write_csv((fs::path(out_dir) / "steady.csv").string());
@@ -304,13 +380,55 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   }
   write_text((fs::path(out_dir) / "fits.toml").string(), fits_to_toml(fits, models));
 
+  // Cost against I, for a campaign over I (measured I spanning a factor 1.5 or more).
+  std::string html_cost;
+  {
+    double lo = INFINITY, hi = 0;
+    std::size_t n = 0;
+    for (const Point& p : points)
+      if (p.cost && std::isfinite(p.I) && p.I > 0) ++n, lo = std::min(lo, p.I), hi = std::max(hi, p.I);
+    if (n >= 2 && hi >= 1.5 * lo) {
+      sum.cost_plot = true;
+      sum.plots_ok = plot_cost_I(out_dir, points) && sum.plots_ok;
+      html_cost = "<h2>Cost against I</h2><img src='cost_I.png' width=600>"
+                  "<p>Data: <a href='cost_I.csv'>cost_I.csv</a>.</p>\n";
+    }
+  }
+
+  // The table of points: physics, then what each cost (summary.toml; n/a without one).
+  std::string html_points =
+      "<h2>Points</h2>\n<table border=1 cellspacing=0 cellpadding=3>\n"
+      "<tr><th colspan=6>physics (steady window)</th><th colspan=5>cost (summary.toml)</th></tr>\n"
+      "<tr><th>run</th><th>status</th><th>I</th><th>μ* = q/p</th><th>φ</th><th>z</th>"
+      "<th>wall time (s)</th><th>CPU time (s)</th><th>steps</th><th>sweeps/step</th><th>at cap</th></tr>\n";
+  for (const Point& p : points) {
+    const std::vector<double> c = cost_values(p.cost);
+    html_points += fmt::format(
+        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
+        "<td>{}</td><td>{}</td><td>{}</td></tr>\n",
+        html_escape(p.name), html_escape(p.status), or_na(p.I, p.I_err), or_na(p.mu, p.mu_err),
+        or_na(p.phi, p.phi_err), or_na(p.z, p.z_err), or_na(c[0], "{:.1f}"), or_na(c[1], "{:.1f}"),
+        or_na(c[2], "{:.0f}"), or_na(c[3], "{:.1f}"),
+        std::isfinite(c[4]) ? fmt::format("{:.1f} %", 100 * c[4]) : "n/a");
+  }
+  html_points += "</table>\n";
+  const std::string html_total =
+      sum.costed
+          ? fmt::format("<p>Cost of the campaign: {:.1f} s of wall time ({:.2f} h) and {:.1f} s of CPU "
+                        "time over the {} runs with a summary.toml{}.</p>\n",
+                        sum.wall_time, sum.wall_time / 3600, sum.cpu_time, sum.costed,
+                        sum.costed < sum.runs
+                            ? fmt::format("; {} without one are not counted", sum.runs - sum.costed)
+                            : "")
+          : "<p>Cost of the campaign: n/a (no run has a summary.toml).</p>\n";
+
   std::string html = fmt::format(
       "<!doctype html>\n<html><head><meta charset='utf-8'><title>cdanalysis report</title></head><body>\n"
       "<h1>cdanalysis report: {}</h1>\n<p>{} runs, {} steady, {} with fabric. Tables: "
       "<a href='runs.csv'>runs.csv</a>, <a href='steady.csv'>steady.csv</a>, "
       "<a href='fabric.csv'>fabric.csv</a>; fits: <a href='fits.toml'>fits.toml</a>.</p>\n",
       html_escape(campaign), sum.runs, sum.steady, sum.fabric);
-  html += html_fit;
+  html += html_total + html_points + html_fit + html_cost;
   if (!sum.problems.empty()) {
     html += "<h2>Problems</h2><ul>\n";
     for (const auto& p : sum.problems) html += "<li>" + html_escape(p) + "</li>\n";

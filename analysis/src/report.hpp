@@ -44,11 +44,21 @@ std::vector<std::string> campaign_runs(const std::string& campaign);
 
 struct ReportSummary {
   std::size_t runs = 0, steady = 0, fabric = 0;
+  // Cost: runs with a summary.toml, and their wall and CPU time summed (s).
+  std::size_t costed = 0;
+  double wall_time = 0, cpu_time = 0;
+  bool cost_plot = false;  // cost_I.{png,svg} drawn (an inertial campaign)
   std::vector<std::string> problems;  // one line per run or step that failed
   bool plots_ok = true;
 };
 
-// The whole report of a campaign into out_dir (created).
+// The whole report of a campaign into out_dir (created): runs.csv, steady.csv
+// and fabric.csv (each with the cost columns wall_time, cpu_time, steps,
+// sweeps_per_step, cap_share from the run's summary.toml: nan in steady.csv
+// and fabric.csv, which are read back as numbers, "n/a" in runs.csv, when a
+// run has none), fits.toml, plots, cost_I.{csv,png,svg} for a campaign over
+// I, and index.html with a table of points (physics and cost) and the
+// campaign's total wall and CPU time.
 ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins = 36);
 
 }  // namespace cda

@@ -77,10 +77,21 @@ int main(int argc, char** argv) {
     const double per_step = s.steps ? s.wall_time / s.steps : 0.0;
     fmt::print(
         "cdsim: {} steps in {:.2f} s ({:.3g} ms/step, {} threads); iterations/step mean {:.1f}, "
-        "max {}, cap hit {} times; law residual max {:.2e}; overlap max {:.2e} d ({:.2e} of the "
-        "smaller grain's diameter)\n",
+        "max {}, cap hit {} times ({:.1f} % of steps); law residual max {:.2e}; overlap max "
+        "{:.2e} d ({:.2e} of the smaller grain's diameter)\n",
         s.steps, s.wall_time, 1e3 * per_step, omp_get_max_threads(), s.mean_iterations,
-        s.max_iterations, s.cap_hits, s.max_residual, s.max_overlap, s.max_overlap_small);
+        s.max_iterations, s.cap_hits, s.steps ? 100.0 * double(s.cap_hits) / double(s.steps) : 0.0,
+        s.max_residual, s.max_overlap, s.max_overlap_small);
+    fmt::print("cdsim: outputs in {}/ (the run's cost: summary.toml)\n", out);
+    // Over the whole run (every session), as summary.toml says.
+    if (s.cap_share() > 0.01)
+      fmt::print(stderr,
+                 "cdsim: warning: {:.1f} % of the run's steps ({} of {}) stopped at the sweep cap "
+                 "(solver.max_iter = {}) before reaching solver.tol: their contact laws are not "
+                 "converged (raise solver.max_iter or solver.tol, or shorten the time step; "
+                 "docs/accuracy.md)\n",
+                 100.0 * s.cap_share(), static_cast<long long>(s.totals.cap_steps), s.last_step,
+                 scene.max_iter);
     // The overlap users read: relative to the smaller grain of the pair.
     constexpr double kOverlapWarn = 0.01;
     if (s.max_overlap_small > kOverlapWarn)
@@ -89,16 +100,16 @@ int main(int argc, char** argv) {
                  "diameter (> {}): see the series' max_overlap_small column; a smaller time step "
                  "or tolerance reduces it\n",
                  s.max_overlap_small, kOverlapWarn);
-    fmt::print("cdsim: outputs in {}/\n", out);
     if (s.stopped_at_max_steps)
       fmt::print("cdsim: stopped after --max-steps {} (step {} of the scene's {})\n", max_steps,
                  s.first_step + s.steps, s.total_steps);
     if (s.stop_signal) {
       fmt::print("cdsim: stopped by signal {} after step {}{}\n", s.stop_signal,
                  s.first_step + s.steps,
-                 scene.checkpoint_interval > 0 || s.first_step > 0
+                 scene.checkpoint_interval > 0 || scene.checkpoint_strain > 0 ||
+                         scene.checkpoint_wall > 0 || s.first_step > 0
                      ? "; checkpoint written: the same command resumes"
-                     : " (no checkpoint: output.checkpoint_interval = 0)");
+                     : " (no checkpoint: output.checkpoint_interval, _strain and _wall are 0)");
       return 128 + s.stop_signal;
     }
   } catch (const cd::RunDiverged& e) {

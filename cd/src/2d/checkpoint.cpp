@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <tuple>
 #include <type_traits>
@@ -23,8 +24,24 @@ static_assert(std::endian::native == std::endian::little,
 constexpr std::string_view kMagic = "CDLABCKP";
 // 2: the periodic cell; 3: the stage timers as a named array (world.hpp's
 // stage table). A version 2 file is refused: its run's series.csv has the
-// old timer columns, which the resumed rows could not continue.
-constexpr std::uint32_t kVersion = 3;
+// old timer columns, which the resumed rows could not continue. 4: the
+// run's totals (RunTotals, for summary.toml). A version 3 file is refused for
+// a resume (its run's cost would be lost), read as a start sample.
+constexpr std::uint32_t kVersion = 4;
+constexpr std::uint32_t kStartVersion = 3;  // the oldest read as a start sample
+
+// RunTotals' fields, in order: the name of its array, so that a build with
+// other totals refuses the file by name.
+constexpr const char* kTotalsNames[] = {"wall",         "cpu",           "sweeps",
+                                        "sweeps_max",   "cap_steps",     "residual_max",
+                                        "residual_last", "overlap_max",  "sessions"};
+static_assert(sizeof(RunTotals) == std::size(kTotalsNames) * sizeof(double),
+              "a RunTotals field is missing from kTotalsNames (checkpoint.cpp)");
+std::string totals_name() {
+  std::string s = "totals";
+  for (const char* n : kTotalsNames) s += std::string(":") + n;
+  return s;
+}
 
 // The name of the timers' array: the stage names, so that a checkpoint
 // from a build with another stage table is refused by name.
@@ -130,7 +147,8 @@ std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h) {
   return h;
 }
 
-void save_checkpoint(const std::string& path, const World& w, std::uint64_t scene_key) {
+void save_checkpoint(const std::string& path, const World& w, std::uint64_t scene_key,
+                     const RunTotals& totals) {
   Writer o;
   o.buf += kMagic;
   o.put(kVersion);
@@ -142,11 +160,14 @@ void save_checkpoint(const std::string& path, const World& w, std::uint64_t scen
   o.array("warm.keys", w.warm_start().keys);
   o.array("warm.p", w.warm_start().p);
   o.array("cell", std::vector<CellState>{w.cell});
+  std::vector<double> t(std::size(kTotalsNames));
+  std::memcpy(t.data(), &totals, sizeof totals);
+  o.array(totals_name(), t);
   o.put(fnv1a(o.buf));
   write_file_atomic(path, o.buf);  // binary-safe: the string is written as is
 }
 
-std::uint64_t load_checkpoint(const std::string& path, World& w) {
+std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* totals) {
   std::ifstream f(path, std::ios::binary);
   std::ostringstream text;
   if (f) text << f.rdbuf();
@@ -157,8 +178,12 @@ std::uint64_t load_checkpoint(const std::string& path, World& w) {
   if (!kMagic.starts_with(in.rest.substr(0, kMagic.size()))) in.fail("is not a cdlab checkpoint");
   in.need(kMagic.size(), "the magic string");
   in.rest.remove_prefix(kMagic.size());
-  if (const auto v = in.get<std::uint32_t>("the version"); v != kVersion)
-    in.fail(fmt::format("has format version {}; this build reads version {}", v, kVersion));
+  const auto version = in.get<std::uint32_t>("the version");
+  if (version == kStartVersion && totals)
+    in.fail(fmt::format("has format version {}, which holds no run totals (summary.toml); this "
+                        "build resumes version {} only", version, kVersion));
+  if (version != kVersion && version != kStartVersion)
+    in.fail(fmt::format("has format version {}; this build reads version {}", version, kVersion));
   // The checksum first: a truncated or damaged file is named as such, not by
   // whichever field happens to look wrong.
   in.need(sizeof(std::uint64_t), "the header");
@@ -187,6 +212,13 @@ std::uint64_t load_checkpoint(const std::string& path, World& w) {
   std::vector<CellState> cell;
   in.array("cell", cell);
   if (cell.size() != 1) in.fail("is corrupt (cell state)");
+  RunTotals tot;
+  if (version >= 4) {
+    std::vector<double> t;
+    in.array(totals_name(), t);
+    if (t.size() != std::size(kTotalsNames)) in.fail("is corrupt (run totals)");
+    std::memcpy(static_cast<void*>(&tot), t.data(), sizeof tot);
+  }
   if (!in.rest.empty()) in.fail("has unexpected data after the last array");
 
   w.bodies = std::move(b);
@@ -195,6 +227,7 @@ std::uint64_t load_checkpoint(const std::string& path, World& w) {
   w.times = times;
   w.set_warm_start(std::move(warm));
   w.cell = cell[0];
+  if (totals) *totals = tot;
   return key;
 }
 
@@ -207,6 +240,8 @@ std::uint64_t scene_key(const Scene& scene) {
   s.threads = 0;
   s.quiet = false;
   s.checkpoint_interval = 0;
+  s.checkpoint_strain = 0;
+  s.checkpoint_wall = 0;
   return fnv1a(resolved_toml(s));
 }
 

@@ -1,5 +1,7 @@
 #include "run.hpp"
 
+#include <omp.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -7,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include <fmt/format.h>
 
@@ -14,12 +17,38 @@
 #include "output.hpp"
 #include "problem.hpp"
 #include "setup.hpp"
+#include "version.hpp"
 
 namespace cd {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// CPU time of the process, user + system (s): every thread's.
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// The 1, 5 and 15 minute load averages; empty when /proc/loadavg is unreadable.
+std::vector<double> load_average() {
+  std::ifstream f("/proc/loadavg");
+  double a, b, c;
+  if (f >> a >> b >> c) return {a, b, c};
+  return {};
+}
+
+// A TOML float: shortest text that reads back exactly, with a '.' or exponent.
+std::string toml_float(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  std::string t = fmt::format("{}", x);
+  if (t.find_first_of(".e") == std::string::npos) t += ".0";
+  return t;
+}
 
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_stop(int sig) { g_stop = sig; }
@@ -57,6 +86,7 @@ void clear_previous(const std::filesystem::path& dir) {
     const std::string f = e.path().filename().string();
     const bool ours = f == "series.csv" || f == "scene.toml" || e.path().extension() == ".pvd" ||
                       f.starts_with("checkpoint.bin") || f.starts_with("problem_") ||
+                    f.starts_with("summary.toml") ||
                       (e.path().extension() == ".vtp" &&
                        (f.starts_with("particles_") || f.starts_with("contacts_") ||
                         f.starts_with("walls_") || f.starts_with("shapes_")));
@@ -121,6 +151,38 @@ struct ShearInterval {
 
 }  // namespace
 
+std::string summary_toml(const RunSummary& s) {
+  const RunTotals& t = s.totals;
+  const auto load = [](const std::vector<double>& l) {
+    std::string o = "[";
+    for (std::size_t i = 0; i < l.size(); ++i) o += (i ? ", " : "") + toml_float(l[i]);
+    return o + "]";
+  };
+  const auto line = [](const std::string& kv, const char* doc) {
+    return fmt::format("{:<32} # {}\n", kv, doc);
+  };
+  std::string o =
+      "# The cost of this run, over every session (cdsim call) that ran it: docs/outputs.md\n";
+  o += line(fmt::format("cdlab_version = \"{}\"", version()), "git describe of the build; \"unknown\" outside a clone");
+  o += line(fmt::format("status = \"{}\"", s.status), "done, stopped (signal), max-steps, diverged");
+  o += line(fmt::format("steps = {}", s.last_step), "the last step taken (series.csv's last row)");
+  o += line(fmt::format("total_steps = {}", s.total_steps), "the scene's steps");
+  o += line(fmt::format("sessions = {}", std::llround(t.sessions)), "cdsim calls that took steps (1 + resumes)");
+  o += line("wall_time = " + toml_float(t.wall), "s, in the run loop, summed over sessions up to the last checkpoint or the end");
+  o += line("cpu_time = " + toml_float(t.cpu), "s, user + system of every thread, likewise");
+  o += line(fmt::format("threads = {}", s.threads), "OpenMP threads of the last session");
+  o += line("load_start = " + load(s.load_start), "/proc/loadavg (1, 5, 15 min) when the last session started");
+  o += line("load_end = " + load(s.load_end), "and when it ended");
+  o += line("sweeps_mean = " + toml_float(s.last_step ? t.sweeps / double(s.last_step) : 0.0), "NLGS sweeps per step, mean over the steps");
+  o += line(fmt::format("sweeps_max = {}", std::llround(t.sweeps_max)), "most sweeps of one step");
+  o += line(fmt::format("cap_steps = {}", std::llround(t.cap_steps)), "steps stopped at solver.max_iter");
+  o += line("cap_share = " + toml_float(s.cap_share()), "cap_steps / steps");
+  o += line("residual_final = " + toml_float(t.residual_last), "law residual of the last step");
+  o += line("residual_max = " + toml_float(t.residual_max), "largest law residual of any step");
+  o += line("overlap_max = " + toml_float(t.overlap_max), "largest overlap, in mean diameters");
+  return o;
+}
+
 void install_stop_handlers() {
   std::signal(SIGINT, on_stop);
   std::signal(SIGTERM, on_stop);
@@ -144,21 +206,30 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   };
   const std::int64_t every_row = steps_of(s.series_interval);
   const std::int64_t every_snap = s.snapshot_interval > 0 ? steps_of(s.snapshot_interval) : 0;
-  // Checkpoints fall on series rows, so that no row's interval spans a restart.
-  const std::int64_t every_ckpt =
-      s.checkpoint_interval > 0
-          ? every_row * std::max<std::int64_t>(
-                            1, (steps_of(s.checkpoint_interval) + every_row - 1) / every_row)
-          : 0;
+  // Checkpoints fall on series rows, so that no row's interval spans a
+  // restart: every so much simulated time, or shear strain, rounded up to
+  // whole rows; or at the first row after checkpoint_wall seconds of wall
+  // clock. Writing one only reads the state, so when they fall (even by the
+  // clock) changes no result.
+  const auto on_rows = [&](std::int64_t k) {
+    return every_row * std::max<std::int64_t>(1, (k + every_row - 1) / every_row);
+  };
+  const std::int64_t every_ckpt = s.checkpoint_interval > 0 ? on_rows(steps_of(s.checkpoint_interval)) : 0;
+  const double rate = shear_rate(s);
+  const std::int64_t every_ckpt_strain =
+      s.checkpoint_strain > 0 && rate > 0 ? on_rows(steps_of(s.checkpoint_strain / rate)) : 0;
+  const double ckpt_wall = s.checkpoint_wall;
+  const bool checkpoints = every_ckpt || every_ckpt_strain || ckpt_wall > 0;
   const bool progress = !opt.quiet && isatty(STDERR_FILENO);
 
   // Resume from a checkpoint of this scene; checked before anything is written.
   const std::uint64_t key = scene_key(s);
   const bool resume = !opt.fresh && fs::exists(ckpt);
   std::vector<std::string> columns;  // of series.csv, cut back to the checkpoint
+  RunTotals tot;                     // the run's cost so far (summary.toml)
   if (resume) {
     try {
-      if (load_checkpoint(ckpt, w) != key || w.steps > nsteps)
+      if (load_checkpoint(ckpt, w, &tot) != key || w.steps > nsteps)
         throw CheckpointError(fmt::format("checkpoint '{}' was written by a different scene "
                                           "(compare with {})", ckpt, (dir / "scene.toml").string()));
       columns = truncate_series(series_path, w.steps);
@@ -168,6 +239,18 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     }
   }
   const std::int64_t k0 = resume ? w.steps : 0;
+
+  // An interval as long as the run writes no checkpoint before the end.
+  const auto warn_long = [&](std::int64_t every, const std::string& what) {
+    if (every && every >= nsteps)
+      std::fprintf(stderr, "cdsim: warning: %s is %lld steps (rounded up to whole series rows), "
+                   "not shorter than the run's %lld: it writes no checkpoint before the end%s\n",
+                   what.c_str(), static_cast<long long>(every), static_cast<long long>(nsteps),
+                   ckpt_wall > 0 ? " (output.checkpoint_wall still does)"
+                                 : ", so a kill loses the whole run");
+  };
+  warn_long(every_ckpt, fmt::format("output.checkpoint_interval = {} s", s.checkpoint_interval));
+  warn_long(every_ckpt_strain, fmt::format("output.checkpoint_strain = {}", s.checkpoint_strain));
 
   fs::create_directories(opt.out);
   if (!resume) clear_previous(opt.out);
@@ -186,8 +269,37 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   double v_prev = w.cell.width * w.cell.height, t_prev = w.time;
   iv.t0 = w.times;  // restored on resume
   const auto start = Clock::now();
-  auto last_print = start;
+  const double cpu0 = cpu_seconds();
+  sum.load_start = load_average();
+  auto last_print = start, last_ckpt = start;
   long iter_total = 0;
+  if (k0 < nsteps) tot.sessions += 1;
+  // The totals as they stand now: the wall and CPU time of this session added.
+  const auto totals_now = [&] {
+    RunTotals t = tot;
+    t.wall += std::chrono::duration<double>(Clock::now() - start).count();
+    t.cpu += cpu_seconds() - cpu0;
+    return t;
+  };
+  // summary.toml: at the end of the session, however it ends.
+  const auto write_summary = [&](const char* status, std::int64_t last) {
+    sum.status = status;
+    sum.last_step = last;
+    sum.total_steps = nsteps;
+    sum.totals = totals_now();
+    sum.threads = omp_get_max_threads();
+    sum.load_end = load_average();
+    write_file_atomic((dir / "summary.toml").string(), summary_toml(sum));
+  };
+  // A diverged run still says what it cost, up to `last`, the last step
+  // counted; a failure to write that does not hide the divergence.
+  const auto diverged = [&](std::int64_t last, const std::string& msg) {
+    try {
+      write_summary("diverged", last);
+    } catch (const std::exception&) {
+    }
+    return RunDiverged(msg);
+  };
 
   auto timed_output = [&](auto&& f) {
     const auto t = Clock::now();
@@ -219,14 +331,14 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     } catch (const std::runtime_error& e) {
       // A step that cannot go on (e.g. a periodic cell shrunk below what
       // detection needs): the run stops as a diverged one, its outputs kept.
-      throw RunDiverged(fmt::format("step {} (t = {:.6g} s): {}; series.csv holds the rows before it",
+      throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): {}; series.csv holds the rows before it",
                                     k, w.time, e.what()));
     }
     const StepStats& st = w.last();
     if (const std::string bad = non_finite(w); !bad.empty())
-      throw RunDiverged(fmt::format("step {} (t = {:.6g} s): non-finite state: {}; series.csv "
+      throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): non-finite state: {}; series.csv "
                                     "holds the rows before it{}", k, w.time, bad,
-                                    every_ckpt ? ", checkpoint.bin (if written) the last good state" : ""));
+                                    checkpoints ? ", checkpoint.bin (if written) the last good state" : ""));
     const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps;
     const bool stopping = g_stop != 0 || at_limit;
     if (stopping) k_end = k;
@@ -243,6 +355,12 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     sum.max_residual = std::max(sum.max_residual, st.solve.residual_max);
     sum.max_overlap = std::max(sum.max_overlap, st.max_overlap);
     sum.max_overlap_small = std::max(sum.max_overlap_small, st.max_overlap_small);
+    tot.sweeps += st.solve.iterations;
+    tot.sweeps_max = std::max(tot.sweeps_max, double(st.solve.iterations));
+    tot.cap_steps += st.solve.cap_hit;
+    tot.residual_max = std::max(tot.residual_max, st.solve.residual_max);
+    tot.residual_last = st.solve.residual_max;
+    tot.overlap_max = std::max(tot.overlap_max, st.max_overlap);
 
     if (k % every_row == 0 || k == nsteps || stopping) {
       timed_output([&] {
@@ -306,7 +424,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
         }
         for (const auto& [name, x] : cols)
           if (!std::isfinite(x))
-            throw RunDiverged(fmt::format("step {} (t = {:.6g} s): series column {} is {}; "
+            throw diverged(k, fmt::format("step {} (t = {:.6g} s): series column {} is {}; "
                                           "series.csv holds the rows before it", k, w.time, name, x));
         series.row(cols);
         series.flush();
@@ -317,8 +435,13 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     if (every_snap && k % every_snap == 0) timed_output([&] { snaps.write(w); });
     // After this step's outputs, so that a restart has them all. A resumed
     // run keeps its checkpoint current even with checkpoints off.
-    if ((every_ckpt && k % every_ckpt == 0) || ((k == nsteps || stopping) && (every_ckpt || resume)))
-      timed_output([&] { save_checkpoint(ckpt, w, key); });
+    const bool wall_due = ckpt_wall > 0 && k % every_row == 0 &&
+                          std::chrono::duration<double>(Clock::now() - last_ckpt).count() >= ckpt_wall;
+    if ((every_ckpt && k % every_ckpt == 0) || (every_ckpt_strain && k % every_ckpt_strain == 0) ||
+        wall_due || ((k == nsteps || stopping) && (checkpoints || resume))) {
+      timed_output([&] { save_checkpoint(ckpt, w, key, totals_now()); });
+      last_ckpt = Clock::now();
+    }
     if (stopping) {
       sum.stop_signal = g_stop;
       sum.stopped_at_max_steps = at_limit && !g_stop;
@@ -345,6 +468,7 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   sum.mean_iterations = sum.steps ? double(iter_total) / sum.steps : 0.0;
   sum.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
   sum.kinetic_energy = w.kinetic_energy();
+  write_summary(sum.stop_signal ? "stopped" : sum.stopped_at_max_steps ? "max-steps" : "done", k_end);
   return sum;
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "checkpoint.hpp"
 #include "scene.hpp"
 #include "world.hpp"
 
@@ -53,7 +54,20 @@ struct RunSummary {
   double max_overlap_small = 0;  // largest overlap / the smaller grain's diameter
   double wall_time = 0;
   double kinetic_energy = 0;
+
+  // The whole run, every session (what summary.toml holds).
+  std::string status;           // "done", "stopped" (signal), "max-steps", "diverged"
+  std::int64_t last_step = 0;   // the last step taken
+  RunTotals totals;             // summed over sessions (checkpoint.hpp)
+  int threads = 0;              // OpenMP threads of this session
+  std::vector<double> load_start, load_end;  // /proc/loadavg (1, 5, 15 min) of this session; empty if unreadable
+  double cap_share() const { return last_step ? totals.cap_steps / double(last_step) : 0.0; }
 };
+
+// summary.toml, written into the run folder at the end of every session
+// (done, stopped by a signal or --max-steps, diverged): the cost of the whole
+// run, documented in docs/outputs.md.
+std::string summary_toml(const RunSummary& s);
 
 // Runs the world for the scene's duration. The caller has validated the
 // scene and checked the output folder; this creates it and writes into it.

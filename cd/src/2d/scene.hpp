@@ -86,6 +86,8 @@ struct Scene {
   double series_interval = 0.005;    // time between series rows (s)
   double snapshot_interval = 0.025;  // time between VTK snapshots (s); 0: none
   double checkpoint_interval = 0.0;  // time between checkpoints (s); 0: none
+  double checkpoint_strain = 0.0;    // shear strain between checkpoints; 0: none
+  double checkpoint_wall = 0.0;      // most wall-clock seconds between checkpoints; 0: none
   bool quiet = false;
 
   // [shear]: boundary protocols (method.md section 9)

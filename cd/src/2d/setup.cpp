@@ -103,6 +103,10 @@ namespace {
 void check_shear(const Scene& s) {
   auto fail = [](const std::string& m) { throw SceneError(m); };
   const bool shear = s.shear_mode != "none";
+  if (s.checkpoint_strain > 0 && (!shear || s.inertial_number <= 0))
+    fail("output.checkpoint_strain > 0 needs a shear rate (shear.mode \"periodic\" or \"walls\" "
+         "and shear.inertial_number > 0); use output.checkpoint_interval or "
+         "output.checkpoint_wall for other runs");
   if (s.cohesion_number > 0) {
     if (s.pressure <= 0) fail("contact.cohesion_number > 0 needs shear.pressure > 0 (f_a = eta p d)");
     if (s.adhesion > 0) fail("give contact.adhesion or contact.cohesion_number, not both");
