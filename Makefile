@@ -14,7 +14,7 @@ DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libbenchmark-dev gnuplot-nox libfclib-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build run test bench regress accuracy-cost tensile clean help analyze-inertial analyze-cohesive analyze-angularity scene-doc figures frozen-shear
+.PHONY: all deps build run test bench regress accuracy-cost tensile clean help analyze-inertial analyze-inertial-ladder analyze-cohesive analyze-angularity scene-doc figures frozen-shear
 
 all: build
 
@@ -28,6 +28,7 @@ help:
 	@echo "make scene-doc      regenerate docs/scene-parameters.md from cdsim --help-scene (test_help_scene checks it)"
 	@echo "make figures        regenerate docs/figures/ (installs ParaView's pvbatch and xvfb if missing; not part of make test)"
 	@echo "make campaign-inertial|campaign-cohesive|campaign-angularity [N=200 STRAIN=2 P=100 ...]"
+	@echo "make campaign-inertial-ladder  the inertial values from the highest I down, each from the point above"
 	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
 	@echo "make frozen-shear   steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into $(FROZEN)/ [FS_N=1000]"
 	@echo "make regress        re-run the reference campaign, refit mu(I), compare with tests/data/regress/"
@@ -192,6 +193,29 @@ $(CAMPAIGNS)/inertial/I_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
 	$(call shear_run,$*,0)
 	touch $@
 
+# The ladder (make campaign-inertial-ladder): the same values of I, run from
+# the highest down, each point starting from the end state of the point above
+# it (shear.start on a sheared run continues it: Lees-Edwards offset and cell
+# rates kept, mean flow set to the new rate), the highest from the compacted
+# sample. Each point's transient is short (the structure is already sheared)
+# and cdanalysis detects the steady window as for fresh runs; LADDER_STRAIN
+# (default STRAIN) may be shorter. Runs in inertial-ladder/, beside the fresh
+# campaign, so that the two compare (docs/shear.md).
+LADDER_STRAIN ?= $(STRAIN)
+ladder_runs := $(foreach i,$(INERTIAL_I),$(CAMPAIGNS)/inertial-ladder/I_$(i))
+# The point above I in INERTIAL_I sorted by value ("" for the highest).
+ladder_above = $(shell printf '%s\n' $(INERTIAL_I) | sort -g | awk -v i=$(1) 'f { print; exit } $$1 == i { f = 1 }')
+ladder_start = $(if $(call ladder_above,$(1)),$(CAMPAIGNS)/inertial-ladder/I_$(call ladder_above,$(1)),$(CAMPAIGNS)/prep/ns_0)
+.PHONY: campaign-inertial-ladder
+campaign-inertial-ladder: $(addsuffix /.done,$(ladder_runs))
+.SECONDEXPANSION:
+$(CAMPAIGNS)/inertial-ladder/I_%/.done: $$(call ladder_start,$$*)/.done
+	$(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) \
+	  --set shear.start='"$(call ladder_start,$*)/checkpoint.bin"' --set shear.pressure=$(P) \
+	  --set shear.inertial_number=$* --set shear.strain=$(LADDER_STRAIN) --set shear.dt_tp=$(call dt_tp,$*) \
+	  --set output.series_interval=$(call series_dt,$*) --set output.snapshot_interval=$(call snapshot_dt,$*)
+	touch $@
+
 # eta_<eta>_I_<I>: f_a = eta p d; eta = 0 are the reference runs of the fit.
 $(CAMPAIGNS)/cohesive/eta_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
 	$(call shear_run,$(lastword $(subst _I_, ,$*)),0) --set contact.cohesion_number=$(firstword $(subst _I_, ,$*)) \
@@ -264,6 +288,10 @@ analyze-inertial: build
 analyze-cohesive: build
 	$(CDA) report $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive
 	$(CDA) fit cohesion $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive/cohesion --toml $(ANALYSIS)/cohesive/cohesion.toml
+
+analyze-inertial-ladder: build
+	$(CDA) report $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder
+	$(CDA) fit mu-i $(CAMPAIGNS)/inertial-ladder --toml $(ANALYSIS)/inertial-ladder/mu_i.toml
 
 analyze-angularity: build
 	$(CDA) report $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity
