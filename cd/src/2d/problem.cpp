@@ -21,6 +21,7 @@
 
 #include "law.hpp"
 #include "nlgs.hpp"
+#include "block_rows.hpp"
 #include "coupling.hpp"
 #include "colour_blocks.hpp"
 
@@ -620,26 +621,8 @@ NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& op
 
   // Block rows of W: for contact a, the 2x2 blocks W_ab of every b it
   // couples to (W is column-major: entry (i, j) goes to block (i/2, j/2)).
-  std::vector<std::vector<std::pair<std::int32_t, std::array<double, 4>>>> brow(nc);
-  using It = Eigen::SparseMatrix<double>::InnerIterator;
-  for (int j = 0; j < 2 * nc; ++j)
-    for (It it(p.W, j); it; ++it) {
-      const int a = static_cast<int>(it.row()) / 2, b = j / 2;
-      auto& v = brow[a];
-      auto f = std::find_if(v.begin(), v.end(), [&](const auto& e) { return e.first == b; });
-      if (f == v.end()) {
-        v.push_back({b, {0, 0, 0, 0}});
-        f = v.end() - 1;
-      }
-      f->second[2 * (it.row() % 2) + j % 2] += it.value();
-    }
-  std::vector<std::vector<std::int32_t>> adj(nc);
-  for (int a = 0; a < nc; ++a)
-    for (const auto& e : brow[a])
-      if (e.first != a) {
-        adj[a].push_back(e.first);
-        adj[e.first].push_back(a);
-      }
+  auto brow = block_rows<2>(p.W, nc, std::array<double, 4>{0, 0, 0, 0},
+                           [](std::array<double, 4>& b, int i, int j, double v) { b[2 * i + j] += v; });
 
   // Rows in colour order. A dumped W need not be exactly symmetric (the
   // slider-crank files' W_nt and W_tn differ by 6e-7 relative), but the
@@ -647,9 +630,8 @@ NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& op
   // S of W_kk and the law sees b = u_k - S r_k with u_k from the true
   // blocks, so a fixed point of the sweep satisfies u = W r + q exactly.
   // (Rejected: a non-symmetric local solver, only to serve dumped round-off.)
-  const Colouring col = colour_blocks(nc, adj);
-  std::vector<std::int32_t> inv(nc);
-  for (int i = 0; i < nc; ++i) inv[col.perm[i]] = i;
+  const Colouring col = colour_blocks(nc, block_adjacency(brow));
+  const std::vector<std::int32_t> inv = inverse_permutation(col.perm);
   std::vector<ContactRow> rows(nc);
   bool friction = false;
   for (int i = 0; i < nc; ++i) {
@@ -670,23 +652,9 @@ NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& op
   }
   MatrixCoupling c;
   c.base = rows.data();
-  c.start.assign(nc + 1, 0);
-  for (int i = 0; i < nc; ++i) c.start[i + 1] = c.start[i] + static_cast<int>(brow[col.perm[i]].size());
-  c.col.resize(c.start[nc]);
-  c.blk.resize(c.start[nc]);
-  for (int i = 0; i < nc; ++i) {
-    auto& v = brow[col.perm[i]];
-    std::sort(v.begin(), v.end(), [&](const auto& x, const auto& y) { return inv[x.first] < inv[y.first]; });
-    for (std::size_t m = 0; m < v.size(); ++m) {
-      c.col[c.start[i] + m] = inv[v[m].first];
-      c.blk[c.start[i] + m] = v[m].second;
-    }
-  }
+  colour_ordered_rows(brow, col.perm, inv, c.start, c.col, c.blk);
 
-  SolverParams prm;
-  prm.tol = opt.tol;
-  prm.max_iter = opt.max_sweeps;
-  if (opt.min_parallel > 0) prm.min_parallel = opt.min_parallel;
+  const SolverParams prm = solver_params(opt);
   const int every = std::max(1, opt.check_every);
   auto record = [&](int sweep, double dp_rel) {
     SolveStats s;

@@ -1,5 +1,7 @@
 #include "problem3.hpp"
 
+#include "block_rows.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <climits>
@@ -235,28 +237,10 @@ NlgsStats solve_nlgs(const Problem3& p, Eigen::VectorXd& r, const NlgsOptions& o
 
   // Block rows of W: for contact a, the 3x3 blocks W_ab (W column-major:
   // entry (i, j) goes to block (i/3, j/3)).
-  std::vector<std::vector<std::pair<std::int32_t, Mat3>>> brow(nc);
-  for (int j = 0; j < 3 * nc; ++j)
-    for (SpMat::InnerIterator it(p.W, j); it; ++it) {
-      const int a = static_cast<int>(it.row()) / 3, b = j / 3;
-      auto& v = brow[a];
-      auto f = std::find_if(v.begin(), v.end(), [&](const auto& e) { return e.first == b; });
-      if (f == v.end()) {
-        v.push_back({b, Mat3::Zero()});
-        f = v.end() - 1;
-      }
-      f->second(it.row() % 3, j % 3) += it.value();
-    }
-  std::vector<std::vector<std::int32_t>> adj(nc);
-  for (int a = 0; a < nc; ++a)
-    for (const auto& e : brow[a])
-      if (e.first != a) {
-        adj[a].push_back(e.first);
-        adj[e.first].push_back(a);
-      }
-  const Colouring col = colour_blocks(nc, adj);
-  std::vector<std::int32_t> inv(nc);
-  for (int i = 0; i < nc; ++i) inv[col.perm[i]] = i;
+  auto brow = block_rows<3>(p.W, nc, Mat3(Mat3::Zero()),
+                           [](Mat3& b, int i, int j, double v) { b(i, j) += v; });
+  const Colouring col = colour_blocks(nc, block_adjacency(brow));
+  const std::vector<std::int32_t> inv = inverse_permutation(col.perm);
 
   // As in 2D: the row holds the symmetric part S of W_kk (a condensed W is
   // symmetric only to round-off) and the law sees b = u_k - S r_k with u_k
@@ -281,23 +265,9 @@ NlgsStats solve_nlgs(const Problem3& p, Eigen::VectorXd& r, const NlgsOptions& o
   }
   MatrixCoupling3 c;
   c.base = rows.data();
-  c.start.assign(nc + 1, 0);
-  for (int i = 0; i < nc; ++i) c.start[i + 1] = c.start[i] + static_cast<int>(brow[col.perm[i]].size());
-  c.col.resize(c.start[nc]);
-  c.blk.resize(c.start[nc]);
-  for (int i = 0; i < nc; ++i) {
-    auto& v = brow[col.perm[i]];
-    std::sort(v.begin(), v.end(), [&](const auto& x, const auto& y) { return inv[x.first] < inv[y.first]; });
-    for (std::size_t m = 0; m < v.size(); ++m) {
-      c.col[c.start[i] + m] = inv[v[m].first];
-      c.blk[c.start[i] + m] = v[m].second;
-    }
-  }
+  colour_ordered_rows(brow, col.perm, inv, c.start, c.col, c.blk);
 
-  SolverParams prm;
-  prm.tol = opt.tol;
-  prm.max_iter = opt.max_sweeps;
-  if (opt.min_parallel > 0) prm.min_parallel = opt.min_parallel;
+  const SolverParams prm = solver_params(opt);
   const int every = std::max(1, opt.check_every);
   auto record = [&](int sweep, double dp_rel) {
     SolveStats s;

@@ -4,6 +4,8 @@
 #pragma once
 #include <vector>
 
+#include "solver.hpp"
+
 namespace cd {
 
 // Law residual of (r, u = W r + q): max and mean over contacts of the
@@ -20,6 +22,15 @@ struct NlgsOptions {
   int check_every = 10;  // law residual into the history every k sweeps (and at the end)
   int min_parallel = 0;  // > 0: the sweep's parallel threshold (0: the production default)
 };
+
+// The sweep's parameters for a frozen-problem solve.
+inline SolverParams solver_params(const NlgsOptions& opt) {
+  SolverParams prm;
+  prm.tol = opt.tol;
+  prm.max_iter = opt.max_sweeps;
+  if (opt.min_parallel > 0) prm.min_parallel = opt.min_parallel;
+  return prm;
+}
 
 struct NlgsCheckpoint {
   int sweep;
