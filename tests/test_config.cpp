@@ -36,14 +36,14 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 
 void compare(const Scene& x, const Scene& y, bool same) {
   const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, adhesion, debond, tol,
-               max_iter, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
+               max_iter, residual_tol, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
                box_width, box_height, disks, walls, series_interval, snapshot_interval,
                checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, pressure,
                inertial_number, cell_mass, isotropic, strain, dt_tp, start, cohesion_number] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
-  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(adhesion); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(threads);
+  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(adhesion); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(threads);
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
   CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
@@ -79,6 +79,7 @@ Scene nondefault() {
   s.debond = 0.02;
   s.tol = 1e-6;
   s.max_iter = 500;
+  s.residual_tol = 2e-3;
   s.threads = 2;
   s.n = 3;
   s.d_mean = 2e-3;
@@ -362,9 +363,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 45 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 46 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 45u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 46u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

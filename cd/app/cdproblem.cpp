@@ -121,11 +121,13 @@ int solve3(const std::string& path, const cd::NlgsOptions& opt, bool lemke, int 
 // A dumped step: the production solve of its rows, with the step's own
 // tolerance and cap unless given. Writes the impulses (row order, hex
 // floats: exact) to `out` if given.
-int solve_step(const std::string& path, double tol, int max_sweeps, const std::string& out) {
+int solve_step(const std::string& path, double tol, int max_sweeps, double residual_tol,
+               const std::string& out) {
   cd::SolverParams prm;
   cd::ContactProblem p = cd::read_contact_problem(path, prm);
   if (tol > 0) prm.tol = tol;
   if (max_sweeps > 0) prm.max_iter = max_sweeps;
+  if (residual_tol >= 0) prm.residual_tol = residual_tol;
   fmt::print("{}: {} rows, {} bodies, {} colours, {} boundary dofs, law {}, rotation {}\n", path,
              p.rows.size(), p.vel.size(), p.colouring.split.size(), p.dofs.size(),
              cd::law_name(p.law), p.rotation ? "on" : "off");
@@ -135,7 +137,7 @@ int solve_step(const std::string& path, double tol, int max_sweeps, const std::s
   fmt::print(
       "nlgs: {} after {} sweeps (rms |dp|/|p| {:.3e}, tol {:.3g}), residual max {:.3e} mean "
       "{:.3e} (mean |p| {:.3e}), time {:.3g} s\n",
-      st.cap_hit ? "NOT converged (sweep cap)" : "converged", st.iterations, st.dp_rel, prm.tol,
+      st.cap_hit ? "NOT converged (sweep cap)" : st.residual_met ? "converged (law residual)" : "converged", st.iterations, st.dp_rel, prm.tol,
       st.residual_max, st.residual_mean, st.p_mean, t);
   if (!out.empty()) {
     std::string text;
@@ -179,6 +181,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   std::string out;
   cmd->add_option("--out", out, "(.cdp) write the impulses, one row a line, as hex floats");
+  double residual_tol = -1;
+  cmd->add_option("--residual-tol", residual_tol,
+                  "(.cdp) also stop when the largest law residual is below this (checked every 10 "
+                  "sweeps; solver.residual_tol); 0: off; default: the step's own")
+      ->check(CLI::Range(0.0, 1.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -188,7 +195,8 @@ int main(int argc, char** argv) {
     if (path.size() > 4 && path.substr(path.size() - 4) == ".cdp") {
       if (lemke) throw std::runtime_error("--lemke takes a .dat problem (matrix form)");
       const bool tol_given = cmd->count("--tol") > 0, cap_given = cmd->count("--max-sweeps") > 0;
-      return solve_step(path, tol_given ? opt.tol : 0.0, cap_given ? opt.max_sweeps : 0, out);
+      return solve_step(path, tol_given ? opt.tol : 0.0, cap_given ? opt.max_sweeps : 0, residual_tol,
+                        out);
     }
     if (path.size() > 5 && path.substr(path.size() - 5) == ".hdf5") return solve3(path, opt, lemke, facets);
     return solve(path, opt, lemke);

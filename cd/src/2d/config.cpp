@@ -118,6 +118,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"contact", "overlap_correction", &Scene::overlap_correction, "", in(0, 1), "beta: an overlapping contact must separate at beta |gap|/dt; injects energy (bounded by the series column correction_work); 0: pure CD, overlaps never pushed apart"},
       {"solver", "tol", &Scene::tol, "", in_open_closed(0, 1), "NLGS convergence tolerance (relative)"},
       {"solver", "max_iter", &Scene::max_iter, "", in(1, 1e8), "NLGS iteration cap per time step"},
+      {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone"},
       {"solver", "threads", &Scene::threads, "", in(0, 1024), "OpenMP threads; 0: OpenMP default"},
       {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},

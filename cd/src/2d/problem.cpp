@@ -60,6 +60,14 @@ class Reader {
     return {};
   }
 
+  // The next token without taking it (empty at end of file).
+  std::string_view peek() {
+    const std::size_t li = li_, col = col_, last = last_;
+    const std::string_view t = token();
+    li_ = li, col_ = col, last_ = last;
+    return t;
+  }
+
   // The line after the one the cursor is on (the rest of that one is dropped).
   const std::string& next_line(const char* what) {
     if (col_ > 0) {
@@ -326,6 +334,7 @@ void write_contact_problem(const ContactProblem& p, const SolverParams& prm, std
   out << "law " << law_name(p.law) << "\nrotation " << (p.rotation ? 1 : 0) << "\n";
   out << "tol " << x(prm.tol) << "\nmax_iter " << prm.max_iter << "\nmin_parallel "
       << prm.min_parallel << "\n";
+  if (prm.residual_tol > 0) out << "residual_tol " << x(prm.residual_tol) << "\n";
   out << "bodies " << p.vel.size() << "\n";
   for (const BodyVel& v : p.vel)
     out << fmt::format("{} {} {} {} {}\n", x(v.vx), x(v.vy), x(v.w), x(v.inv_m), x(v.inv_I));
@@ -380,6 +389,10 @@ ContactProblem read_contact_problem(std::istream& in, const std::string& name, S
   prm.max_iter = static_cast<int>(rd.integer("the sweep cap", 1, INT_MAX));
   rd.expect("min_parallel", "after max_iter");
   prm.min_parallel = static_cast<int>(rd.integer("the parallel threshold", 0, INT_MAX));
+  if (rd.peek() == "residual_tol") {  // optional: written when > 0
+    rd.token();
+    prm.residual_tol = rd.number("the residual tolerance");
+  }
   rd.expect("bodies", "after the solver's parameters");
   const long long nb = rd.integer("the number of bodies", 0, INT_MAX);
   p.vel.resize(nb);

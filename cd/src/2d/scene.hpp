@@ -55,6 +55,7 @@ struct Scene {
   // The solver's defaults are SolverParams' (nlgs.hpp): one source.
   double tol = SolverParams{}.tol;           // NLGS tolerance eps_f (relative)
   int max_iter = SolverParams{}.max_iter;    // iteration cap per step
+  double residual_tol = SolverParams{}.residual_tol;  // > 0: also stop on the law residual
   int threads = 0;           // 0: OpenMP default
 
   // [particles]: random generation (n = 0 for none)

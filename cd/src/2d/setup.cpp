@@ -214,6 +214,7 @@ WorldParams world_params(const Scene& s0) {
     // c.mass: set by build_world, which knows the particles' mass
   }
   p.solver.tol = s.tol;
+  p.solver.residual_tol = s.residual_tol;
   p.solver.max_iter = s.max_iter;
   p.rotation = s.rotation;
   return p;

@@ -21,6 +21,7 @@
 //       (returns its residual; see 2d/nlgs.hpp).
 #pragma once
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <vector>
 
@@ -29,6 +30,7 @@
 namespace cd::sweep {
 
 constexpr int kBlock = 128;  // rows per reduction block (fixed: see nlgs.hpp)
+constexpr int kResidualEvery = 10;  // sweeps between checks of SolverParams::residual_tol
 
 struct RowBlock {
   std::int32_t begin, end;
@@ -177,6 +179,15 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
           psum += bs[b].psum;
         }
         done = end_sweep(++it, dsum, psum, n, R, dofs, prm, observer, st);
+        // The optional second criterion: the law residual itself, checked
+        // every kResidualEvery sweeps (a read-only pass over the rows, on
+        // this thread). Off (residual_tol = 0) it costs nothing.
+        if (!done && prm.residual_tol > 0 && it % kResidualEvery == 0) {
+          SolveStats r;
+          residuals(rows, c, INT_MAX, r);
+          st.residual_met = r.residual_max < prm.residual_tol && st.dof_rel < prm.tol;
+          done = st.residual_met;
+        }
       }
       // implicit barrier: every thread sees the same 'done'
     }
