@@ -282,6 +282,7 @@ ANALYSIS := outputs/analysis
 analyze-inertial: build
 	$(CDA) report $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial
 	$(CDA) fit mu-i $(CAMPAIGNS)/inertial --toml $(ANALYSIS)/inertial/mu_i.toml
+	$(CDA) fit nu-i $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/nu_i --toml $(ANALYSIS)/inertial/nu_i.toml
 	$(CDA) fit dilatancy $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/dilatancy --toml $(ANALYSIS)/inertial/dilatancy.toml
 
 # The eta = 0 reference runs (eta_0_I_*) must be in the cohesive campaign.
@@ -295,6 +296,7 @@ analyze-inertial-ladder: build
 
 analyze-angularity: build
 	$(CDA) report $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity
+	$(CDA) fit angularity $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity/fit --toml $(ANALYSIS)/angularity/mu_alpha.toml
 
 # Regression of fitted curves: re-runs the small reference campaign of
 # tests/data/regress/ from scratch (same sizes and seed, ~1 min on 2 cores),

@@ -5,7 +5,9 @@
 // malformed file, non-finite value, option out of range).
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
+#include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +20,7 @@
 #include "analysis/src/fit.hpp"
 #include "analysis/src/report.hpp"
 #include "analysis/src/run.hpp"
+#include "analysis/src/trends.hpp"
 
 namespace fs = std::filesystem;
 using namespace cda;
@@ -70,6 +73,13 @@ std::vector<std::string> expand_runs(const std::vector<std::string>& args) {
     runs.insert(runs.end(), r.begin(), r.end());
   }
   return runs;
+}
+
+// The command as typed, for the plots' "made by" line.
+std::string command_line(int argc, char** argv) {
+  std::string c = "cdanalysis";
+  for (int i = 1; i < argc; ++i) c += std::string(" ") + argv[i];
+  return c;
 }
 
 std::vector<double> col_or_empty(const Table& t, const std::string& name) {
@@ -147,6 +157,36 @@ int main(int argc, char** argv) {
   dil->add_option("--strain", strain_range, "use the rows with a <= strain <= b only (a:b; default all)");
   dil->add_option("--out", out, "folder for the binned points, the fit curve and the plot (png, svg)");
   dil->add_option("--toml", toml_out, "write the fit parameters (fixed and free slope) to this TOML file");
+  auto* ang = fit->add_subcommand(
+      "angularity",
+      "mu*(alpha) = mu0 + (mu1 - mu0)(1 - exp(-alpha/alpha_c)) over steady shear runs, alpha = 2 pi/n_s "
+      "(disks 0) from each run's shapes; also the table of nu*, z, anisotropies, sliding and side-side "
+      "shares, partial strengths q_sv/p, q_ss/p and the check q/p ~ (sum a)/2 per run");
+  int ang_snapshots = 5;
+  ang->add_option("runs", runs, "run or campaign folders (series.csv, scene.toml, contact snapshots)")->required();
+  ang->add_option("--snapshots", ang_snapshots, "last contact snapshots averaged per run for the fabric")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  ang->add_option("--bins", bins, "angular bins over [0, pi)")->check(CLI::Range(4, 36000))->capture_default_str();
+  ang->add_option("--out", out, "folder for angularity.csv, the fit curve and the plots (png, svg)");
+  ang->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
+  auto* nui = fit->add_subcommand("nu-i", "nu(I) = nu_max - a I over steady runs (packing_fraction against "
+                                          "the measured inertial number)");
+  nui->add_option("runs", runs, "run or campaign folders");
+  nui->add_option("--table", table, "CSV with columns I, nu and optionally nu_err, instead of runs");
+  nui->add_option("--out", out, "folder for the plot nu_I.png/svg and its data");
+  nui->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
+  auto* comp = fit->add_subcommand(
+      "compaction", "e = e0 - lambda ln(p/p0) over steady (or compacted) runs at several p: e = 1/nu - 1 "
+                    "from the steady packing_fraction, p the steady mean of the series' p (else the scene's "
+                    "[shear] pressure)");
+  double p0 = 0;
+  comp->add_option("runs", runs, "run or campaign folders");
+  comp->add_option("--table", table, "CSV with columns p, e and optionally e_err, instead of runs");
+  comp->add_option("--p0", p0, "reference pressure (default: the geometric mean of the p's)")
+      ->check(CLI::PositiveNumber);
+  comp->add_option("--out", out, "folder for the plot compaction.png/svg and its data");
+  comp->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
   auto* bounds = fit->add_subcommand("fabric-bounds", "envelope z_min, z_max of (z, a_c) points");
   double k_bound = 1.0;
   bounds->add_option("--table", table, "CSV with columns z, a_c (optionally z_err, a_c_err)")->required();
@@ -346,6 +386,129 @@ int main(int argc, char** argv) {
       write_toml(toml_out, {f.fixed, f.free}, {dilatancy(), dilatancy_free()});
       if (!out.empty() && !plot_dilatancy(out, f))
         fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
+    } else if (ang->parsed()) {
+      AngularityOptions opt;
+      opt.snapshots = ang_snapshots;
+      opt.bins = bins;
+      std::vector<AngularityPoint> pts;
+      const auto all = expand_runs(runs);
+      for (const auto& r : all) {
+        try {
+          pts.push_back(angularity_point(r, opt));
+        } catch (const AnalysisError& e) {
+          if (all.size() == 1) throw;
+          fmt::print("{}: skipped: {}\n", r, e.what());
+        }
+      }
+      if (pts.empty()) throw AnalysisError("fit angularity: no usable run (each was skipped, see above)");
+      std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.alpha < b.alpha; });
+      fmt::print("sliding: |f_t| >= mu f_n (1 - tol), tol = the run's [solver] tol; fabric: mean +- sem over "
+                 "the last {} contact snapshots\n", ang_snapshots);
+      fmt::print("{:>3} {:>3} {:>6}  {:>15} {:>15} {:>13} {:>15} {:>15} {:>15} {:>15} {:>15} {:>15} {:>15} "
+                 "{:>15} {:>15} {:>7} {:>7} {:>7}\n",
+                 "#", "n_s", "alpha", "mu*", "nu*", "z", "a_c", "a_ln", "a_lt", "a_fn", "a_ft", "sliding",
+                 "ss share", "q_sv/p", "q_ss/p", "q/p", "sum/2", "tensor");
+      auto pm = [](const Val& v, int w) {
+        return std::isfinite(v.err) ? fmt::format("{:.{}f}±{:.{}f}", v.v, w, v.err, w)
+                                    : (std::isfinite(v.v) ? fmt::format("{:.{}f}", v.v, w) : "n/a");
+      };
+      for (std::size_t k = 0; k < pts.size(); ++k) {
+        const auto& a = pts[k];
+        fmt::print("{:>3} {:>3} {:>6.4f}  {:>15} {:>15} {:>13} {:>15} {:>15} {:>15} {:>15} {:>15} {:>15} {:>15} "
+                   "{:>15} {:>15} {:>7.4f} {:>7.4f} {:>7.4f}\n",
+                   k, a.nsides, a.alpha, pm(a.mu, 4), pm(a.nu, 4), pm(a.z, 3), pm(a.a_c, 4), pm(a.a_ln, 4),
+                   pm(a.a_lt, 4), pm(a.a_fn, 4), pm(a.a_ft, 4), pm(a.sliding, 4), pm(a.ss_share, 4),
+                   pm(a.q_sv, 4), pm(a.q_ss, 4), a.q_over_p_snap.v, a.sum_half_fft.v, a.sum_half_tensor.v);
+      }
+      for (std::size_t k = 0; k < pts.size(); ++k)
+        fmt::print("  {} = {} (alpha from the {})\n", k, pts[k].run, pts[k].alpha_source);
+      fmt::print("check q/p ~ (sum a)/2: q/p of the snapshots' contact stress against the Fourier sum and the "
+                 "tensor sum with directions (columns q/p, sum/2, tensor)\n");
+      std::optional<FitResult> r;
+      try {
+        r = fit_angularity(pts);
+        print_fit(*r, mu_of_alpha());
+        write_toml(toml_out, {*r}, {mu_of_alpha()});
+      } catch (const AnalysisError& e) {
+        if (out.empty()) throw;
+        fmt::print(stderr, "cdanalysis: refused: {}\n", e.what());
+      }
+      if (!out.empty()) {
+        if (!plot_angularity(out, pts, r ? &*r : nullptr, command_line(argc, argv)))
+          fmt::print(stderr, "warning: gnuplot failed; the scripts are in {}\n", out);
+        fmt::print("wrote {}/angularity.csv and the angularity_*.png/svg plots\n", out);
+        if (!r) return 1;
+      }
+    } else if (nui->parsed() || comp->parsed()) {
+      const bool is_nu = nui->parsed();
+      std::vector<StatePoint> pts;
+      if (!table.empty()) {
+        if (!runs.empty()) throw AnalysisError("fit: give run folders or --table, not both");
+        const auto t = Table::read_csv(table);
+        const auto xs = t.column(is_nu ? "I" : "p");
+        const auto ys = t.column(is_nu ? "nu" : "e");
+        const auto es = col_or_empty(t, is_nu ? "nu_err" : "e_err");
+        for (std::size_t i = 0; i < xs.size(); ++i) {
+          StatePoint s;
+          s.run = fmt::format("row {}", i + 1);
+          const double err = es.empty() ? std::nan("") : es[i];
+          if (is_nu) {
+            s.I = {xs[i], std::nan("")};
+            s.nu = {ys[i], err};
+          } else {  // e given: store nu = 1/(1 + e) so that e() is e again
+            s.p = {xs[i], std::nan("")};
+            s.nu = {1 / (1 + ys[i]), err / ((1 + ys[i]) * (1 + ys[i]))};
+          }
+          pts.push_back(s);
+        }
+      } else {
+        if (runs.empty()) throw AnalysisError("fit: give run folders or --table");
+        for (const auto& r : expand_runs(runs)) {
+          const auto s = state_point(r);
+          if (is_nu)
+            fmt::print("{}: I = {:.4g} +- {:.2g}, nu = {:.5f} +- {:.5f}\n", r, s.I.v, s.I.err, s.nu.v, s.nu.err);
+          else
+            fmt::print("{}: p = {:.5g}{}, nu = {:.5f} +- {:.5f}, e = {:.5f} +- {:.5f}\n", r, s.p.v,
+                       s.p_from_scene ? " (scene)" : fmt::format(" +- {:.2g}", s.p.err), s.nu.v, s.nu.err, s.e(),
+                       s.e_err());
+          pts.push_back(s);
+        }
+      }
+      // Without error bars on every point the fit is unweighted.
+      bool all_err = true;
+      for (auto& s : pts) all_err = all_err && std::isfinite(s.nu.err) && s.nu.err > 0;
+      FitResult r;
+      Model m = nu_of_I();
+      double pref = p0;
+      if (is_nu) {
+        if (all_err) {
+          r = fit_nu_I_points(pts);
+        } else {
+          std::vector<double> I, nu;
+          for (const auto& s : pts) I.push_back(s.I.v), nu.push_back(s.nu.v);
+          r = fit_nu_I(I, nu, {});
+        }
+      } else {
+        if (!(pref > 0)) pref = default_p0(pts);
+        m = void_ratio(pref);
+        if (all_err) {
+          r = fit_compaction_points(pts, pref);
+        } else {
+          std::vector<double> p, e;
+          for (const auto& s : pts) p.push_back(s.p.v), e.push_back(s.e());
+          r = fit_void_ratio(p, e, {}, pref);
+        }
+      }
+      print_fit(r, m);
+      write_toml(toml_out, {r}, {m});
+      if (!out.empty()) {
+        if (!all_err)
+          for (auto& s : pts) s.nu.err = 0;
+        const bool ok = is_nu ? plot_nu_I(out, pts, r, command_line(argc, argv))
+                              : plot_compaction(out, pts, r, pref, command_line(argc, argv));
+        if (!ok) fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
+        else fmt::print("wrote {}/{}.png and .svg\n", out, is_nu ? "nu_I" : "compaction");
+      }
     } else if (cmp->parsed()) {
       const auto a = read_fit_toml(ref_toml);
       const auto b = read_fit_toml(new_toml);
@@ -371,6 +534,8 @@ int main(int argc, char** argv) {
                    s.costed < s.runs ? fmt::format(" ({} without summary.toml: n/a)", s.runs - s.costed) : "");
       else
         fmt::print("cost: n/a (no run has a summary.toml)\n");
+      fmt::print("campaign kind: {}; fits: {}\n", s.kinds.empty() ? "none" : fmt::format("{}", fmt::join(s.kinds, "; ")),
+                 s.fits.empty() ? "none" : fmt::format("{}", fmt::join(s.fits, ", ")));
       for (const auto& p : s.problems) fmt::print(stderr, "problem: {}\n", p);
       fmt::print("open {}/index.html\n", dir);
     }

@@ -1,6 +1,7 @@
 #include "report.hpp"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,10 @@
 #include <fstream>
 #include <numbers>
 
+#include "cohesion.hpp"
 #include "cost.hpp"
+#include "scene_info.hpp"
+#include "trends.hpp"
 
 namespace fs = std::filesystem;
 
@@ -64,8 +68,46 @@ struct Point {
   std::string name, status;
   double I = std::nan(""), I_err = std::nan(""), mu = std::nan(""), mu_err = std::nan("");
   double phi = std::nan(""), phi_err = std::nan(""), z = std::nan(""), z_err = std::nan("");
+  double p = std::nan(""), p_err = std::nan("");
   std::optional<RunCost> cost;
+  // From scene.toml (nan / -1 when absent) and the particles snapshots.
+  std::string run;
+  double eta = std::nan(""), I_imposed = std::nan(""), pressure = std::nan("");
+  int nsides = -1;
+  bool steady = false;
 };
+
+// The shapes of a run: the nsides of its last particles snapshot when it
+// has one shape there, else scene.toml's; -1 unknown or mixed.
+int run_nsides(const std::string& run, const std::optional<SceneInfo>& scene) {
+  try {
+    const auto snaps = list_snapshots(run, "particles");
+    if (!snaps.empty()) {
+      int n = -2;
+      for (const auto& q : read_particles(snaps.back())) {
+        if (q.nsides < 0) break;
+        if (n == -2) n = q.nsides;
+        else if (n != q.nsides) return -1;
+      }
+      if (n >= 0) return n;
+    }
+  } catch (const AnalysisError&) {
+  }
+  return scene && scene->nsides ? *scene->nsides : -1;
+}
+
+// Distinct finite values.
+std::vector<double> distinct(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  return v;
+}
+
+std::string made_by(const std::string& report_cmd, const std::string& fit_cmd) {
+  return fmt::format("<p><small>Made by <code>{}</code> (alone: <code>{}</code>).</small></p>\n",
+                     html_escape(report_cmd), html_escape(fit_cmd));
+}
 
 // Wall time and sweeps per step against the measured I (log-log), the
 // points of an inertial campaign: dir/cost_I.{png,svg}, data in cost_I.csv.
@@ -267,6 +309,18 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     html_runs += fmt::format("<h3>{} ({})</h3>\n", html_escape(name), stem);
     Point pt;
     pt.name = name;
+    pt.run = run;
+    {
+      std::optional<SceneInfo> scene;
+      try {
+        scene = read_scene_info(run);
+        if (scene->cohesion_number) pt.eta = *scene->cohesion_number;
+        if (scene->inertial_number) pt.I_imposed = *scene->inertial_number;
+        if (scene->pressure) pt.pressure = *scene->pressure;
+      } catch (const AnalysisError&) {
+      }
+      pt.nsides = run_nsides(run, scene);
+    }
     try {
       pt.cost = read_run_cost(run);
     } catch (const AnalysisError& e) {
@@ -309,12 +363,9 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         steady.add_row(row);
         pt.mu = row[1], pt.mu_err = row[2], pt.I = row[3], pt.I_err = row[4];
         pt.phi = row[5], pt.phi_err = row[6], pt.z = row[7], pt.z_err = row[8];
+        pt.p = row[9], pt.p_err = row[10];
+        pt.steady = series.has("q_over_p") || series.has("packing_fraction");
         ++sum.steady;
-        if (series.has("q_over_p") && series.has("inertial_number")) {
-          I.push_back(row[3]);
-          mu.push_back(row[1]);
-          mu_err.push_back(row[2]);
-        }
       } catch (const AnalysisError& e) {
         status = "not steady";
         sum.problems.push_back(fmt::format("{}: {}", run, e.what()));
@@ -363,20 +414,219 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   std::vector<FitResult> fits;
   std::vector<Model> models;
   std::string html_fit;
-  if (I.size() >= 4) {
-    try {
-      const auto r = fit_mu_I(I, mu, mu_err);
-      fits.push_back(r);
-      models.push_back(mu_of_I());
-      sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r) && sum.plots_ok;
-      html_fit = fmt::format("<h2>μ(I)</h2><img src='mu_I.png' width=600><p>{}: chi2/dof = {:.2f}</p>\n",
-                             html_escape(mu_of_I().formula), r.chi2_dof);
-    } catch (const AnalysisError& e) {
-      sum.problems.push_back(fmt::format("mu(I) fit: {}", e.what()));
+  const std::string report_cmd = fmt::format("cdanalysis report {} --out {}", campaign, out_dir);
+
+  // The campaign's kind, from the runs: what their scenes (and shapes) vary.
+  std::vector<double> etas, Is, ps, ns;
+  for (const Point& p : points) {
+    etas.push_back(p.eta);
+    Is.push_back(p.I_imposed);
+    ps.push_back(p.pressure);
+    ns.push_back(p.nsides >= 0 ? p.nsides : std::nan(""));
+  }
+  const bool by_shape = distinct(ns).size() >= 2, by_eta = distinct(etas).size() >= 2,
+             by_p = distinct(ps).size() >= 2;
+  bool by_I = distinct(Is).size() >= 2;
+  if (distinct(Is).empty()) {  // no scene says I: the measured I spanning a factor 1.5
+    double lo = INFINITY, hi = 0;
+    for (const Point& p : points)
+      if (std::isfinite(p.I) && p.I > 0) lo = std::min(lo, p.I), hi = std::max(hi, p.I);
+    by_I = hi >= 1.5 * lo;
+  }
+  std::vector<std::string> kinds;
+  if (by_I) kinds.push_back("inertial (I varies)");
+  if (by_eta) kinds.push_back("cohesive (cohesion_number varies)");
+  if (by_shape) kinds.push_back("angularity (nsides varies)");
+  if (by_p) kinds.push_back("pressure series (pressure varies)");
+  sum.kinds = kinds;
+  html_fit += fmt::format("<h2>Fits</h2><p>Campaign kind, from the runs' scenes: {}.</p>\n",
+                          kinds.empty() ? std::string("none (the runs differ in none of I, cohesion_number, "
+                                                      "nsides, pressure): no fit across runs")
+                                        : html_escape(fmt::format("{}", fmt::join(kinds, "; "))));
+
+  // Inertial: mu(I) and nu(I) over the cohesionless runs of one shape.
+  if (by_I) {
+    std::vector<double> I, mu, mu_err;
+    std::vector<StatePoint> sp;
+    const int shape0 = [&] {
+      for (const Point& p : points)
+        if (p.steady) return p.nsides;
+      return -1;
+    }();
+    for (const Point& p : points) {
+      if (!p.steady || !std::isfinite(p.I) || (std::isfinite(p.eta) && p.eta != 0) || p.nsides != shape0)
+        continue;
+      if (std::isfinite(p.mu)) I.push_back(p.I), mu.push_back(p.mu), mu_err.push_back(p.mu_err);
+      if (std::isfinite(p.phi)) {
+        StatePoint s;
+        s.run = p.run;
+        s.I = {p.I, p.I_err};
+        s.nu = {p.phi, p.phi_err};
+        sp.push_back(s);
+      }
     }
-  } else {
-    html_fit = fmt::format("<p>μ(I) fit skipped: {} steady runs with q_over_p and inertial_number "
-                           "(4 needed)</p>\n", I.size());
+    const std::string sel = by_eta || by_shape ? " (runs with cohesion_number 0 and the first run's shape)" : "";
+    if (I.size() >= 4) {
+      try {
+        const auto r = fit_mu_I(I, mu, mu_err);
+        fits.push_back(r);
+        models.push_back(mu_of_I());
+        sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r) && sum.plots_ok;
+        sum.fits.push_back("mu_I");
+        html_fit += fmt::format("<h3>μ(I){}</h3><img src='mu_I.png' width=600><p>{}: μ1 = {:.4f} ± {:.2g}, "
+                                "μ2 = {:.4f} ± {:.2g}, I0 = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",
+                                sel, html_escape(mu_of_I().formula), r["mu1"], r.err("mu1"), r["mu2"],
+                                r.err("mu2"), r["I0"], r.err("I0"), r.chi2_dof) +
+                    made_by(report_cmd, fmt::format("cdanalysis fit mu-i {} --out DIR", campaign));
+      } catch (const AnalysisError& e) {
+        sum.problems.push_back(fmt::format("mu(I) fit: {}", e.what()));
+      }
+    } else {
+      html_fit += fmt::format("<p>μ(I) fit skipped: {} steady runs with q_over_p and inertial_number{} "
+                              "(4 needed)</p>\n", I.size(), sel);
+    }
+    if (sp.size() >= 3) {
+      try {
+        const auto r = fit_nu_I_points(sp);
+        fits.push_back(r);
+        models.push_back(nu_of_I());
+        sum.plots_ok = plot_nu_I(out_dir, sp, r, report_cmd) && sum.plots_ok;
+        sum.fits.push_back("nu_I");
+        html_fit += fmt::format("<h3>ν(I){}</h3><img src='nu_I.png' width=600><p>{}: ν_max = {:.4f} ± {:.2g}, "
+                                "a = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",
+                                sel, html_escape(nu_of_I().formula), r["nu_max"], r.err("nu_max"), r["a"],
+                                r.err("a"), r.chi2_dof) +
+                    made_by(report_cmd, fmt::format("cdanalysis fit nu-i {} --out DIR", campaign));
+      } catch (const AnalysisError& e) {
+        sum.problems.push_back(fmt::format("nu(I) fit: {}", e.what()));
+      }
+    } else {
+      html_fit += fmt::format("<p>ν(I) fit skipped: {} steady runs with packing_fraction{} (3 needed)</p>\n",
+                              sp.size(), sel);
+    }
+  }
+
+  // Pressure series: e = e0 - lambda ln(p/p0).
+  if (by_p) {
+    std::vector<StatePoint> sp;
+    for (const Point& p : points) {
+      if (!p.steady || !std::isfinite(p.phi)) continue;
+      StatePoint s;
+      s.run = p.run;
+      s.nu = {p.phi, p.phi_err};
+      s.p = std::isfinite(p.p) ? Val{p.p, p.p_err} : Val{p.pressure, std::nan("")};
+      sp.push_back(s);
+    }
+    try {
+      const double p0 = default_p0(sp);
+      const auto r = fit_compaction_points(sp, p0);
+      fits.push_back(r);
+      models.push_back(void_ratio(p0));
+      sum.plots_ok = plot_compaction(out_dir, sp, r, p0, report_cmd) && sum.plots_ok;
+      sum.fits.push_back("void_ratio");
+      html_fit += fmt::format("<h3>Compaction e(p)</h3><img src='compaction.png' width=600><p>{}: e0 = {:.4f} ± "
+                              "{:.2g}, λ = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",
+                              html_escape(void_ratio(p0).formula), r["e0"], r.err("e0"), r["lambda"],
+                              r.err("lambda"), r.chi2_dof) +
+                  made_by(report_cmd, fmt::format("cdanalysis fit compaction {} --out DIR", campaign));
+    } catch (const AnalysisError& e) {
+      sum.problems.push_back(fmt::format("compaction fit: {}", e.what()));
+      html_fit += fmt::format("<p>Compaction fit refused: {}</p>\n", html_escape(e.what()));
+    }
+  }
+
+  // Cohesive: c/p against the eta = 0 runs of the campaign.
+  if (by_eta) {
+    try {
+      std::vector<SteadyPoint> ref_pts, coh_pts;
+      for (const Point& p : points) {
+        if (!p.steady || !std::isfinite(p.eta)) continue;
+        const auto q = steady_point(p.run);
+        (q.eta == 0 ? ref_pts : coh_pts).push_back(q);
+      }
+      if (coh_pts.empty() || ref_pts.empty())
+        throw AnalysisError(fmt::format("{} eta = 0 and {} eta > 0 steady runs: both are needed", ref_pts.size(),
+                                        coh_pts.size()));
+      const SinPhiReference ref(ref_pts, SinPhiReference::Mode::Auto);
+      std::vector<CohesionPoint> cps;
+      std::vector<double> eta, I, c, ce;
+      for (const auto& q : coh_pts) {
+        cps.push_back(cohesion_point(q, ref));
+        eta.push_back(q.eta), I.push_back(q.I), c.push_back(cps.back().c_over_p), ce.push_back(cps.back().c_over_p_err);
+      }
+      const auto r = fit_cohesion(eta, I, c, ce);
+      fits.push_back(r);
+      models.push_back(cohesion());
+      sum.plots_ok = plot_cohesion(out_dir, cps, r) && sum.plots_ok;
+      sum.fits.push_back("cohesion");
+      html_fit += fmt::format("<h3>Cohesion c/p</h3><img src='cohesion.png' width=600><p>{}: k0 = {:.4g} ± {:.2g}, "
+                              "β = {:.4g} ± {:.2g}, α = {:.4g} ± {:.2g}, χ²/dof = {:.2f}; sin φ(I) from {} η = 0 "
+                              "runs by {}</p>\n",
+                              html_escape(cohesion().formula), r["k0"], r.err("k0"), r["beta"], r.err("beta"),
+                              r["alpha"], r.err("alpha"), r.chi2_dof, ref_pts.size(),
+                              ref.uses_fit() ? "the μ(I) fit" : "interpolation in ln I") +
+                  made_by(report_cmd, fmt::format("cdanalysis fit cohesion {} --out DIR", campaign));
+    } catch (const AnalysisError& e) {
+      sum.problems.push_back(fmt::format("cohesion fit: {}", e.what()));
+      html_fit += fmt::format("<p>Cohesion fit refused: {}</p>\n", html_escape(e.what()));
+    }
+  }
+
+  // Angularity: the table of steady quantities against alpha and mu*(alpha).
+  if (by_shape) {
+    std::vector<AngularityPoint> ap;
+    AngularityOptions opt;
+    opt.bins = bins;
+    for (const Point& p : points) {
+      if (!p.steady) continue;
+      try {
+        ap.push_back(angularity_point(p.run, opt));
+      } catch (const AnalysisError& e) {
+        sum.problems.push_back(fmt::format("angularity: {}", e.what()));
+      }
+    }
+    std::sort(ap.begin(), ap.end(), [](const auto& a, const auto& b) { return a.alpha < b.alpha; });
+    std::optional<FitResult> r;
+    try {
+      r = fit_angularity(ap);
+      fits.push_back(*r);
+      models.push_back(mu_of_alpha());
+      sum.fits.push_back("mu_alpha");
+    } catch (const AnalysisError& e) {
+      sum.problems.push_back(fmt::format("mu*(alpha) fit: {}", e.what()));
+    }
+    if (!ap.empty()) {
+      const std::string fit_cmd = fmt::format("cdanalysis fit angularity {} --out DIR", campaign);
+      sum.plots_ok = plot_angularity(out_dir, ap, r ? &*r : nullptr, report_cmd) && sum.plots_ok;
+      sum.angularity = ap.size();
+      html_fit += "<h3>Angularity</h3>\n";
+      if (r)
+        html_fit += fmt::format("<p>{}: μ0 = {:.4f} ± {:.2g}, μ1 = {:.4f} ± {:.2g}, α_c = {:.4g} ± {:.2g}, "
+                                "χ²/dof = {:.2f} (dof {})</p>\n",
+                                html_escape(mu_of_alpha().formula), (*r)["mu0"], r->err("mu0"), (*r)["mu1"],
+                                r->err("mu1"), (*r)["alpha_c"], r->err("alpha_c"), r->chi2_dof, r->dof);
+      else
+        html_fit += "<p>μ*(α) fit refused (see Problems).</p>\n";
+      html_fit +=
+          "<p>Table: <a href='angularity.csv'>angularity.csv</a>. Series quantities: steady mean ± block-"
+          "averaging error; fabric: mean ± sem over the last 5 contact snapshots. Sliding: |f_t| ≥ μ f_n (1 − "
+          "tol) with the run's solver tol. Check q/p ≈ ½Σa: contact-stress q/p of the snapshots against the "
+          "Fourier sum and the tensor sum with directions.</p>\n"
+          "<table border=1 cellspacing=0 cellpadding=3><tr><th>n_s</th><th>α</th><th>μ*</th><th>ν*</th><th>z</th>"
+          "<th>a_c</th><th>a_ln</th><th>a_lt</th><th>a_fn</th><th>a_ft</th><th>sliding</th><th>side–side</th>"
+          "<th>q_sv/p</th><th>q_ss/p</th><th>q/p (snapshots)</th><th>½Σa (Fourier)</th><th>½|ΣA| (tensor)</th></tr>\n";
+      for (const auto& a : ap) {
+        html_fit += fmt::format("<tr><td>{}</td><td>{:.4f}</td>", a.nsides, a.alpha);
+        for (const Val* v : {&a.mu, &a.nu, &a.z, &a.a_c, &a.a_ln, &a.a_lt, &a.a_fn, &a.a_ft, &a.sliding,
+                             &a.ss_share, &a.q_sv, &a.q_ss, &a.q_over_p_snap, &a.sum_half_fft, &a.sum_half_tensor})
+          html_fit += "<td>" + or_na(v->v, v->err) + "</td>";
+        html_fit += "</tr>\n";
+      }
+      html_fit += "</table>\n";
+      for (const auto& stem : kAngularityPlots)
+        html_fit += fmt::format("<img src='{}.png' width=450>\n", stem);
+      html_fit += made_by(report_cmd, fit_cmd);
+    }
   }
   write_text((fs::path(out_dir) / "fits.toml").string(), fits_to_toml(fits, models));
 

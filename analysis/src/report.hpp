@@ -50,6 +50,9 @@ struct ReportSummary {
   bool cost_plot = false;  // cost_I.{png,svg} drawn (an inertial campaign)
   std::vector<std::string> problems;  // one line per run or step that failed
   bool plots_ok = true;
+  std::vector<std::string> kinds;  // what the runs vary (inertial, cohesive, angularity, pressure)
+  std::vector<std::string> fits;   // models fitted into fits.toml
+  std::size_t angularity = 0;      // runs in angularity.csv
 };
 
 // The whole report of a campaign into out_dir (created): runs.csv, steady.csv

@@ -83,7 +83,8 @@ Estimate measured_inertial_number(const Table& series, const std::string& x_colu
   return {i, 0.5 * i * ss.error() / ss.mean};
 }
 
-RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume) {
+RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume, double mu,
+                     double sliding_tol) {
   RunFabric f;
   f.file = snapshot_path(run_dir, "contacts", k);
   const auto raw = read_contacts(f.file);
@@ -109,6 +110,8 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume)
   const double V = f.has_volume ? volume : 1.0;
   f.stress = contact_stress(raw, V);
   f.sliding = sliding_share(cs, 0, 1e-6, f_eps);
+  if (mu > 0) f.sliding_coulomb = sliding_share(cs, mu, sliding_tol, f_eps);
+  f.ss_share = static_cast<double>(of_type(cs, 2).size()) / static_cast<double>(cs.size());
   f.fabric = cd::obs::fabric_tensor<2>(forces, f_eps);
   for (int type : {1, 2}) {
     const auto sub = of_type(cs, type);

@@ -2,6 +2,7 @@
 // the reader to the steady-state and fabric measurements, so the command
 // line and the report share one path.
 #pragma once
+#include <cmath>
 #include <optional>
 #include <string>
 #include <utility>
@@ -59,7 +60,12 @@ struct RunFabric {
   AngularProfile profile;
   Stress stress;               // with the given volume (1 if none: stress times V)
   bool has_volume = false;
-  double sliding = 0;
+  double sliding = 0;           // status flag 2 (the solver's own test, see sliding_share)
+  // |f_t| >= mu f_n (1 - tol) with the mu and tol given to run_fabric (nan
+  // when mu <= 0), and the share of side-side contacts, both over the
+  // force-bearing physical contacts.
+  double sliding_coulomb = std::nan("");
+  double ss_share = 0;
   cd::obs::Tensor<2> fabric{};  // fabric tensor <n n> over the force-bearing physical contacts
   std::optional<Connectivity> connectivity;  // when the particles snapshot exists
   // Per-type partial results (sv, ss), when the set has such contacts.
@@ -68,7 +74,9 @@ struct RunFabric {
 };
 
 // snapshot k of contacts_NNNNN.vtp (k < 0 from the end). volume <= 0: none.
-RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume);
+// mu > 0: also the Coulomb test of sliding with that friction and tolerance.
+RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume, double mu = 0,
+                     double sliding_tol = 1e-4);
 
 // "a:b" -> (a, b); throws AnalysisError on bad syntax or a >= b.
 std::pair<double, double> parse_range(const std::string& s);

@@ -2,7 +2,10 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <numbers>
+#include <vector>
 #include <toml.hpp>
 
 namespace fs = std::filesystem;
@@ -40,8 +43,35 @@ SceneInfo read_scene_info(const std::string& run_dir) {
   s.cohesion_number = number(root, "contact", "cohesion_number", s.file);
   s.inertial_number = number(root, "shear", "inertial_number", s.file);
   s.pressure = number(root, "shear", "pressure", s.file);
+  s.friction = number(root, "contact", "mu", s.file);
+  s.solver_tol = number(root, "solver", "tol", s.file);
+  if (root.is_table() && root.contains("particles") && root.at("particles").is_table() &&
+      root.at("particles").contains("nsides")) {
+    const auto& v = root.at("particles").at("nsides");
+    std::vector<long long> ns;
+    if (v.is_integer()) {
+      ns.push_back(v.as_integer());
+    } else if (v.is_array()) {
+      for (const auto& e : v.as_array()) {
+        if (!e.is_integer())
+          throw InputError(fmt::format("'{}': [particles] nsides holds a non-integer", s.file));
+        ns.push_back(e.as_integer());
+      }
+    } else {
+      throw InputError(fmt::format("'{}': [particles] nsides is neither an integer nor an array", s.file));
+    }
+    for (long long n : ns)
+      if (n != 0 && n < 3)
+        throw InputError(fmt::format("'{}': [particles] nsides holds {} (0 for disks or 3 and more)", s.file, n));
+    std::sort(ns.begin(), ns.end());
+    ns.erase(std::unique(ns.begin(), ns.end()), ns.end());
+    if (ns.size() == 1) s.nsides = static_cast<int>(ns[0]);
+    else if (ns.size() > 1) s.nsides_mixed = true;
+  }
   return s;
 }
+
+double angularity_of(int nsides) { return nsides == 0 ? 0.0 : 2 * std::numbers::pi / nsides; }
 
 double require(const SceneInfo& s, const std::optional<double>& v, const std::string& key) {
   if (!v) throw InputError(fmt::format("'{}' has no {}", s.file, key));

@@ -14,7 +14,17 @@ struct SceneInfo {
   std::optional<double> cohesion_number;   // [contact] cohesion_number (eta; 0: cohesionless)
   std::optional<double> inertial_number;   // [shear] inertial_number (imposed I)
   std::optional<double> pressure;          // [shear] pressure
+  // [particles] nsides: sides of the polygons (0: disks). Set when the array
+  // holds one value (or is a plain integer); a mixture of shapes leaves it
+  // empty and sets nsides_mixed.
+  std::optional<int> nsides;
+  bool nsides_mixed = false;
+  std::optional<double> friction;          // [contact] mu (interparticle friction)
+  std::optional<double> solver_tol;        // [solver] tol (NLGS convergence)
 };
+
+// The angularity of a shape with n sides, alpha = 2 pi/n (disks, n = 0: 0).
+double angularity_of(int nsides);
 
 // Throws AnalysisError naming the folder when scene.toml is missing, or the
 // file when it does not parse or a key has a non-numeric value. Absent keys

@@ -198,6 +198,7 @@ ParticleSet read_particles(const std::string& path) {
   vtkDataArray* omega = pdat->GetArray("omega");
   vtkDataArray* angle = pdat->GetArray("angle");
   vtkDataArray* mass = pdat->GetArray("mass");
+  vtkDataArray* nsides = pdat->GetArray("nsides");
   for (vtkIdType i = 0; i < n; ++i) {
     Particle p;
     double x[3];
@@ -213,6 +214,7 @@ ParticleSet read_particles(const std::string& path) {
     if (omega) p.omega = omega->GetTuple1(i);
     if (angle) p.angle = angle->GetTuple1(i);
     if (mass) p.mass = mass->GetTuple1(i);
+    p.nsides = nsides ? static_cast<int>(nsides->GetTuple1(i)) : -1;
     ps.push_back(p);
   }
   return ps;
@@ -278,8 +280,9 @@ void write_contacts(const std::string& path, const ContactSet& cs, const Particl
 void write_particles(const std::string& path, const ParticleSet& ps) {
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();  // float32 would cost 1e-7 relative on branch vectors
-  vtkNew<vtkIntArray> id;
+  vtkNew<vtkIntArray> id, nsides;
   id->SetName("id");
+  nsides->SetName("nsides");
   vtkNew<vtkDoubleArray> radius, vel, omega, angle, mass;
   radius->SetName("radius");
   vel->SetName("velocity");
@@ -290,6 +293,7 @@ void write_particles(const std::string& path, const ParticleSet& ps) {
   for (const auto& p : ps) {
     pts->InsertNextPoint(p.x, p.y, 0);
     id->InsertNextValue(p.id);
+    nsides->InsertNextValue(p.nsides < 0 ? 0 : p.nsides);
     radius->InsertNextValue(p.radius);
     vel->InsertNextTuple3(p.vx, p.vy, 0);
     omega->InsertNextValue(p.omega);
@@ -299,6 +303,7 @@ void write_particles(const std::string& path, const ParticleSet& ps) {
   vtkNew<vtkPolyData> pd;
   pd->SetPoints(pts);
   pd->GetPointData()->AddArray(id);
+  pd->GetPointData()->AddArray(nsides);
   for (vtkDataArray* a : {static_cast<vtkDataArray*>(radius), static_cast<vtkDataArray*>(vel),
                           static_cast<vtkDataArray*>(omega), static_cast<vtkDataArray*>(angle),
                           static_cast<vtkDataArray*>(mass)})

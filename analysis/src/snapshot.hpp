@@ -35,6 +35,7 @@ struct Particle {
   double x = 0, y = 0;
   double radius = 0;
   double vx = 0, vy = 0, omega = 0, angle = 0, mass = 0;
+  int nsides = -1;  // 0 disk, n polygon; -1: the snapshot has no nsides array
 };
 
 using ParticleSet = std::vector<Particle>;
