@@ -185,7 +185,7 @@ $(CAMPAIGNS)/prep/ns_%/.done: | build
 	touch $@
 
 shear_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) \
-	  --set shear.start='"$(CAMPAIGNS)/prep/ns_$(2)/checkpoint.bin"' --set shear.pressure=$(P) \
+	  --set shear.start='"$(CAMPAIGNS)/prep/ns_$(2)/checkpoint.bin"' --set particles.nsides=[$(2)] --set shear.pressure=$(P) \
 	  --set shear.inertial_number=$(1) --set shear.strain=$(STRAIN) --set shear.dt_tp=$(call dt_tp,$(1)) \
 	  --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=$(call snapshot_dt,$(1))
 
