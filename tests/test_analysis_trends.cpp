@@ -19,6 +19,7 @@
 #include "analysis/src/scene_info.hpp"
 #include "analysis/src/snapshot.hpp"
 #include "analysis/src/trends.hpp"
+#include "config.hpp"
 #include "analysis_synth.hpp"
 #include "cli_util.hpp"
 
@@ -306,4 +307,21 @@ TEST(AnalysisTrends, ReportOnAnAngularityCampaign) {
   EXPECT_NE(html.find("<h3>Angularity</h3>"), std::string::npos);
   EXPECT_NE(html.find("angularity_mu.png"), std::string::npos);
   EXPECT_NE(html.find("cdanalysis fit angularity"), std::string::npos);
+}
+
+// The shape as cdsim records it: the resolved scene.toml that cdsim writes
+// (cd::resolved_toml) lists particles.nsides as floats ([6.0]); the analysis
+// must read it as 6 (a real campaign's runs were all skipped otherwise).
+TEST(AnalysisTrends, ReadsTheShapeFromCdsimsResolvedScene) {
+  const fs::path d = cdtest::scratch_dir("analysis_trends", "resolved");
+  for (const double n : {0.0, 6.0, 20.0}) {
+    cd::Scene s;
+    s.nsides = {n};
+    std::ofstream(d / "scene.toml") << cd::resolved_toml(s);
+    EXPECT_EQ(cda::read_scene_info(d.string()).nsides, static_cast<int>(n));
+  }
+  cd::Scene mixed;
+  mixed.nsides = {0.0, 6.0};
+  std::ofstream(d / "scene.toml") << cd::resolved_toml(mixed);
+  EXPECT_TRUE(cda::read_scene_info(d.string()).nsides_mixed);
 }

@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <numbers>
 #include <vector>
@@ -49,14 +50,19 @@ SceneInfo read_scene_info(const std::string& run_dir) {
       root.at("particles").contains("nsides")) {
     const auto& v = root.at("particles").at("nsides");
     std::vector<long long> ns;
-    if (v.is_integer()) {
-      ns.push_back(v.as_integer());
+    // cdsim's resolved scene.toml writes the list as floats (nsides = [6.0]):
+    // a float with an integer value counts as that integer.
+    const auto side_count = [&](const toml::value& e) -> long long {
+      if (e.is_integer()) return e.as_integer();
+      if (e.is_floating() && std::isfinite(e.as_floating()) && e.as_floating() == std::floor(e.as_floating()) &&
+          std::abs(e.as_floating()) < 1e9)
+        return static_cast<long long>(e.as_floating());
+      throw InputError(fmt::format("'{}': [particles] nsides holds a non-integer", s.file));
+    };
+    if (v.is_integer() || v.is_floating()) {
+      ns.push_back(side_count(v));
     } else if (v.is_array()) {
-      for (const auto& e : v.as_array()) {
-        if (!e.is_integer())
-          throw InputError(fmt::format("'{}': [particles] nsides holds a non-integer", s.file));
-        ns.push_back(e.as_integer());
-      }
+      for (const auto& e : v.as_array()) ns.push_back(side_count(e));
     } else {
       throw InputError(fmt::format("'{}': [particles] nsides is neither an integer nor an array", s.file));
     }
