@@ -391,3 +391,52 @@ TEST(World3, IdenticalWithOneAndTwoThreads) {
   for (std::size_t k = 0; k < s1.size(); ++k) diff += s1[k] != s2[k];
   EXPECT_EQ(diff, 0u);
 }
+
+// A sphere spinning in free space at constant w: the orientation after n
+// steps is the rotation by n dt |w| about w, and stays a unit quaternion.
+TEST(World3, QuaternionFollowsConstantSpin) {
+  WorldParams3 p;
+  p.dt = 1e-3;
+  World3 w(p);
+  const Vec3 omega(3.0, -1.0, 2.0);
+  const int s = w.bodies.add_sphere(Vec3::Zero(), 0.01, 1000, Vec3(0.1, 0, 0), omega);
+  const int n = 1000;
+  for (int k = 0; k < n; ++k) w.step();
+  const Quat expect(Eigen::AngleAxisd(n * p.dt * omega.norm(), omega.normalized()));
+  EXPECT_NEAR(w.bodies.orient[s].norm(), 1.0, 1e-15);
+  EXPECT_LT(w.bodies.orient[s].angularDistance(expect), 1e-12);
+  EXPECT_NEAR(w.bodies.pos[s].x(), 0.1 * n * p.dt, 1e-14);  // 2000 half-step sums
+  EXPECT_EQ(w.bodies.vel[s].w, omega);
+}
+
+// Adhesion: a sphere under a ceiling, pull-off force twice its weight,
+// hangs (r_n = -m g dt, no motion), frictionless and frictional law.
+TEST(World3, CohesiveSphereHangsUnderACeiling) {
+  for (const bool friction : {false, true}) {
+    WorldParams3 p;
+    p.dt = 1e-3;
+    p.gravity = Vec3(0, 0, -kG);
+    p.mu = p.mu_wall = friction ? 0.3 : 0.0;
+    p.alert = 1e-4;
+    p.debond = 1e-3;
+    p.solver.tol = 1e-12;
+    const double r = 0.01;
+    {
+      World3 probe(p);
+      probe.bodies.add_sphere(Vec3::Zero(), r, 2600);
+      p.adhesion = 2.0 * probe.bodies.mass[0] * kG;
+    }
+    World3 w(p);
+    w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, -1));
+    const int s = w.bodies.add_sphere(Vec3(0, 0, -r), r, 2600);
+    const double m = w.bodies.mass[s];
+    for (int k = 0; k < 200; ++k) {
+      w.step();
+      ASSERT_EQ(w.rows().size(), 1u);
+      EXPECT_NEAR(w.rows()[0].r[0], -m * kG * p.dt, 1e-14 * m * kG * p.dt);
+      EXPECT_LE(w.last().solve.residual_max, 1e-12);
+    }
+    EXPECT_NEAR(w.bodies.pos[s].z(), -r, 1e-15);
+    EXPECT_LT(w.bodies.vel[s].v.norm(), 1e-15);
+  }
+}
