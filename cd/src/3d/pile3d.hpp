@@ -44,8 +44,10 @@ inline World3 make_pile3d(const Pile3dParams& q) {
   std::uniform_real_distribution<double> R(0.5 * q.r_mean, q.r_mean), J(-0.05 * q.r_mean, 0.05 * q.r_mean);
   for (int m = 0; m < q.n_spheres; ++m) {
     const int i = m % n, j = (m / n) % n, k = m / (n * n);
-    const Vec3 x((i + 0.5) * pitch + J(rng), (j + 0.5) * pitch + J(rng), 1.1 * rmax + k * pitch + J(rng));
-    w.bodies.add_sphere(x, R(rng), q.density);
+    // One draw per statement: the order of a call's arguments is unspecified.
+    const double jx = J(rng), jy = J(rng), jz = J(rng), r = R(rng);
+    w.bodies.add_sphere(Vec3((i + 0.5) * pitch + jx, (j + 0.5) * pitch + jy, 1.1 * rmax + k * pitch + jz), r,
+                        q.density);
   }
   return w;
 }
