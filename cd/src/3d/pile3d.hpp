@@ -18,7 +18,11 @@ struct Pile3dParams {
   double density = 2600.0;
   double mu = 0.4;
   double dt = 1e-3;
-  double alert_rel = 0.2;  // alert distance / r_mean
+  // Alert distance / r_mean. It must exceed the relative travel in a step:
+  // at N = 4000 spheres fall ~0.18 m and hit at ~2 m/s, 2 mm a 1 ms step;
+  // measured: 0.2 lost contacts (largest overlap 0.042 r_mean during the
+  // impact), 0.5 kept it at 0.0039 r_mean for 10% more time.
+  double alert_rel = 0.5;
   std::uint64_t seed = 1;
   SolverParams solver;
 };
