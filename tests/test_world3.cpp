@@ -426,3 +426,25 @@ TEST(World3, CohesiveSphereHangsUnderACeiling) {
     EXPECT_LT(w.bodies.vel[s].v.norm(), 1e-15);
   }
 }
+
+// Overlap correction: a sphere overlapping a plane by delta (no gravity)
+// leaves it at beta delta / dt in one step; beta = 0 leaves it at rest.
+TEST(World3, OverlapCorrectionSeparatesAtBetaGapOverDt) {
+  for (const double beta : {0.0, 0.3}) {
+    WorldParams3 p;
+    p.dt = 1e-3;
+    p.mu = p.mu_wall = 0.4;
+    p.overlap_correction = beta;
+    p.solver.tol = 1e-12;
+    World3 w(p);
+    w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
+    const double r = 0.01, delta = 1e-5;
+    const int s = w.bodies.add_sphere(Vec3(0, 0, r - delta), r, 2600);
+    w.step();
+    EXPECT_NEAR(w.bodies.vel[s].v.z(), beta * delta / p.dt, 1e-12 * delta / p.dt);
+    EXPECT_EQ(w.bodies.vel[s].v.x(), 0.0);
+    // r_n = m beta delta / dt, work r_n beta delta / dt = m v^2 (twice the kinetic energy: a bound)
+    const double v = beta * delta / p.dt;
+    EXPECT_NEAR(w.last().correction_work, w.bodies.mass[s] * v * v, 1e-12 * w.bodies.mass[s] * 1e-4);
+  }
+}

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   app.add_option("--tol", q.solver.tol, "NLGS tolerance (rms |dp| / mean |p|)");
   app.add_option("--max-iter", q.solver.max_iter, "NLGS sweep cap");
   app.add_option("--alert", q.alert_rel, "alert distance / r_mean");
+  app.add_option("--overlap-correction", q.overlap_correction,
+                 "beta: overlaps separate at beta |gap|/dt (0: pure CD)");
   app.add_option("--seed", q.seed, "random seed (radii, jitter)");
   app.add_option("--out", out, "output folder");
   app.add_option("--vtk-every", every, "a spheres_NNNNN.vtp every k steps (0: first and last only)");

@@ -23,6 +23,7 @@ struct Pile3dParams {
   // measured: 0.2 lost contacts (largest overlap 0.042 r_mean during the
   // impact), 0.5 kept it at 0.0039 r_mean for 10% more time.
   double alert_rel = 0.5;
+  double overlap_correction = 0.0;  // beta (WorldParams3)
   std::uint64_t seed = 1;
   SolverParams solver;
 };
@@ -35,6 +36,7 @@ inline World3 make_pile3d(const Pile3dParams& q) {
   p.gravity = Vec3(0, 0, -9.81);
   p.mu = p.mu_wall = q.mu;
   p.alert = q.alert_rel * q.r_mean;
+  p.overlap_correction = q.overlap_correction;
   p.d_ref = 1.5 * q.r_mean;  // mean diameter of U[0.5, 1] r_mean radii
   p.solver = q.solver;
   World3 w(p);

@@ -103,8 +103,9 @@ void World3::build() {
     r.mu = bodies.driven[r.b1] ? prm_.mu_wall : prm_.mu;
     const double gap = info_[k].gap;
     // Gap term u_n + g_m/dt >= 0 for an open candidate (g_m > 0): the next
-    // midpoint gap is g_m + dt u+_n >= 0 (2D's choice, method.md section 6).
-    r.bn = gap > 0.0 ? gap / dt : 0.0;
+    // midpoint gap is g_m + dt u+_n >= 0 (2D's choice, method.md section 6);
+    // an overlap separates at beta |g|/dt (beta = 0: pure CD).
+    r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
     r.adh = adhesion_on_ && gap <= prm_.debond ? a : 0.0;
     // Warm start: the previous impulse by contact key, on the new frame.
     const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
@@ -189,6 +190,13 @@ void World3::observe() {
     }
   }
   last_.active = active;
+  // Work of the overlap correction: a row with bias b_n < 0 holds u_n >=
+  // -b_n, and r_n (-b_n) bounds the energy that bias puts in.
+  double work = 0.0;
+  if (prm_.overlap_correction > 0.0)
+    for (std::size_t k = 0; k < nr; ++k)
+      if (info_[k].gap < 0.0 && rows_[k].bn < 0.0) work += rows_[k].r[0] * -rows_[k].bn;
+  last_.correction_work = work;
   last_.max_overlap = omax / prm_.d_ref;
   last_.mean_overlap = nover ? osum / nover / prm_.d_ref : 0.0;
 }

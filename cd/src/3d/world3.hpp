@@ -29,6 +29,10 @@ struct WorldParams3 {
   Vec3 gravity = Vec3::Zero();
   double mu = 0.0, mu_wall = 0.0;  // sphere-sphere; rows with a driven body 1
   double alert = 0.0;              // absolute alert distance
+  // Overlap correction beta, as 2D's: an overlapping contact must separate
+  // at beta |g|/dt (0: pure CD, overlaps are never pushed apart). The
+  // velocity it gives persists, so it injects energy.
+  double overlap_correction = 0.0;
   // Adhesion-shifted Signorini law: pull-off force f_a on every contact
   // whose midpoint gap is <= debond (absolute); 0: none.
   double adhesion = 0.0, debond = 0.0;
@@ -42,6 +46,7 @@ struct StepStats3 {
   int active = 0;          // rows carrying a force (r_n + a > 0)
   double max_overlap = 0;  // max over contacts of -gap / d_ref (midpoint configuration)
   double mean_overlap = 0; // mean of -gap / d_ref over overlapping contacts
+  double correction_work = 0;  // sum of r_n x bias velocity of the overlap correction (J)
 };
 
 class World3 {
