@@ -6,59 +6,15 @@
 #include <variant>
 
 #include "law.hpp"
+#include "colour_rows.hpp"
 #include "coupling.hpp"
 
 namespace cd {
 
-namespace {
-
-constexpr int kMaxColours = 63;  // colour 63 of the mask is the overflow colour
-
-}  // namespace
-
 Colouring colour_rows(const std::vector<ContactRow>& rows, const Bodies& bodies) {
-  const int n = static_cast<int>(rows.size());
-  std::vector<std::uint64_t> mask(bodies.size(), 0);
-  std::vector<std::uint8_t> colour(n);
-  int used = 0;
-  bool overflow = false;
-  for (int i = 0; i < n; ++i) {
-    const ContactRow& r = rows[i];
-    const bool dyn1 = bodies.is_dynamic(r.b1);
-    std::uint64_t m = mask[r.b2] | (dyn1 ? mask[r.b1] : 0);
-    int c = std::countr_one(m);
-    if (c >= kMaxColours) {
-      c = kMaxColours;  // overflow: solved in sequence, after all colours
-      overflow = true;
-    } else {
-      mask[r.b2] |= std::uint64_t{1} << c;
-      if (dyn1) mask[r.b1] |= std::uint64_t{1} << c;
-      used = std::max(used, c + 1);
-    }
-    colour[i] = static_cast<std::uint8_t>(c);
-  }
-  const int ncol = overflow ? used + 1 : used;
-  // Counting sort by (colour, body 1 dynamic): stable, so deterministic.
-  auto slot = [&](int i) {
-    const int c = colour[i] == kMaxColours ? used : colour[i];
-    return 2 * c + (bodies.is_dynamic(rows[i].b1) ? 1 : 0);
-  };
-  std::vector<std::int32_t> count(2 * ncol + 1, 0);
-  for (int i = 0; i < n; ++i) ++count[slot(i) + 1];
-  for (int s = 0; s < 2 * ncol; ++s) count[s + 1] += count[s];
-  Colouring col;
-  col.overflow = overflow;
-  col.start.resize(ncol + 1);
-  col.split.resize(ncol);
-  for (int c = 0; c < ncol; ++c) {
-    col.start[c] = count[2 * c];
-    col.split[c] = count[2 * c + 1];
-  }
-  col.start[ncol] = n;
-  col.perm.resize(n);
-  std::vector<std::int32_t> pos(count.begin(), count.end() - 1);
-  for (int i = 0; i < n; ++i) col.perm[pos[slot(i)]++] = i;
-  return col;
+  return colour_by_bodies(
+      static_cast<int>(rows.size()), bodies.size(), [&](int i) { return rows[i].b1; },
+      [&](int i) { return rows[i].b2; }, [&](std::int32_t b) { return bodies.is_dynamic(b); });
 }
 
 void apply_impulses(const std::vector<ContactRow>& rows, std::vector<BodyVel>& vel, bool rotation) {

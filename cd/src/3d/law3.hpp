@@ -230,6 +230,35 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
   return br;
 }
 
+// The exact local solve for a block W = diag(W_nn, W_tt, W_tt) and a round
+// cone (spheres: the lever arms are along n, so rotation adds to W_tt only
+// and there is no normal-tangential coupling). solve_local3's enumeration
+// then has a closed form: the normal impulse decouples, s_n = max(0,
+// s_n-trial), and the sliding impulse is the stick trial -q_t / W_tt
+// projected radially onto the disk of radius mu s_n (u_t = W_tt r_t + q_t is
+// then parallel to -r_t, as maximal dissipation wants). Adhesion a shifts the
+// normal impulse as in solve_local3. tests/test_world3.cpp checks it against
+// solve_local3 on such blocks.
+inline Branch3 solve_sphere3(double wnn, double wtt, const Vec3& q, double mu, double a, Vec3& r) {
+  const double sn = std::max(0.0, a - q[0] / wnn);  // shifted normal impulse
+  r[0] = sn - a;
+  if (sn == 0.0) {
+    r[1] = r[2] = 0.0;
+    return Branch3::Open;
+  }
+  const double gt1 = -q[1] / wtt, gt2 = -q[2] / wtt;
+  const double gt = std::hypot(gt1, gt2), lim = mu * sn;
+  if (gt <= lim) {
+    r[1] = gt1;
+    r[2] = gt2;
+    return Branch3::Stick;
+  }
+  const double f = lim / gt;
+  r[1] = f * gt1;
+  r[2] = f * gt2;
+  return Branch3::Slide;
+}
+
 // Natural-map residual of the law at (u, r), in impulse units, with De
 // Saxce's modified velocity, written in the cone's own metric (the unit
 // cone after the change of variables above):

@@ -1,0 +1,75 @@
+// 3D contacts: the hot row the NLGS sweep works on and the cold record kept
+// for warm starts and output (the 3D sibling of 2d/contact.hpp).
+//
+// Frame: n points from body 1 to body 2; (t1, t2) complete it to a
+// right-handed orthonormal basis, built from n alone without a branch near
+// the poles (Duff et al., "Building an orthonormal basis, revisited", JCGT
+// 2017: Frisvad's construction with its singularity at n_z = -1 removed).
+// The relative velocity at the contact point is
+//     u = (v2 + w2 x c2) - (v1 + w1 x c1),
+// c_i from the centre of body i to the contact point, and in the frame
+// (rows of F = [n; t1; t2]) u_loc = F u. An impulse r (frame components) on
+// body 2, -r on body 1, changes it by W r with the Delassus block
+//     W = F ( (1/m1 + 1/m2) I + sum_i (1/I_i)(|c_i|^2 I - c_i c_i^T) ) F^T
+// (scalar inertia). For spheres c_i is parallel to n, so W = diag(W_nn,
+// W_tt, W_tt) with W_nn = 1/m1 + 1/m2 and W_tt = W_nn + |c1|^2/I1 +
+// |c2|^2/I2: the row keeps these two numbers (tests/test_world3.cpp checks
+// them against the assembled H^T M^-1 H).
+#pragma once
+#include <cmath>
+#include <cstdint>
+
+#include "bodies3.hpp"
+
+namespace cd {
+
+// Orthonormal t1, t2 with (n, t1, t2) right-handed, for a unit n (Duff et al. 2017).
+inline void orthonormal_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
+  const double s = std::copysign(1.0, n.z());
+  const double a = -1.0 / (s + n.z());
+  const double b = n.x() * n.y() * a;
+  t1 = Vec3(1.0 + s * n.x() * n.x() * a, s * b, -s * n.x());
+  t2 = Vec3(b, s + n.y() * n.y() * a, -n.y());
+}
+
+// Hot row: everything one local solve reads or writes. Impulses r = f dt in
+// the frame (n, t1, t2).
+struct SphereRow {
+  std::int32_t b1, b2;
+  Vec3 n, t1, t2;
+  Vec3 c1, c2;     // lever arms (centre of body i to the contact point)
+  double wnn, wtt; // the Delassus block diag(wnn, wtt, wtt)
+  double bn;       // constant normal velocity offset of the law (gap term)
+  Vec3 r;          // impulse over the step, frame components
+  double mu;       // friction coefficient (round cone)
+  double adh;      // adhesion impulse f_a dt (0 in non-cohesive scenes)
+
+  Vec3 to_frame(const Vec3& x) const { return {n.dot(x), t1.dot(x), t2.dot(x)}; }
+  Vec3 to_world(const Vec3& x) const { return x[0] * n + x[1] * t1 + x[2] * t2; }
+};
+
+// Cold record, same index as the row.
+struct ContactInfo3 {
+  std::uint64_t key;  // (b1, b2): one contact a pair of spheres or sphere and plane
+  double gap;         // signed gap at the midpoint configuration (< 0: overlap)
+  Vec3 point;         // contact point (midpoint configuration)
+  Vec3 branch;        // from the centre of body 1 to the centre of body 2 (plane: to the sphere's foot)
+};
+
+inline std::uint64_t contact_key3(std::int32_t b1, std::int32_t b2) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(b1)) << 32) |
+         static_cast<std::uint32_t>(b2);
+}
+
+// Relative velocity of a row's contact point, world frame.
+inline Vec3 relative_velocity(const SphereRow& r, const BodyVel3& A, const BodyVel3& B) {
+  return B.v + B.w.cross(r.c2) - A.v - A.w.cross(r.c1);
+}
+
+// The Delassus block of a row from its lever arms and its bodies.
+inline void set_block(SphereRow& r, const BodyVel3& A, const BodyVel3& B) {
+  r.wnn = A.inv_m + B.inv_m;
+  r.wtt = r.wnn + A.inv_I * r.c1.squaredNorm() + B.inv_I * r.c2.squaredNorm();
+}
+
+}  // namespace cd

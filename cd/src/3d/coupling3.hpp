@@ -1,0 +1,91 @@
+// The 3D sphere rows for the sweep (core/sweep.hpp): rows coupled through
+// the velocities of their bodies (BodyCoupling3, the sibling of 2D's
+// BodyCoupling), the laws chosen once per scene, and what the sweep asks of
+// a row (its law residual, its impulse norm, a boundary dof type).
+#pragma once
+#include <algorithm>
+#include <cmath>
+
+#include "contact3.hpp"
+#include "law3.hpp"
+#include "sweep.hpp"
+
+namespace cd {
+
+// The local law of a scene, fixed once (no test inside the sweep):
+// frictionless or round Coulomb, with or without adhesion. The local solve
+// is law3's exact solver for the sphere block diag(W_nn, W_tt, W_tt)
+// (solve_sphere3); u = W r + q with q the velocity the others leave.
+template <bool Friction, bool Cohesion>
+struct SphereLaw3 {
+  static constexpr bool tangential = Friction;
+  static void solve(const SphereRow& r, const Vec3& q, Vec3& out) {
+    const double a = Cohesion ? r.adh : 0.0;
+    if constexpr (Friction) {
+      solve_sphere3(r.wnn, r.wtt, q, r.mu, a, out);
+    } else {
+      out = Vec3(std::max(-a, -q[0] / r.wnn), 0.0, 0.0);
+    }
+  }
+};
+
+// No boundary dofs in the 3D step yet; the sweep's interface asks for a type.
+struct NoDof3 {
+  double v = 0, v0 = 0;
+};
+inline double update_dof(NoDof3&, SphereRow*) { return 0.0; }
+
+inline double impulse_norm(const SphereRow& r) { return r.r.norm(); }
+
+namespace sweep {
+
+// Rows coupled through the velocities of their bodies (the 3D simulator).
+struct BodyCoupling3 {
+  BodyVel3* vel;
+
+  // The row's relative velocity in its frame, with the law's offset.
+  Vec3 velocity(const SphereRow& r) const {
+    const Vec3 du = relative_velocity(r, vel[r.b1], vel[r.b2]);
+    return {r.n.dot(du) + r.bn, r.t1.dot(du), r.t2.dot(du)};
+  }
+
+  // One row update. Write1 = false when body 1 is driven (a wall): read,
+  // never written, so rows of one colour may share it without a data race.
+  template <class L, bool Write1>
+  void update(SphereRow& r, double& dp2, double& pabs) const {
+    BodyVel3& A = vel[r.b1];
+    BodyVel3& B = vel[r.b2];
+    const Vec3 du = relative_velocity(r, A, B);
+    Vec3 q;
+    q[0] = r.n.dot(du) + r.bn - r.wnn * r.r[0];
+    if constexpr (L::tangential) {
+      q[1] = r.t1.dot(du) - r.wtt * r.r[1];
+      q[2] = r.t2.dot(du) - r.wtt * r.r[2];
+    } else {
+      q[1] = q[2] = 0.0;
+    }
+    Vec3 rn;
+    L::solve(r, q, rn);
+    const Vec3 dr = rn - r.r;
+    r.r = rn;
+    dp2 = dr.squaredNorm();
+    pabs = rn.norm();
+    const Vec3 P = r.to_world(dr);
+    B.v += B.inv_m * P;
+    B.w += B.inv_I * r.c2.cross(P);
+    if constexpr (Write1) {
+      A.v -= A.inv_m * P;
+      A.w -= A.inv_I * r.c1.cross(P);
+    }
+  }
+};
+
+}  // namespace sweep
+
+// The law residual of a row (law3.hpp, rho = 1/W_nn) at the velocity its
+// coupling gives.
+inline double row_residual(const sweep::BodyCoupling3& c, const SphereRow& r) {
+  return law_residual3(c.velocity(r), r.r, Cone3::round(r.mu), r.adh, 1.0 / r.wnn);
+}
+
+}  // namespace cd

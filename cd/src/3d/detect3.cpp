@@ -1,0 +1,178 @@
+#include "detect3.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <omp.h>
+
+namespace cd {
+
+namespace {
+
+void set_frame(SphereRow& row, int b1, int b2, const Vec3& n, const Vec3& c1, const Vec3& c2) {
+  row.b1 = b1;
+  row.b2 = b2;
+  row.n = n;
+  orthonormal_basis(n, row.t1, row.t2);
+  row.c1 = c1;
+  row.c2 = c2;
+  row.wnn = row.wtt = 0.0;
+  row.bn = 0.0;
+  row.r = Vec3::Zero();
+  row.mu = 0.0;
+  row.adh = 0.0;
+}
+
+}  // namespace
+
+bool sphere_sphere(int i, int j, const Vec3& xi, const Vec3& xj, double ri, double rj,
+                   double alert, SphereRow& row, ContactInfo3& info) {
+  const Vec3 d = xj - xi;
+  const double dist2 = d.squaredNorm();
+  const double reach = ri + rj + alert;
+  if (dist2 > reach * reach) return false;
+  const double dist = std::sqrt(dist2);
+  const Vec3 n = dist > 0 ? Vec3(d / dist) : Vec3(0.0, 0.0, 1.0);
+  const double gap = dist - ri - rj;
+  // Contact point: middle of the gap (or of the overlap) on the line of centres.
+  const Vec3 c1 = (ri + 0.5 * gap) * n;
+  const Vec3 p = xi + c1;
+  set_frame(row, i, j, n, c1, p - xj);
+  info = {contact_key3(i, j), gap, p, d};
+  return true;
+}
+
+bool plane_sphere(int pl, int k, const Vec3& xp, const Vec3& np, const Vec3& xk, double rk,
+                  double alert, SphereRow& row, ContactInfo3& info) {
+  const double dist = (xk - xp).dot(np);
+  const double gap = dist - rk;
+  if (gap > alert) return false;
+  const Vec3 foot = xk - dist * np;
+  const Vec3 p = foot + 0.5 * gap * np;
+  set_frame(row, pl, k, np, p - xp, p - xk);
+  info = {contact_key3(pl, k), gap, p, xk - foot};
+  return true;
+}
+
+void detect3(const Bodies3& bodies, const std::vector<Vec3>& x, double alert, CellGrid3& grid,
+             std::vector<SphereRow>& rows, std::vector<ContactInfo3>& info, int min_parallel) {
+  rows.clear();
+  info.clear();
+  const int nb = static_cast<int>(bodies.size());
+  std::vector<int> spheres, planes;
+  spheres.reserve(nb);
+  double rmax = 0;
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (int i = 0; i < nb; ++i) {
+    if (bodies.shape[i] == Shape3::Plane) {
+      planes.push_back(i);
+    } else {
+      spheres.push_back(i);
+      rmax = std::max(rmax, bodies.radius[i]);
+      lo = lo.cwiseMin(x[i]);
+      hi = hi.cwiseMax(x[i]);
+    }
+  }
+  const int ns = static_cast<int>(spheres.size());
+  const int nthreads = omp_get_max_threads();
+  grid.rows_t.resize(nthreads);
+  grid.info_t.resize(nthreads);
+  if (ns > 1) {
+    // Cells of side h >= 2 r_max + alert: a pair within reach is in the same
+    // or a neighbouring cell. The count is bounded by ~2 cells a sphere (and
+    // a sphere far away coarsens the grid rather than blowing up memory).
+    double h = 2 * rmax + alert;
+    const Vec3 ext = hi - lo;
+    auto cells = [&](double hh) {
+      return (std::floor(ext.x() / hh) + 1) * (std::floor(ext.y() / hh) + 1) * (std::floor(ext.z() / hh) + 1);
+    };
+    const double cap = 2.0 * ns + 64;
+    while (cells(h) > cap) h *= 1.25;
+    const int nx = static_cast<int>(ext.x() / h) + 1, ny = static_cast<int>(ext.y() / h) + 1,
+              nz = static_cast<int>(ext.z() / h) + 1;
+    const int ncell = nx * ny * nz;
+    auto axis = [&](double v, double l, int n) {
+      return std::clamp(static_cast<int>(std::floor((v - l) / h)), 0, n - 1);
+    };
+    // Counting sort of the spheres by cell, in index order inside a cell.
+    grid.cell_start.assign(ncell + 1, 0);
+    grid.cell_of.resize(ns);
+    for (int a = 0; a < ns; ++a) {
+      const Vec3& p = x[spheres[a]];
+      const int c = (axis(p.z(), lo.z(), nz) * ny + axis(p.y(), lo.y(), ny)) * nx + axis(p.x(), lo.x(), nx);
+      grid.cell_of[a] = c;
+      ++grid.cell_start[c + 1];
+    }
+    for (int c = 0; c < ncell; ++c) grid.cell_start[c + 1] += grid.cell_start[c];
+    grid.items.resize(ns);
+    {
+      std::vector<int> pos(grid.cell_start.begin(), grid.cell_start.end() - 1);
+      for (int a = 0; a < ns; ++a) grid.items[pos[grid.cell_of[a]]++] = spheres[a];
+    }
+    const std::vector<int>& cs = grid.cell_start;
+    const std::vector<int>& it = grid.items;
+    // Half of the 27-cell stencil: the cell itself (pairs a < b) and the 13
+    // neighbours after it in (z, y, x) order.
+    static constexpr int off[13][3] = {{1, 0, 0},  {-1, 1, 0}, {0, 1, 0},  {1, 1, 0},  {-1, -1, 1},
+                                       {0, -1, 1}, {1, -1, 1}, {-1, 0, 1}, {0, 0, 1},  {1, 0, 1},
+                                       {-1, 1, 1}, {0, 1, 1},  {1, 1, 1}};
+    const bool par = ns >= min_parallel / 2;
+    for (int t = 0; t < nthreads; ++t) {  // a team may be smaller than nthreads
+      grid.rows_t[t].clear();
+      grid.info_t[t].clear();
+    }
+#pragma omp parallel if (par)
+    {
+      const int t = omp_get_thread_num();
+      std::vector<SphereRow>& R = grid.rows_t[t];
+      std::vector<ContactInfo3>& I = grid.info_t[t];
+      SphereRow row;
+      ContactInfo3 inf;
+      auto pair = [&](int i, int j) {
+        if (i > j) std::swap(i, j);
+        if (bodies.driven[i] && bodies.driven[j]) return;
+        // A driven body is body 1 (the colouring's split and the wall
+        // friction look at body 1 only).
+        if (bodies.driven[j] && !bodies.driven[i]) std::swap(i, j);
+        if (sphere_sphere(i, j, x[i], x[j], bodies.radius[i], bodies.radius[j], alert, row, inf)) {
+          R.push_back(row);
+          I.push_back(inf);
+        }
+      };
+#pragma omp for schedule(static)
+      for (int cz = 0; cz < nz; ++cz)
+        for (int cy = 0; cy < ny; ++cy)
+          for (int cx = 0; cx < nx; ++cx) {
+            const int c = (cz * ny + cy) * nx + cx;
+            for (int a = cs[c]; a < cs[c + 1]; ++a) {
+              const int i = it[a];
+              for (int b = a + 1; b < cs[c + 1]; ++b) pair(i, it[b]);
+              for (const auto& o : off) {
+                const int qx = cx + o[0], qy = cy + o[1], qz = cz + o[2];
+                if (qx < 0 || qx >= nx || qy < 0 || qy >= ny || qz >= nz) continue;
+                const int d = (qz * ny + qy) * nx + qx;
+                for (int b = cs[d]; b < cs[d + 1]; ++b) pair(i, it[b]);
+              }
+            }
+          }
+    }
+    // Joined in thread order: each thread had a contiguous range of slabs,
+    // so this is the sequential order.
+    for (int t = 0; t < nthreads; ++t) {
+      rows.insert(rows.end(), grid.rows_t[t].begin(), grid.rows_t[t].end());
+      info.insert(info.end(), grid.info_t[t].begin(), grid.info_t[t].end());
+    }
+  }
+  for (const int p : planes)
+    for (const int k : spheres) {
+      if (bodies.driven[k]) continue;
+      SphereRow row;
+      ContactInfo3 inf;
+      if (plane_sphere(p, k, x[p], bodies.normal[p], x[k], bodies.radius[k], alert, row, inf)) {
+        rows.push_back(row);
+        info.push_back(inf);
+      }
+    }
+}
+
+}  // namespace cd

@@ -1,0 +1,221 @@
+#include "world3.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "colour_rows.hpp"
+#include "coupling3.hpp"
+
+namespace cd {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+template <class L>
+SolveStats solve_with(std::vector<SphereRow>& rows, const Colouring& col, std::vector<BodyVel3>& vel,
+                      const SolverParams& prm) {
+  sweep::BodyCoupling3 c{vel.data()};
+  std::vector<NoDof3>* nodofs = nullptr;
+  return sweep::solve<L>(rows, col, c, prm, nodofs, {});
+}
+
+// exp(h w) q: the rotation by the angle h |w| about w (world frame), then
+// renormalised so that round-off does not accumulate in |q|.
+Quat rotate(const Quat& q, const Vec3& w, double h) {
+  const double a = h * w.norm();
+  if (a == 0.0) return q;
+  Quat r = Quat(Eigen::AngleAxisd(a, w.normalized())) * q;
+  r.normalize();
+  return r;
+}
+
+}  // namespace
+
+void World3::configure() {
+  gravity_on_ = prm_.gravity.squaredNorm() > 0.0;
+  adhesion_on_ = prm_.adhesion > 0.0;
+  // Contacts within the alert distance enter the solver with the gap term
+  // u_n + g_m/dt >= 0, which closes gaps without overlap (as in 2D).
+  alert_ = prm_.alert;
+  if (adhesion_on_) alert_ = std::max(alert_, prm_.debond);
+  const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
+  if (adhesion_on_)
+    solve_fn_ = friction ? &solve_with<SphereLaw3<true, true>> : &solve_with<SphereLaw3<false, true>>;
+  else
+    solve_fn_ = friction ? &solve_with<SphereLaw3<true, false>> : &solve_with<SphereLaw3<false, false>>;
+}
+
+void World3::step() {
+  static constexpr std::array<std::pair<Stage, void (World3::*)()>, 7> kTable = {{
+      {Stage::Predict, &World3::predict},
+      {Stage::Detect, &World3::detect_stage},
+      {Stage::Build, &World3::build},
+      {Stage::Colour, &World3::colour},
+      {Stage::Solve, &World3::solve},
+      {Stage::Integrate, &World3::integrate},
+      {Stage::Observe, &World3::observe},
+  }};
+  for (const auto& [stage, run] : kTable) {
+    const auto t0 = Clock::now();
+    (this->*run)();
+    times[stage] += since(t0);
+  }
+  ++steps;
+  time = static_cast<double>(steps) * prm_.dt;  // not a running sum: no drift
+}
+
+void World3::predict() {
+  const std::size_t n = bodies.size();
+  const double h = 0.5 * prm_.dt;
+  xm_.resize(n);
+  qm_.resize(n);
+  const bool par = static_cast<int>(n) >= prm_.solver.min_parallel / 2;
+#pragma omp parallel for schedule(static) if (par)
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodyVel3& v = bodies.vel[i];
+    xm_[i] = bodies.pos[i] + h * v.v;
+    qm_[i] = rotate(bodies.orient[i], v.w, h);
+  }
+}
+
+void World3::detect_stage() {
+  detect3(bodies, xm_, alert_, grid_, rows_, info_, prm_.solver.min_parallel);
+}
+
+void World3::build() {
+  const double dt = prm_.dt;
+  const auto& V = bodies.vel;
+  const std::size_t nr = rows_.size();
+  const bool par = static_cast<int>(nr) >= prm_.solver.min_parallel;
+  const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
+  const double a = adhesion_on_ ? prm_.adhesion * dt : 0.0;
+#pragma omp parallel for schedule(static) if (par)
+  for (std::size_t k = 0; k < nr; ++k) {
+    SphereRow& r = rows_[k];
+    set_block(r, V[r.b1], V[r.b2]);
+    r.mu = bodies.driven[r.b1] ? prm_.mu_wall : prm_.mu;
+    const double gap = info_[k].gap;
+    // Gap term u_n + g_m/dt >= 0 for an open candidate (g_m > 0): the next
+    // midpoint gap is g_m + dt u+_n >= 0 (2D's choice, method.md section 6);
+    // an overlap separates at beta |g|/dt (beta = 0: pure CD).
+    r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
+    r.adh = adhesion_on_ && gap <= prm_.debond ? a : 0.0;
+    // Warm start: the previous impulse by contact key, on the new frame.
+    const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
+    if (it != warm_.keys.end() && *it == info_[k].key) {
+      r.r = r.to_frame(warm_.p[it - warm_.keys.begin()]);
+      if (!friction) r.r[1] = r.r[2] = 0.0;
+    }
+  }
+}
+
+void World3::colour() {
+  colouring_ = colour_by_bodies(
+      static_cast<int>(rows_.size()), bodies.size(), [&](int i) { return rows_[i].b1; },
+      [&](int i) { return rows_[i].b2; }, [&](std::int32_t b) { return bodies.is_dynamic(b); });
+  const std::vector<std::int32_t>& perm = colouring_.perm;
+  std::vector<SphereRow> r(rows_.size());
+  std::vector<ContactInfo3> f(info_.size());
+#pragma omp parallel for schedule(static) if (static_cast<int>(rows_.size()) >= prm_.solver.min_parallel)
+  for (std::size_t k = 0; k < rows_.size(); ++k) {
+    r[k] = rows_[perm[k]];
+    f[k] = info_[perm[k]];
+  }
+  rows_.swap(r);
+  info_.swap(f);
+}
+
+void World3::solve() {
+  auto& V = bodies.vel;
+  if (gravity_on_) {
+    const Vec3 dv = prm_.dt * prm_.gravity;
+    for (std::size_t i = 0; i < bodies.size(); ++i)
+      if (bodies.is_dynamic(i)) V[i].v += dv;
+  }
+  // Warm-start impulses into the velocities (sequential: bodies are shared).
+  for (const SphereRow& r : rows_) {
+    const Vec3 P = r.to_world(r.r);
+    BodyVel3& A = V[r.b1];
+    BodyVel3& B = V[r.b2];
+    B.v += B.inv_m * P;
+    B.w += B.inv_I * r.c2.cross(P);
+    A.v -= A.inv_m * P;
+    A.w -= A.inv_I * r.c1.cross(P);
+  }
+  last_.solve = solve_fn_(rows_, colouring_, V, prm_.solver);
+
+  // Keep the impulses (world frame) for the next step's warm start.
+  const std::size_t nr = rows_.size();
+  std::vector<std::size_t> idx(nr);
+  std::iota(idx.begin(), idx.end(), 0);
+  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return info_[a].key < info_[b].key; });
+  warm_.keys.resize(nr);
+  warm_.p.resize(nr);
+  for (std::size_t k = 0; k < nr; ++k) {
+    warm_.keys[k] = info_[idx[k]].key;
+    warm_.p[k] = rows_[idx[k]].to_world(rows_[idx[k]].r);
+  }
+}
+
+void World3::integrate() {
+  const double h = 0.5 * prm_.dt;
+  const std::size_t n = bodies.size();
+#pragma omp parallel for schedule(static) if (static_cast<int>(n) >= prm_.solver.min_parallel / 2)
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodyVel3& v = bodies.vel[i];
+    bodies.pos[i] = xm_[i] + h * v.v;
+    bodies.orient[i] = rotate(qm_[i], v.w, h);
+  }
+}
+
+void World3::observe() {
+  const std::size_t nr = rows_.size();
+  last_.contacts = static_cast<int>(nr);
+  int active = 0, nover = 0;
+  double omax = 0, osum = 0;
+  for (std::size_t k = 0; k < nr; ++k) {
+    if (rows_[k].r[0] + rows_[k].adh > 0.0) ++active;
+    const double ov = -info_[k].gap;
+    if (ov > 0) {
+      ++nover;
+      osum += ov;
+      omax = std::max(omax, ov);
+    }
+  }
+  last_.active = active;
+  // Work of the overlap correction: a row with bias b_n < 0 holds u_n >=
+  // -b_n, and r_n (-b_n) bounds the energy that bias puts in.
+  double work = 0.0;
+  if (prm_.overlap_correction > 0.0)
+    for (std::size_t k = 0; k < nr; ++k)
+      if (info_[k].gap < 0.0 && rows_[k].bn < 0.0) work += rows_[k].r[0] * -rows_[k].bn;
+  last_.correction_work = work;
+  last_.max_overlap = omax / prm_.d_ref;
+  last_.mean_overlap = nover ? osum / nover / prm_.d_ref : 0.0;
+}
+
+double World3::kinetic_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies.is_dynamic(i)) continue;
+    const BodyVel3& v = bodies.vel[i];
+    e += 0.5 * bodies.mass[i] * v.v.squaredNorm() + 0.5 * bodies.inertia[i] * v.w.squaredNorm();
+  }
+  return e;
+}
+
+double World3::potential_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies.is_dynamic(i)) e -= bodies.mass[i] * prm_.gravity.dot(bodies.pos[i]);
+  return e;
+}
+
+}  // namespace cd

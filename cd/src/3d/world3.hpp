@@ -1,0 +1,111 @@
+// World3: spheres and planes, per-scene settings, and the time step as the
+// stage table of core/stages.hpp (the 3D sibling of 2d/world.hpp; midpoint
+// Moreau-Jean scheme, method.md sections 6 and 14):
+//   predict    x_m = x + dt/2 v-, q_m = exp(dt/2 w-) q (unit quaternion)
+//   detect     contacts at the midpoint configuration (detect3.hpp)
+//   build      W blocks, gap terms, friction, adhesion, warm start
+//   colour     rows in colour order (core/colour_rows.hpp)
+//   solve      gravity, warm start into the velocities, NLGS
+//              (core/sweep.hpp through BodyCoupling3), impulses kept for
+//              the next warm start
+//   integrate  x+ = x_m + dt/2 v+, q+ = exp(dt/2 w+) q_m
+//   observe    contacts, active contacts, overlaps
+// The law (frictionless, Coulomb, cohesive or not) is fixed once per scene
+// into a template instance of the sweep.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "bodies3.hpp"
+#include "contact3.hpp"
+#include "detect3.hpp"
+#include "solver.hpp"
+#include "stages.hpp"
+
+namespace cd {
+
+struct WorldParams3 {
+  double dt = 1e-3;
+  Vec3 gravity = Vec3::Zero();
+  double mu = 0.0, mu_wall = 0.0;  // sphere-sphere; rows with a driven body 1
+  double alert = 0.0;              // absolute alert distance
+  // Overlap correction beta, as 2D's: an overlapping contact must separate
+  // at beta |g|/dt (0: pure CD, overlaps are never pushed apart). The
+  // velocity it gives persists, so it injects energy.
+  double overlap_correction = 0.0;
+  // Adhesion-shifted Signorini law: pull-off force f_a on every contact
+  // whose midpoint gap is <= debond (absolute); 0: none.
+  double adhesion = 0.0, debond = 0.0;
+  double d_ref = 1.0;  // length scale for overlaps (mean diameter)
+  SolverParams solver;
+};
+
+struct StepStats3 {
+  SolveStats solve;
+  int contacts = 0;        // rows handed to the solver
+  int active = 0;          // rows carrying a force (r_n + a > 0)
+  double max_overlap = 0;  // max over contacts of -gap / d_ref (midpoint configuration)
+  double mean_overlap = 0; // mean of -gap / d_ref over overlapping contacts
+  double correction_work = 0;  // sum of r_n x bias velocity of the overlap correction (J)
+};
+
+class World3 {
+ public:
+  explicit World3(const WorldParams3& p) : prm_(p) { configure(); }
+
+  Bodies3 bodies;
+  double time = 0.0;
+  std::int64_t steps = 0;
+  StageTimes times;
+
+  const WorldParams3& params() const { return prm_; }
+  void set_params(const WorldParams3& p) {
+    prm_ = p;
+    configure();
+  }
+
+  void step();
+  const StepStats3& last() const { return last_; }
+  // The last step's rows (solved) and their records, in colour order.
+  const std::vector<SphereRow>& rows() const { return rows_; }
+  const std::vector<ContactInfo3>& infos() const { return info_; }
+
+  double kinetic_energy() const;    // translational + rotational, dynamic bodies
+  double potential_energy() const;  // -m g.x summed over dynamic bodies
+
+  // Warm-start memory: the previous step's impulses (world frame, on body
+  // 2) by contact key (sorted). Re-projected on the new frame when reused,
+  // so that a turning frame does not rotate the remembered friction.
+  struct WarmStart {
+    std::vector<std::uint64_t> keys;
+    std::vector<Vec3> p;
+  };
+  const WarmStart& warm_start() const { return warm_; }
+
+ private:
+  void configure();
+  void predict();
+  void detect_stage();
+  void build();
+  void colour();
+  void solve();
+  void integrate();
+  void observe();
+
+  using SolveFn = SolveStats (*)(std::vector<SphereRow>&, const Colouring&, std::vector<BodyVel3>&,
+                                 const SolverParams&);
+  WorldParams3 prm_;
+  bool gravity_on_ = false, adhesion_on_ = false;
+  double alert_ = 0.0;
+  SolveFn solve_fn_ = nullptr;
+  StepStats3 last_;
+  std::vector<Vec3> xm_;
+  std::vector<Quat> qm_;
+  std::vector<SphereRow> rows_;
+  std::vector<ContactInfo3> info_;
+  Colouring colouring_;
+  CellGrid3 grid_;
+  WarmStart warm_;
+};
+
+}  // namespace cd
