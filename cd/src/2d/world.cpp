@@ -11,13 +11,6 @@
 
 namespace cd {
 
-namespace {
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-}  // namespace
-
 void World::configure() {
   gravity_on_ = prm_.gravity.squaredNorm() > 0.0;
   restitution_on_ = prm_.e_n > 0.0 || prm_.e_t > 0.0;
@@ -45,7 +38,7 @@ void World::configure() {
 // The step: its stages in order, each timed into its own slot (Box2D's
 // stage list). A stage with nothing to do for a scene returns at once.
 void World::step() {
-  static constexpr std::array<std::pair<Stage, void (World::*)()>, 7> kTable = {{
+  static constexpr StageTable<World> kTable = {{
       {Stage::Predict, &World::predict},
       {Stage::Detect, &World::detect_stage},
       {Stage::Build, &World::build},
@@ -62,11 +55,7 @@ void World::step() {
     prepared_ = true;
   }
   std::visit([&](const auto& b) { b.begin_step(*this); }, boundary_);
-  for (const auto& [stage, run] : kTable) {
-    const auto t0 = Clock::now();
-    (this->*run)();
-    times[stage] += since(t0);
-  }
+  run_stages(*this, kTable, times);
   ++steps;
   time = static_cast<double>(steps) * prm_.dt;  // not a running sum: no drift
 }

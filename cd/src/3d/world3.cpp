@@ -13,10 +13,6 @@ namespace cd {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 template <class L>
 SolveStats solve_with(std::vector<SphereRow>& rows, const Colouring& col, std::vector<BodyVel3>& vel,
@@ -53,7 +49,7 @@ void World3::configure() {
 }
 
 void World3::step() {
-  static constexpr std::array<std::pair<Stage, void (World3::*)()>, 7> kTable = {{
+  static constexpr StageTable<World3> kTable = {{
       {Stage::Predict, &World3::predict},
       {Stage::Detect, &World3::detect_stage},
       {Stage::Build, &World3::build},
@@ -62,11 +58,7 @@ void World3::step() {
       {Stage::Integrate, &World3::integrate},
       {Stage::Observe, &World3::observe},
   }};
-  for (const auto& [stage, run] : kTable) {
-    const auto t0 = Clock::now();
-    (this->*run)();
-    times[stage] += since(t0);
-  }
+  run_stages(*this, kTable, times);
   ++steps;
   time = static_cast<double>(steps) * prm_.dt;  // not a running sum: no drift
 }

@@ -3,6 +3,9 @@
 // series columns t_<name> and the checkpoint's record of the timers.
 #pragma once
 #include <array>
+#include <chrono>
+#include <cstddef>
+#include <utility>
 
 namespace cd {
 
@@ -19,5 +22,20 @@ struct StageTimes {  // wall-clock seconds, accumulated, per stage
   double& operator[](Stage s) { return t[static_cast<int>(s)]; }
   double operator[](Stage s) const { return t[static_cast<int>(s)]; }
 };
+
+// The stages of a world's step W, in order, each a member function.
+template <class W>
+using StageTable = std::array<std::pair<Stage, void (W::*)()>, kStages - 1>;  // Output: the run loop's
+
+// Runs a step's stages in order, each timed into its slot of `times`.
+template <class W>
+void run_stages(W& w, const StageTable<W>& table, StageTimes& times) {
+  using Clock = std::chrono::steady_clock;
+  for (const auto& [stage, run] : table) {
+    const auto t0 = Clock::now();
+    (w.*run)();
+    times[stage] += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+}
 
 }  // namespace cd
