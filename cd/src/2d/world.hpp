@@ -78,16 +78,6 @@ struct CellState {
   double strain = 0.0;               // integral of the shear rate
 };
 
-struct StepStats {
-  SolveStats solve;
-  int contacts = 0;        // rows handed to the solver
-  int active = 0;          // rows carrying a force (p_n + a > 0)
-  double max_overlap = 0;  // max over contacts of -gap / d_ref (midpoint configuration)
-  double mean_overlap = 0; // mean of -gap / d_ref over overlapping contacts
-  double max_overlap_small = 0;  // max over contacts of -gap / (the smaller grain's diameter)
-  double correction_work = 0;  // sum of p_n x bias velocity of the overlap correction (J)
-};
-
 class World {
  public:
   explicit World(const WorldParams& p) : prm_(p) { configure(); }

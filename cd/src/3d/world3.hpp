@@ -40,15 +40,6 @@ struct WorldParams3 {
   SolverParams solver;
 };
 
-struct StepStats3 {
-  SolveStats solve;
-  int contacts = 0;        // rows handed to the solver
-  int active = 0;          // rows carrying a force (r_n + a > 0)
-  double max_overlap = 0;  // max over contacts of -gap / d_ref (midpoint configuration)
-  double mean_overlap = 0; // mean of -gap / d_ref over overlapping contacts
-  double correction_work = 0;  // sum of r_n x bias velocity of the overlap correction (J)
-};
-
 class World3 {
  public:
   explicit World3(const WorldParams3& p) : prm_(p) { configure(); }
@@ -65,7 +56,7 @@ class World3 {
   }
 
   void step();
-  const StepStats3& last() const { return last_; }
+  const StepStats& last() const { return last_; }
   // The last step's rows (solved) and their records, in colour order.
   const std::vector<SphereRow>& rows() const { return rows_; }
   const std::vector<ContactInfo3>& infos() const { return info_; }
@@ -98,7 +89,7 @@ class World3 {
   bool gravity_on_ = false, adhesion_on_ = false;
   double alert_ = 0.0;
   SolveFn solve_fn_ = nullptr;
-  StepStats3 last_;
+  StepStats last_;
   std::vector<Vec3> xm_;
   std::vector<Quat> qm_;
   std::vector<SphereRow> rows_;

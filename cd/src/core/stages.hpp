@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <utility>
 
+#include "solver.hpp"
+
 namespace cd {
 
 // The stages of a step, in the order they run, and `output` (timed by the
@@ -21,6 +23,17 @@ struct StageTimes {  // wall-clock seconds, accumulated, per stage
   std::array<double, kStages> t{};
   double& operator[](Stage s) { return t[static_cast<int>(s)]; }
   double operator[](Stage s) const { return t[static_cast<int>(s)]; }
+};
+
+// What one step reports, in 2D and 3D (max_overlap_small: 2D only so far).
+struct StepStats {
+  SolveStats solve;
+  int contacts = 0;        // rows handed to the solver
+  int active = 0;          // rows carrying a force (p_n + a > 0)
+  double max_overlap = 0;  // max over contacts of -gap / d_ref (midpoint configuration)
+  double mean_overlap = 0; // mean of -gap / d_ref over overlapping contacts
+  double max_overlap_small = 0;  // max over contacts of -gap / (the smaller grain's diameter)
+  double correction_work = 0;  // sum of p_n x bias velocity of the overlap correction (J)
 };
 
 // The stages of a world's step W, in order, each a member function.
