@@ -133,7 +133,14 @@ COHESIVE_I ?= 0.01 0.1
 COHESIVE_TOL ?= 1e-3
 ANGULAR_NS ?= 0 3 4 5 6 8 10 20 60
 ANGULAR_I ?= 0.01
-CDSIM := $(BUILD)/cd/cdsim
+# Threads of each cdsim run: `make -jJ` runs J at once, so each gets nproc/J
+# threads (at least 1; plain -j: 1); THREADS=n overrides. More threads than
+# free cores make the solver's spinning barriers slow every run many-fold
+# (28x measured: docs/accuracy.md, Performance); results do not depend on it.
+NPROC := $(shell nproc)
+run_jobs = $(if $(filter -j,$(MAKEFLAGS)),$(NPROC),$(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),1))
+run_threads = $(or $(THREADS),$(shell echo $$(( $(NPROC) / $(run_jobs) > 1 ? $(NPROC) / $(run_jobs) : 1 ))))
+CDSIM = OMP_NUM_THREADS=$(run_threads) $(BUILD)/cd/cdsim
 # The size law of the samples (docs/scenes.md): d_max/d_min and the
 # distribution (uniform_area: equal area per size class, the seeds' choice;
 # uniform: uniform in d). The preparation's cell is sized by cdsim from the

@@ -9,12 +9,15 @@
 #include <omp.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "config.hpp"
+#include "load.hpp"
+#include "parallel.hpp"
 #include "output.hpp"
 #include "run.hpp"
 #include "setup.hpp"
@@ -67,6 +70,13 @@ int main(int argc, char** argv) {
     cd::World world = cd::build_world(scene);
     cd::check_output_dir(out);
     if (scene.threads > 0) omp_set_num_threads(scene.threads);
+    const char* wait = std::getenv("OMP_WAIT_POLICY");
+    const bool sleeps = wait && (std::string(wait) == "passive" || std::string(wait) == "PASSIVE");
+    if (const auto l = cd::load_average();
+        !l.empty() && !sleeps && world.bodies.size() >= std::size_t(cd::kMinParallelBodies)) {
+      const std::string w = cd::oversubscription_warning(omp_get_max_threads(), l[0], omp_get_num_procs());
+      if (!w.empty()) fmt::print(stderr, "cdsim: warning: {}\n", w);
+    }
 
     cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps, max_steps};
     cd::install_stop_handlers();

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "checkpoint.hpp"
+#include "load.hpp"
 #include "output.hpp"
 #include "problem.hpp"
 #include "setup.hpp"
@@ -31,14 +32,6 @@ double cpu_seconds() {
   getrusage(RUSAGE_SELF, &u);
   return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
          1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-// The 1, 5 and 15 minute load averages; empty when /proc/loadavg is unreadable.
-std::vector<double> load_average() {
-  std::ifstream f("/proc/loadavg");
-  double a, b, c;
-  if (f >> a >> b >> c) return {a, b, c};
-  return {};
 }
 
 // A TOML float: shortest text that reads back exactly, with a '.' or exponent.
