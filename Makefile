@@ -14,7 +14,7 @@ DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libbenchmark-dev gnuplot-nox libfclib-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build run test bench regress accuracy-cost tensile clean help analyze-inertial analyze-inertial-ladder analyze-cohesive analyze-angularity scene-doc figures frozen-shear
+.PHONY: all deps build run test bench regress accuracy-cost accuracy-shear tensile clean help analyze-inertial analyze-inertial-ladder analyze-cohesive analyze-angularity scene-doc figures frozen-shear
 
 all: build
 
@@ -23,6 +23,7 @@ help:
 	@echo "make test           build and run the test suite (ctest)"
 	@echo "make bench          build and run the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv)"
 	@echo "make accuracy-cost  eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s)"
+	@echo "make accuracy-shear solver settings against steady mu*, phi, z and cost in shear (outputs/accuracy-shear/; hours)"
 	@echo "make tensile        tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
 	@echo "make deps           install the missing Debian packages (idempotent)"
 	@echo "make scene-doc      regenerate docs/scene-parameters.md from cdsim --help-scene (test_help_scene checks it)"
@@ -280,6 +281,43 @@ $(CAMPAIGNS)/frozen/ns_%/I_0.01/.done: $(CAMPAIGNS)/prep/ns_%/.done
 $(CAMPAIGNS)/frozen/ns_%/I_0.001/.done: $(CAMPAIGNS)/prep/ns_%/.done
 	$(call frozen_run,0.001,$(FS_QS_STRAIN),$(CAMPAIGNS)/prep/ns_$*/checkpoint.bin)
 	touch $@
+
+# ---- Accuracy against cost in steady shear (issue 14, item 1) ----------------
+# The campaign protocol (one compacted sample per shape, then shear at imposed
+# p and I) run under several solver settings from the same sample, and a
+# table of what each setting gives (steady mu* = q/p, packing fraction, z,
+# with their error bars) and costs (wall and CPU time, sweeps per step, share
+# of steps at the cap), each against the tightest setting of its (shape, I):
+# cd/bench/accuracy_shear.sh writes $(ACC)/table.csv and table.md. Settings:
+#   tol_<t>     solver.tol = t (the rms |dp|/mean|p| test), cap 2000
+#   rt_<r>      solver.tol = 1e-4 and solver.residual_tol = r, cap 2000
+#   ref         solver.tol = ACC_REF_TOL, cap ACC_REF_CAP (the reference)
+# Defaults are the affordable study (disks, N = 500, I = 1e-2 and 1e-1);
+# ACC_N=1000 ACC_SHAPES="0 6" ACC_I="0.001 0.01 0.1" is the full one (days).
+ACC_N ?= 500
+ACC_SHAPES ?= 0
+ACC_I ?= 0.01 0.1
+ACC_TOLS ?= 1e-2 1e-3 1e-4
+ACC_RTOLS ?= 3e-3
+ACC_REF_TOL ?= 1e-5
+ACC_REF_CAP ?= 10000
+ACC_STRAIN ?= 3
+ACC ?= outputs/accuracy-shear/N_$(ACC_N)
+acc_settings := $(addprefix tol_,$(ACC_TOLS)) $(addprefix rt_,$(ACC_RTOLS)) ref
+acc_runs := $(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(ACC)/ns_$(s)/I_$(i)/$(k))))
+acc_solver = $(if $(filter ref,$(1)),--set solver.tol=$(ACC_REF_TOL) --set solver.max_iter=$(ACC_REF_CAP),$(if \
+  $(filter tol_%,$(1)),--set solver.tol=$(patsubst tol_%,%,$(1)),--set solver.tol=1e-4 --set solver.residual_tol=$(patsubst rt_%,%,$(1))))
+.PHONY: accuracy-shear accuracy-shear-runs
+accuracy-shear: build
+	$(MAKE) --no-print-directory CAMPAIGNS=$(ACC) N=$(ACC_N) accuracy-shear-runs
+	cd/bench/accuracy_shear.sh $(CDA) $(ACC)
+accuracy-shear-runs: $(addsuffix /.done,$(acc_runs))
+define acc_rule
+$(ACC)/ns_$(1)/I_$(2)/$(3)/.done: $(ACC)/prep/ns_$(1)/.done
+	$$(call shear_run,$(2),$(1)) --set shear.strain=$(ACC_STRAIN) $$(call acc_solver,$(3))
+	touch $$@
+endef
+$(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(eval $(call acc_rule,$(s),$(i),$(k))))))
 
 # Campaign analyses: the report of outputs/campaigns/<name> (made by the
 # campaign-* targets) into outputs/analysis/<name>/, plus the campaign's fits.
