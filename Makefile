@@ -291,6 +291,8 @@ $(CAMPAIGNS)/frozen/ns_%/I_0.001/.done: $(CAMPAIGNS)/prep/ns_%/.done
 # cd/bench/accuracy_shear.sh writes $(ACC)/table.csv and table.md. Settings:
 #   tol_<t>     solver.tol = t (the rms |dp|/mean|p| test), cap 2000
 #   rt_<r>      solver.tol = 1e-4 and solver.residual_tol = r, cap 2000
+#   cap_<n>     solver.tol = 1e-4, cap n
+#   dtx_<f>     solver.tol = 1e-4, cap 2000, the campaign's time step times f
 #   ref         solver.tol = ACC_REF_TOL, cap ACC_REF_CAP (the reference)
 # Defaults are the affordable study (disks, N = 500, I = 1e-2 and 1e-1);
 # ACC_N=1000 ACC_SHAPES="0 6" ACC_I="0.001 0.01 0.1" is the full one (days).
@@ -299,14 +301,22 @@ ACC_SHAPES ?= 0
 ACC_I ?= 0.01 0.1
 ACC_TOLS ?= 1e-2 1e-3 1e-4
 ACC_RTOLS ?= 3e-3
+ACC_CAPS ?= 500
+ACC_DTX ?= 0.5 2
 ACC_REF_TOL ?= 1e-5
 ACC_REF_CAP ?= 10000
 ACC_STRAIN ?= 3
 ACC ?= outputs/accuracy-shear/N_$(ACC_N)
-acc_settings := $(addprefix tol_,$(ACC_TOLS)) $(addprefix rt_,$(ACC_RTOLS)) ref
+acc_settings := $(addprefix tol_,$(ACC_TOLS)) $(addprefix rt_,$(ACC_RTOLS)) $(addprefix cap_,$(ACC_CAPS)) \
+  $(addprefix dtx_,$(ACC_DTX)) ref
 acc_runs := $(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(ACC)/ns_$(s)/I_$(i)/$(k))))
-acc_solver = $(if $(filter ref,$(1)),--set solver.tol=$(ACC_REF_TOL) --set solver.max_iter=$(ACC_REF_CAP),$(if \
-  $(filter tol_%,$(1)),--set solver.tol=$(patsubst tol_%,%,$(1)),--set solver.tol=1e-4 --set solver.residual_tol=$(patsubst rt_%,%,$(1))))
+acc_solver = $(strip \
+  $(if $(filter ref,$(2)),--set solver.tol=$(ACC_REF_TOL) --set solver.max_iter=$(ACC_REF_CAP)) \
+  $(if $(filter tol_%,$(2)),--set solver.tol=$(patsubst tol_%,%,$(2))) \
+  $(if $(filter rt_%,$(2)),--set solver.tol=1e-4 --set solver.residual_tol=$(patsubst rt_%,%,$(2))) \
+  $(if $(filter cap_%,$(2)),--set solver.tol=1e-4 --set solver.max_iter=$(patsubst cap_%,%,$(2))) \
+  $(if $(filter dtx_%,$(2)),--set solver.tol=1e-4 \
+    --set shear.dt_tp=$(shell awk 'BEGIN { printf "%.4g", $(patsubst dtx_%,%,$(2)) * $(call dt_tp,$(1)) }')))
 .PHONY: accuracy-shear accuracy-shear-runs
 accuracy-shear: build
 	$(MAKE) --no-print-directory CAMPAIGNS=$(ACC) N=$(ACC_N) accuracy-shear-runs
@@ -314,7 +324,7 @@ accuracy-shear: build
 accuracy-shear-runs: $(addsuffix /.done,$(acc_runs))
 define acc_rule
 $(ACC)/ns_$(1)/I_$(2)/$(3)/.done: $(ACC)/prep/ns_$(1)/.done
-	$$(call shear_run,$(2),$(1)) --set shear.strain=$(ACC_STRAIN) $$(call acc_solver,$(3))
+	$$(call shear_run,$(2),$(1)) --set shear.strain=$(ACC_STRAIN) $$(call acc_solver,$(2),$(3))
 	touch $$@
 endef
 $(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(eval $(call acc_rule,$(s),$(i),$(k))))))
