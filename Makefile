@@ -112,6 +112,7 @@ bench: build
 
 accuracy-cost: build
 	$(BUILD)/cd/bench/accuracy_cost --out outputs/accuracy-cost $(if $(QUICK),--quick)
+	$(BUILD)/cd/bench/accuracy_cost3 --out outputs/accuracy-cost/3d $(if $(QUICK),--quick)
 
 # Cohesion against the time step (docs/accuracy.md, "Cohesion and the time step").
 tensile: build
