@@ -21,8 +21,10 @@ all: build
 help:
 	@echo "make run            build and run the default scene into $(OUT)/"
 	@echo "make test           build and run the test suite (ctest)"
-	@echo "make bench          build and run the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv)"
-	@echo "make accuracy-cost  eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s)"
+	@echo "make bench          build and run the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv;"
+	@echo "                    3D: outputs/bench/3d/, N = 1e3-1e4, BIG=1: to 1e5)"
+	@echo "make accuracy-cost  eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s);"
+	@echo "                    3D: polyhedral-cone Lemke against e and the exact NLGS (outputs/accuracy-cost/3d/)"
 	@echo "make accuracy-shear solver settings against steady mu*, phi, z and cost in shear (outputs/accuracy-shear/; hours)"
 	@echo "make tensile        tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
 	@echo "make deps           install the missing Debian packages (idempotent)"
@@ -108,9 +110,11 @@ bench: build
 	mkdir -p outputs/bench
 	@awk -v n=$$(nproc) '$$1 > n / 2 { printf "make bench: load average %s on %d cores: times, above all the 2-thread ones, will be noisy\n", $$1, n }' /proc/loadavg
 	$(BUILD)/cd/bench/cdbench --benchmark_out=outputs/bench/bench.json --benchmark_out_format=json --csv_dir=outputs/bench
+	$(BUILD)/cd/bench/cdbench3 --out outputs/bench/3d $(if $(BIG),--big)
 
 accuracy-cost: build
 	$(BUILD)/cd/bench/accuracy_cost --out outputs/accuracy-cost $(if $(QUICK),--quick)
+	$(BUILD)/cd/bench/accuracy_cost3 --out outputs/accuracy-cost/3d $(if $(QUICK),--quick)
 
 # Cohesion against the time step (docs/accuracy.md, "Cohesion and the time step").
 tensile: build

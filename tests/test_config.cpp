@@ -35,19 +35,19 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 }
 
 void compare(const Scene& x, const Scene& y, bool same) {
-  const auto& [name, source, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, adhesion, debond, tol,
+  const auto& [name, source, dimension, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, adhesion, debond, tol,
                max_iter, residual_tol, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
-               box_width, box_height, disks, walls, series_interval, snapshot_interval,
+               box_width, box_height, box_depth, disks, walls, series_interval, snapshot_interval,
                checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, pressure,
                inertial_number, cell_mass, isotropic, strain, dt_tp, start, cohesion_number] = x;
   (void)source;  // not a parameter: the file the scene was read from
-  CHECK_FIELD(name); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
+  CHECK_FIELD(name); CHECK_FIELD(dimension); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
   CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(adhesion); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(threads);
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
   CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
-  CHECK_FIELD(box_height); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
+  CHECK_FIELD(box_height); CHECK_FIELD(box_depth); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
   CHECK_FIELD(checkpoint_interval); CHECK_FIELD(checkpoint_strain); CHECK_FIELD(checkpoint_wall);
   CHECK_FIELD(quiet);
   CHECK_FIELD(shear_mode); CHECK_FIELD(cell_width); CHECK_FIELD(cell_height); CHECK_FIELD(pressure);
@@ -65,9 +65,10 @@ void compare(const Scene& x, const Scene& y, bool same) {
 Scene nondefault() {
   Scene s;
   s.name = "silo \"A\"\\1 é";
+  s.dimension = 3;  // the parser reads 3D keys into the same Scene; build_world3 checks the rest
   s.dt = 2.5e-5;
   s.duration = 1.0 / 3.0;
-  s.gravity = {0.1, -9.80665};
+  s.gravity = {0.1, -9.80665, 0.5};
   s.mu = 0.3;
   s.mu_wall = 0.7;
   s.e_n = 0.2;
@@ -95,6 +96,7 @@ Scene nondefault() {
   s.region = {0.0, 0.01, 0.1, 0.2};
   s.box_width = 0.1;
   s.box_height = 0.2;
+  s.box_depth = 0.3;
   s.series_interval = 1e-3;
   s.snapshot_interval = 0.0;
   s.checkpoint_interval = 0.05;
@@ -150,7 +152,7 @@ TEST(FullFile, EveryKeyIsReadAndDiffersFromItsDefault) {
 TEST(FullFile, IntegersAreAcceptedForFloats) {
   const Scene s = cd::parse_scene("[time]\ndt = 1\n[gravity]\ng = [0, -10]\n", "x.toml");
   EXPECT_EQ(s.dt, 1.0);
-  EXPECT_EQ(s.gravity, (std::array<double, 2>{0.0, -10.0}));
+  EXPECT_EQ(s.gravity, (std::vector<double>{0.0, -10.0}));
 }
 
 TEST(Errors, UnknownKeyNamesLineColumnAndClosestKey) {
@@ -184,7 +186,13 @@ TEST(Errors, WrongType) {
   EXPECT_EQ(error("[contact]\nrotation = 1\n"),
             "x.toml:2:1: contact.rotation: expected true or false, got an integer");
   EXPECT_EQ(error("[gravity]\ng = [0, -9.81, 0]\n"),
-            "x.toml:2:1: gravity.g: expected an array of 2 numbers, got an array of 3");
+            "x.toml:2:1: gravity.g = [0, -9.81, 0]: a dimension = 2 scene needs 2 components ([gx, gy])");
+  EXPECT_EQ(error("dimension = 3\n[gravity]\ng = [0, -9.81]\n"),
+            "x.toml:3:1: gravity.g = [0, -9.81]: a dimension = 3 scene needs 3 components ([gx, gy, gz], z up)");
+  EXPECT_EQ(error("[gravity]\ng = [0, -9.81, 0, 1]\n"),
+            "x.toml:2:1: gravity.g = [0, -9.81, 0, 1]: must be a list of 2 or 3 numbers");
+  EXPECT_EQ(error("[box]\ndepth = 0.1\n"),
+            "x.toml:2:1: box.depth = 0.1: only a dimension = 3 scene has a depth");
   EXPECT_EQ(error("[gravity]\ng = [0, \"down\"]\n"),
             "x.toml:2:1: gravity.g: expected an array of numbers, got an array containing a string");
   EXPECT_EQ(error("name = 3\n"), "x.toml:1:1: name: expected a string, got an integer");
@@ -309,7 +317,7 @@ TEST(Overrides, AreAppliedAfterTheFile) {
                                    "particles.size_dist = uniform", "solver.max_iter=7",
                                    "output.quiet=true", "time.dt=1e-5", "time.dt=2e-5"});
   EXPECT_EQ(s.mu, 0.3);
-  EXPECT_EQ(s.gravity, (std::array<double, 2>{0.0, -1.0}));
+  EXPECT_EQ(s.gravity, (std::vector<double>{0.0, -1.0}));
   EXPECT_EQ(s.name, "x y");
   EXPECT_EQ(s.size_dist, "uniform");  // a bare word (the shell ate the quotes) is a string
   EXPECT_EQ(s.max_iter, 7);
@@ -335,7 +343,7 @@ TEST(Overrides, UnknownKeyOrBadValueIsAnError) {
 
 TEST(Resolved, RoundTripsANonDefaultSceneExactly) {
   Scene s = nondefault();
-  s.gravity = {0.1 + 0.2, -1e-300};  // doubles that need 17 digits or an exponent
+  s.gravity = {0.1 + 0.2, -1e-300, 1e300};  // doubles that need 17 digits or an exponent
   s.disks[0].pos = {1.7976931348623157e308, 4.9406564584124654e-324};
   s.disks[1].vel = {-0.0, 2.0 / 3.0};
   s.walls[1].omega = 1e22;
@@ -365,7 +373,7 @@ TEST(Markdown, OneRowPerParameter) {
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
   // 46 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 46u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 48u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

@@ -1,6 +1,6 @@
 // 3D snapshots (cd/src/3d/output3.cpp): one point per dynamic sphere with
-// radius, velocity, omega and orientation, read back through VTK; and the
-// pile3d scene's layout (cd/src/3d/pile3d.hpp).
+// radius, velocity, omega and orientation, read back through VTK; the
+// pile3d scene's layout (cd/src/3d/pile3d.hpp); cdsim's 3D outputs.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -65,18 +65,23 @@ TEST(Output3, Pile3dLayout) {
   EXPECT_LE(rmax, 0.005);
 }
 
-// cdsim3 runs a small pile3d and writes its series and snapshots.
-TEST(Cdsim3, SmallPileWritesSeriesAndSnapshots) {
-  const auto dir = std::filesystem::temp_directory_path() / "cdlab_cdsim3";
+// cdsim runs a small pile3d scene (configs/pile3d.toml, dimension = 3) and
+// writes its series and snapshots (spheres and contacts, with .pvd).
+TEST(Output3, CdsimSmallPileWritesSeriesAndSnapshots) {
+  const auto dir = std::filesystem::temp_directory_path() / "cdlab_cdsim_3d";
   std::filesystem::remove_all(dir);
-  const std::string cmd = std::string(CDLAB_BINARY_DIR "/cd/cdsim3") +
-                          " --n 27 --time 0.05 --threads 1 --vtk-every 25 --out " + dir.string() +
-                          " > " + (dir.string() + ".log") + " 2>&1";
+  const std::string cmd = std::string(CDLAB_BINARY_DIR "/cd/cdsim ") + CDLAB_SOURCE_DIR +
+                          "/configs/pile3d.toml --set particles.n=27 --set time.duration=0.05 "
+                          "--set output.snapshot_interval=0.025 --threads 1 --quiet --out " +
+                          dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   EXPECT_TRUE(std::filesystem::exists(dir / "series.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir / "spheres_00000.vtp"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "contacts_00000.vtp"));
   EXPECT_TRUE(std::filesystem::exists(dir / "spheres_00002.vtp"));  // steps 25 and 50
   EXPECT_FALSE(std::filesystem::exists(dir / "spheres_00003.vtp"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "spheres.pvd"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "contacts.pvd"));
   std::filesystem::remove_all(dir);
   std::filesystem::remove(dir.string() + ".log");
 }

@@ -1,4 +1,4 @@
-// cdsim: runs a scene.
+// cdsim: runs a scene, 2D (disks, polygons) or 3D (spheres; `dimension = 3`).
 //   cdsim SCENE.toml [--set section.key=value]... [--out DIR] [--threads N] [--quiet] [--fresh]
 //         [--dump-problem STEP]...
 // Everything is checked (scene, particles, output folder) before anything is
@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -20,10 +21,12 @@
 #include "parallel.hpp"
 #include "output.hpp"
 #include "run.hpp"
+#include "run3.hpp"
 #include "setup.hpp"
+#include "setup3.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"cdsim: contact dynamics (Moreau-Jean) simulator for rigid 2D grains"};
+  CLI::App app{"cdsim: contact dynamics (Moreau-Jean) simulator for rigid grains, 2D or 3D (dimension = 3)"};
   std::string scene_path, out;
   std::vector<std::string> sets;
   int threads = -1;
@@ -67,20 +70,28 @@ int main(int argc, char** argv) {
     if (quiet) scene.quiet = true;
     if (threads >= 0) scene.threads = threads;
     if (out.empty()) out = "outputs/" + scene.name;
-    cd::World world = cd::build_world(scene);
+    const bool three = scene.dimension == 3;
+    if (three && !dump_steps.empty())
+      throw cd::SceneError("--dump-problem writes 2D contact problems; this scene has dimension = 3");
+    // Everything is built and checked before anything is written.
+    std::optional<cd::World> world;
+    std::optional<cd::World3> world3;
+    if (three) world3.emplace(cd::build_world3(scene));
+    else world.emplace(cd::build_world(scene));
     cd::check_output_dir(out);
     if (scene.threads > 0) omp_set_num_threads(scene.threads);
     const char* wait = std::getenv("OMP_WAIT_POLICY");
     const bool sleeps = wait && (std::string(wait) == "passive" || std::string(wait) == "PASSIVE");
     if (const auto l = cd::load_average();
-        !l.empty() && !sleeps && world.bodies.size() >= std::size_t(cd::kMinParallelBodies)) {
+        !l.empty() && !sleeps &&
+        (three ? world3->bodies.size() : world->bodies.size()) >= std::size_t(cd::kMinParallelBodies)) {
       const std::string w = cd::oversubscription_warning(omp_get_max_threads(), l[0], omp_get_num_procs());
       if (!w.empty()) fmt::print(stderr, "cdsim: warning: {}\n", w);
     }
 
     cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps, max_steps};
     cd::install_stop_handlers();
-    const cd::RunSummary s = cd::run(world, scene, opt);
+    const cd::RunSummary s = three ? cd::run3(*world3, scene, opt) : cd::run(*world, scene, opt);
     if (s.first_step > 0)
       fmt::print("cdsim: resumed from {}/checkpoint.bin at step {} of {}\n", out, s.first_step,
                  s.total_steps);

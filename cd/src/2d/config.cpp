@@ -45,6 +45,12 @@ Rule in_open_closed(double lo, double hi) {
   return {fmt::format("in ({}, {}]", lo, hi),
           [=](const Val& v) { return num(v) > lo && num(v) <= hi; }};
 }
+Rule vector_of(std::size_t a, std::size_t b) {
+  return {fmt::format("a list of {} or {} numbers", a, b), [=](const Val& v) {
+            const auto n = std::get<std::vector<double>>(v).size();
+            return n == a || n == b;
+          }};
+}
 Rule non_empty() {
   return {"non-empty", [](const Val& v) { return !std::get<std::string>(v).empty(); }};
 }
@@ -103,9 +109,10 @@ struct Param {
 const std::vector<Param<Scene>>& scene_params() {
   static const std::vector<Param<Scene>> t = {
       {"", "name", &Scene::name, "", non_empty(), "run name (output folder outputs/<name> unless --out)"},
+      {"", "dimension", &Scene::dimension, "", in(2, 3), "2: disks and polygons in the plane; 3: spheres in a box of plane walls (docs/3d.md: which keys apply)"},
       {"time", "dt", &Scene::dt, "s", gt(0), "time step"},
       {"time", "duration", &Scene::duration, "s", ge(0), "simulated time"},
-      {"gravity", "g", &Scene::gravity, "m/s^2", any(), "gravity vector [gx, gy]"},
+      {"gravity", "g", &Scene::gravity, "m/s^2", vector_of(2, 3), "gravity vector: [gx, gy] in 2D, [gx, gy, gz] in 3D (z up)"},
       {"contact", "mu", &Scene::mu, "", ge(0), "particle-particle friction coefficient"},
       {"contact", "mu_wall", &Scene::mu_wall, "", any(), "particle-wall friction coefficient; < 0: same as mu"},
       {"contact", "e_n", &Scene::e_n, "", in(0, 1), "normal restitution coefficient"},
@@ -126,12 +133,13 @@ const std::vector<Param<Scene>>& scene_params() {
       {"particles", "size_dist", &Scene::size_dist, "", size_dist(), "diameter distribution: uniform in d, or uniform_area (equal area per size class)"},
       {"particles", "diameters", &Scene::diameters, "m", positive_list(), "explicit diameters of the generated particles, placed in an order shuffled by particles.seed; particles.n is then their count (0 or that count), and d_mean, size_ratio, size_dist are not used; []: draw them from the size law"},
       {"particles", "diameters_file", &Scene::diameters_file, "", any(), "a text file of diameters (m; whitespace-separated, # comments; relative to the scene file's folder) read into particles.diameters; \"\": none"},
-      {"particles", "density", &Scene::density, "kg/m^2", gt(0), "mass per unit area (2600 kg/m^3 x 1 mm = 2.6)"},
+      {"particles", "density", &Scene::density, "kg/m^2 (2D), kg/m^3 (3D)", gt(0), "2D: mass per unit area (2600 kg/m^3 x 1 mm = 2.6); 3D: mass per unit volume (2600 for glass)"},
       {"particles", "seed", &Scene::seed, "", any(), "random seed of sizes and positions"},
       {"particles", "nsides", &Scene::nsides, "", side_list(), "shapes of the generated particles, drawn uniformly from the list: 0 disk, n >= 3 regular n-gon (sizes are then circumscribed diameters)"},
       {"particles", "region", &Scene::region, "m", region(), "generation region [xmin, ymin, xmax, ymax]; []: inside the box"},
       {"box", "width", &Scene::box_width, "m", ge(0), "box of four static walls [0, width] x [0, height]; width and height both 0 (no box) or both > 0"},
-      {"box", "height", &Scene::box_height, "m", ge(0), "box height"},
+      {"box", "height", &Scene::box_height, "m", ge(0), "box height; 3D: must be 0 (the box is open at the top)"},
+      {"box", "depth", &Scene::box_depth, "m", ge(0), "3D only: the box is [0, width] x [0, depth] with a floor at z = 0 and four side walls; width and depth both 0: the square that holds the lattice of generated spheres (docs/3d.md)"},
       {"output", "series_interval", &Scene::series_interval, "s", gt(0), "time between rows of series.csv"},
       {"output", "snapshot_interval", &Scene::snapshot_interval, "s", ge(0), "time between VTK snapshots; 0: none"},
       {"output", "checkpoint_interval", &Scene::checkpoint_interval, "s", ge(0), "simulated time between checkpoints (checkpoint.bin: rerunning the same command resumes), rounded up to whole series intervals; 0: none. Any of the three checkpoint keys writes one (and one at the end)"},
@@ -478,7 +486,16 @@ Scene read_scene(const toml::value& root, const std::string& path) {
   }
 
   // Rules that involve two keys.
-  if ((s.box_width > 0) != (s.box_height > 0))
+  if (s.gravity.size() != static_cast<std::size_t>(s.dimension))
+    out.add(child(child(root, "gravity"), "g"), "g",
+            fmt::format("gravity.g = {}: a dimension = {} scene needs {} components ({})",
+                        text(s.gravity, false), s.dimension, s.dimension,
+                        s.dimension == 3 ? "[gx, gy, gz], z up" : "[gx, gy]"));
+  if (s.dimension == 2 && s.box_depth > 0)
+    out.add(child(child(root, "box"), "depth"), "depth",
+            fmt::format("box.depth = {}: only a dimension = 3 scene has a depth",
+                        text(s.box_depth, false)));
+  if (s.dimension == 2 && (s.box_width > 0) != (s.box_height > 0))
     out.add(child(root, "box"), "box",
             fmt::format("box.width = {}, box.height = {}: must be both 0 (no box) or both > 0",
                         text(s.box_width, false), text(s.box_height, false)));

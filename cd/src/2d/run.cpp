@@ -1,50 +1,19 @@
 #include "run.hpp"
 
-#include <omp.h>
-#include <sys/resource.h>
-#include <unistd.h>
-
-#include <chrono>
-#include <csignal>
+#include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include <fmt/format.h>
 
 #include "checkpoint.hpp"
-#include "load.hpp"
 #include "output.hpp"
 #include "problem.hpp"
 #include "setup.hpp"
-#include "version.hpp"
 
 namespace cd {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-// CPU time of the process, user + system (s): every thread's.
-double cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-// A TOML float: shortest text that reads back exactly, with a '.' or exponent.
-std::string toml_float(double x) {
-  if (std::isnan(x)) return "nan";
-  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  std::string t = fmt::format("{}", x);
-  if (t.find_first_of(".e") == std::string::npos) t += ".0";
-  return t;
-}
-
-volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_stop(int sig) { g_stop = sig; }
 
 // The watchdog: the first non-finite quantity of the state a step left, or
 // "". O(bodies + contacts), a few per cent of a step's detection.
@@ -69,47 +38,6 @@ std::string non_finite(const World& w) {
                          c.height, c.offset, c.wdot, c.hdot, c.strain);
   return "";
 }
-
-// Removes the files an earlier run wrote in the folder, so that a shorter
-// run does not leave stale snapshots behind.
-void clear_previous(const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  if (!fs::is_directory(dir)) return;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string f = e.path().filename().string();
-    const bool ours = f == "series.csv" || f == "scene.toml" || e.path().extension() == ".pvd" ||
-                      f.starts_with("checkpoint.bin") || f.starts_with("problem_") ||
-                    f.starts_with("summary.toml") ||
-                      (e.path().extension() == ".vtp" &&
-                       (f.starts_with("particles_") || f.starts_with("contacts_") ||
-                        f.starts_with("walls_") || f.starts_with("shapes_")));
-    if (ours) fs::remove(e.path());
-  }
-}
-
-// Accumulates step statistics over one series interval.
-struct Interval {
-  int steps = 0;
-  long iter_sum = 0;
-  int iter_max = 0;
-  int cap_hits = 0;
-  double res_max = 0, res_mean_sum = 0;
-  double ov_max = 0, ov_small = 0;
-  double corr_work = 0;
-  StageTimes t0;
-
-  void add(const StepStats& s) {
-    ++steps;
-    iter_sum += s.solve.iterations;
-    iter_max = std::max(iter_max, s.solve.iterations);
-    cap_hits += s.solve.cap_hit;
-    res_max = std::max(res_max, s.solve.residual_max);
-    res_mean_sum += s.solve.residual_mean;
-    ov_max = std::max(ov_max, s.max_overlap);
-    ov_small = std::max(ov_small, s.max_overlap_small);
-    corr_work += s.correction_work;
-  }
-};
 
 // Coordination of the last step's contacts, by obs::coordination (the
 // definitions are in observables.hpp): the particles are the dynamic bodies.
@@ -142,54 +70,121 @@ struct ShearInterval {
   }
 };
 
+// The 2D world as the run loop sees it: checkpoints, snapshots, the
+// --dump-problem files and the shear protocols' columns.
+class Engine2 final : public RunEngine {
+ public:
+  Engine2(World& w, const Scene& s, const RunOptions& opt)
+      : w_(w), s_(s), dir_(opt.out), dump_(opt.dump_steps), shear_(s.shear_mode != "none"),
+        d_mean_(mean_diameter(s)) {
+    // --dump-problem: the hook sees the problem of the step being taken
+    // (w.steps + 1) just before its solve.
+    if (!dump_.empty())
+      w_.set_problem_hook([this](const ContactProblem& p, const SolverParams& prm) {
+        const std::int64_t k = w_.steps + 1;
+        if (!dumped(k)) return;
+        const std::string stem = (dir_ / fmt::format("problem_{}", k)).string();
+        write_contact_problem(p, prm, stem + ".cdp");
+        const bool cohesive = std::any_of(p.rows.begin(), p.rows.end(),
+                                          [](const ContactRow& r) { return r.adh != 0.0; });
+        if (!cohesive) write_problem(to_matrix(p), stem + ".dat");
+      });
+  }
+
+  void step() override { w_.step(); }
+  const StepStats& last() const override { return w_.last(); }
+  std::int64_t steps() const override { return w_.steps; }
+  double time() const override { return w_.time; }
+  StageTimes& times() override { return w_.times; }
+  double kinetic_energy() const override { return w_.kinetic_energy(); }
+  std::string non_finite() const override { return cd::non_finite(w_); }
+  void save(const std::string& path, std::uint64_t key, const RunTotals& t) const override {
+    save_checkpoint(path, w_, key, t);
+  }
+  std::uint64_t load(const std::string& path, RunTotals* t) override {
+    return load_checkpoint(path, w_, t);
+  }
+  void open_snapshots(const std::string& dir, Frames frames) override {
+    snaps_ = frames.empty() ? Snapshots(dir) : Snapshots(dir, std::move(frames));
+  }
+  void write_snapshot() override { snaps_.write(w_); }
+
+  void start() override {
+    v_prev_ = w_.cell.width * w_.cell.height;
+    t_prev_ = w_.time;
+  }
+  void after_step(std::int64_t k) override {
+    if (dumped(k)) {
+      std::string text;
+      for (const ContactRow& r : w_.rows()) text += fmt::format("{:a} {:a}\n", r.pn, r.pt);
+      write_file_atomic((dir_ / fmt::format("problem_{}.impulses", k)).string(), text);
+    }
+    if (shear_) sh_.add(w_);
+  }
+  void add_columns(Columns& cols) override {
+    if (!shear_) return;
+    // Contact stress (mean over the interval's steps), compression
+    // positive; p = (s1 + s2)/2, q = (s1 - s2)/2 from the symmetric part.
+    const Eigen::Matrix2d S = sh_.sigma / sh_.steps;
+    const double sxx = S(0, 0), syy = S(1, 1), sxy = 0.5 * (S(0, 1) + S(1, 0));
+    const obs::Tensor<2> St = {{{S(0, 0), S(0, 1)}, {S(1, 0), S(1, 1)}}};
+    const double p = obs::mean_2d(St), q = obs::deviator_2d(St);
+    const double V = w_.cell.width * w_.cell.height;
+    const double gd = w_.shear_rate();
+    const obs::Coordination zc = coordination(w_);
+    const Eigen::Matrix2d K = w_.kinetic_stress();  // at the row's step
+    cols.insert(cols.end(), {{"strain", w_.cell.strain},
+                {"shear_rate", gd},
+                {"sxx", sxx},
+                {"sxy", S(0, 1)},
+                {"syx", S(1, 0)},
+                {"syy", syy},
+                {"p", p},
+                {"q", q},
+                {"q_over_p", p > 0 ? q / p : 0.0},
+                // tau / sigma_n, positive in the imposed sense (the
+                // top moves +x, so sigma_xy < 0 compression-positive)
+                {"shear_stress_ratio", syy > 0 ? -sxy / syy : 0.0},
+                // with the whole normal stress, the one the control imposes
+                {"inertial_number", syy + K(1, 1) > 0
+                                        ? gd * d_mean_ * std::sqrt(s_.density / (syy + K(1, 1)))
+                                        : 0.0},
+                {"packing_fraction", V > 0 ? packing_fraction(w_.bodies, V) : 0.0},
+                {"z", zc.z},
+                {"non_rattler", zc.non_rattler},
+                {"cell_width", w_.cell.width},
+                {"cell_height", w_.cell.height},
+                {"volume_strain_rate",
+                 w_.time > t_prev_ ? std::log(V / v_prev_) / (w_.time - t_prev_) : 0.0},
+                {"kxx", K(0, 0)},
+                {"kxy", K(0, 1)},
+                {"kyy", K(1, 1)}});
+    v_prev_ = V;
+    t_prev_ = w_.time;
+    sh_ = ShearInterval{};
+  }
+
+ private:
+  bool dumped(std::int64_t k) const { return std::find(dump_.begin(), dump_.end(), k) != dump_.end(); }
+
+  World& w_;
+  const Scene& s_;
+  std::filesystem::path dir_;
+  std::vector<std::int64_t> dump_;
+  bool shear_;
+  double d_mean_;
+  Snapshots snaps_{""};
+  ShearInterval sh_;
+  double v_prev_ = 0, t_prev_ = 0;
+};
+
 }  // namespace
 
-std::string summary_toml(const RunSummary& s) {
-  const RunTotals& t = s.totals;
-  const auto load = [](const std::vector<double>& l) {
-    std::string o = "[";
-    for (std::size_t i = 0; i < l.size(); ++i) o += (i ? ", " : "") + toml_float(l[i]);
-    return o + "]";
-  };
-  const auto line = [](const std::string& kv, const char* doc) {
-    return fmt::format("{:<32} # {}\n", kv, doc);
-  };
-  std::string o =
-      "# The cost of this run, over every session (cdsim call) that ran it: docs/outputs.md\n";
-  o += line(fmt::format("cdlab_version = \"{}\"", version()), "git describe of the build; \"unknown\" outside a clone");
-  o += line(fmt::format("status = \"{}\"", s.status), "done, stopped (signal), max-steps, diverged");
-  o += line(fmt::format("steps = {}", s.last_step), "the last step taken (series.csv's last row)");
-  o += line(fmt::format("total_steps = {}", s.total_steps), "the scene's steps");
-  o += line(fmt::format("sessions = {}", std::llround(t.sessions)), "cdsim calls that took steps (1 + resumes)");
-  o += line("wall_time = " + toml_float(t.wall), "s, in the run loop, summed over sessions up to the last checkpoint or the end");
-  o += line("cpu_time = " + toml_float(t.cpu), "s, user + system of every thread, likewise");
-  o += line(fmt::format("threads = {}", s.threads), "OpenMP threads of the last session");
-  o += line("load_start = " + load(s.load_start), "/proc/loadavg (1, 5, 15 min) when the last session started");
-  o += line("load_end = " + load(s.load_end), "and when it ended");
-  o += line("sweeps_mean = " + toml_float(s.last_step ? t.sweeps / double(s.last_step) : 0.0), "NLGS sweeps per step, mean over the steps");
-  o += line(fmt::format("sweeps_max = {}", std::llround(t.sweeps_max)), "most sweeps of one step");
-  o += line(fmt::format("cap_steps = {}", std::llround(t.cap_steps)), "steps stopped at solver.max_iter");
-  o += line("cap_share = " + toml_float(s.cap_share()), "cap_steps / steps");
-  o += line("residual_final = " + toml_float(t.residual_last), "law residual of the last step");
-  o += line("residual_max = " + toml_float(t.residual_max), "largest law residual of any step");
-  o += line("overlap_max = " + toml_float(t.overlap_max), "largest overlap, in mean diameters");
-  return o;
-}
-
-void install_stop_handlers() {
-  std::signal(SIGINT, on_stop);
-  std::signal(SIGTERM, on_stop);
-}
-
-RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
-  namespace fs = std::filesystem;
-  const fs::path dir(opt.out);
-  const std::string ckpt = (dir / "checkpoint.bin").string();
-  const std::string series_path = (dir / "series.csv").string();
-  const double dt = w.params().dt;
-  const std::int64_t nsteps = std::llround(run_duration(s) / dt);
-  const bool shear = s.shear_mode != "none";
-  const double d_mean = mean_diameter(s);
+RunPlan plan_of(const Scene& s, double dt) {
+  RunPlan p;
+  p.dt = dt;
+  p.nsteps = std::llround(run_duration(s) / dt);
+  const std::int64_t nsteps = p.nsteps;
   // An interval in steps, >= 1; one longer than the run is the run (no
   // overflow for huge intervals).
   const auto steps_of = [&](double interval) {
@@ -197,272 +192,30 @@ RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
     return k >= double(nsteps) ? std::max<std::int64_t>(1, nsteps)
                                : std::max<std::int64_t>(1, std::llround(k));
   };
-  const std::int64_t every_row = steps_of(s.series_interval);
-  const std::int64_t every_snap = s.snapshot_interval > 0 ? steps_of(s.snapshot_interval) : 0;
+  p.every_row = steps_of(s.series_interval);
+  p.every_snap = s.snapshot_interval > 0 ? steps_of(s.snapshot_interval) : 0;
   // Checkpoints fall on series rows, so that no row's interval spans a
   // restart: every so much simulated time, or shear strain, rounded up to
   // whole rows; or at the first row after checkpoint_wall seconds of wall
   // clock. Writing one only reads the state, so when they fall (even by the
   // clock) changes no result.
   const auto on_rows = [&](std::int64_t k) {
-    return every_row * std::max<std::int64_t>(1, (k + every_row - 1) / every_row);
+    return p.every_row * std::max<std::int64_t>(1, (k + p.every_row - 1) / p.every_row);
   };
-  const std::int64_t every_ckpt = s.checkpoint_interval > 0 ? on_rows(steps_of(s.checkpoint_interval)) : 0;
+  p.every_ckpt = s.checkpoint_interval > 0 ? on_rows(steps_of(s.checkpoint_interval)) : 0;
   const double rate = shear_rate(s);
-  const std::int64_t every_ckpt_strain =
+  p.every_ckpt_strain =
       s.checkpoint_strain > 0 && rate > 0 ? on_rows(steps_of(s.checkpoint_strain / rate)) : 0;
-  const double ckpt_wall = s.checkpoint_wall;
-  const bool checkpoints = every_ckpt || every_ckpt_strain || ckpt_wall > 0;
-  const bool progress = !opt.quiet && isatty(STDERR_FILENO);
+  p.ckpt_wall = s.checkpoint_wall;
+  p.checkpoint_interval = s.checkpoint_interval;
+  p.checkpoint_strain = s.checkpoint_strain;
+  p.key = scene_key(s);
+  return p;
+}
 
-  // Resume from a checkpoint of this scene; checked before anything is written.
-  const std::uint64_t key = scene_key(s);
-  const bool resume = !opt.fresh && fs::exists(ckpt);
-  std::vector<std::string> columns;  // of series.csv, cut back to the checkpoint
-  RunTotals tot;                     // the run's cost so far (summary.toml)
-  if (resume) {
-    try {
-      if (load_checkpoint(ckpt, w, &tot) != key || w.steps > nsteps)
-        throw CheckpointError(fmt::format("checkpoint '{}' was written by a different scene "
-                                          "(compare with {})", ckpt, (dir / "scene.toml").string()));
-      columns = truncate_series(series_path, w.steps);
-    } catch (const CheckpointError& e) {
-      throw CheckpointError(std::string(e.what()) +
-                            "; run with --fresh to discard the checkpoint and start over");
-    }
-  }
-  const std::int64_t k0 = resume ? w.steps : 0;
-
-  // An interval as long as the run writes no checkpoint before the end.
-  const auto warn_long = [&](std::int64_t every, const std::string& what) {
-    if (every && every >= nsteps)
-      std::fprintf(stderr, "cdsim: warning: %s is %lld steps (rounded up to whole series rows), "
-                   "not shorter than the run's %lld: it writes no checkpoint before the end%s\n",
-                   what.c_str(), static_cast<long long>(every), static_cast<long long>(nsteps),
-                   ckpt_wall > 0 ? " (output.checkpoint_wall still does)"
-                                 : ", so a kill loses the whole run");
-  };
-  warn_long(every_ckpt, fmt::format("output.checkpoint_interval = {} s", s.checkpoint_interval));
-  warn_long(every_ckpt_strain, fmt::format("output.checkpoint_strain = {}", s.checkpoint_strain));
-
-  fs::create_directories(opt.out);
-  if (!resume) clear_previous(opt.out);
-  write_file_atomic((dir / "scene.toml").string(), opt.scene_toml);
-  // On resume, the snapshots up to the checkpoint are known by their steps
-  // (the time is computed as World::step does, steps * dt).
-  std::vector<std::pair<double, std::string>> frames;
-  for (std::int64_t j = 0; resume && every_snap && j * every_snap <= k0; ++j)
-    frames.emplace_back(static_cast<double>(j * every_snap) * dt, fmt::format("{:05d}", j));
-  Series series = resume ? Series(series_path, std::move(columns)) : Series(series_path);
-  Snapshots snaps = resume ? Snapshots(opt.out, std::move(frames)) : Snapshots(opt.out);
-
-  RunSummary sum;
-  Interval iv;
-  ShearInterval sh;
-  double v_prev = w.cell.width * w.cell.height, t_prev = w.time;
-  iv.t0 = w.times;  // restored on resume
-  const auto start = Clock::now();
-  const double cpu0 = cpu_seconds();
-  sum.load_start = load_average();
-  auto last_print = start, last_ckpt = start;
-  long iter_total = 0;
-  if (k0 < nsteps) tot.sessions += 1;
-  // The totals as they stand now: the wall and CPU time of this session added.
-  const auto totals_now = [&] {
-    RunTotals t = tot;
-    t.wall += std::chrono::duration<double>(Clock::now() - start).count();
-    t.cpu += cpu_seconds() - cpu0;
-    return t;
-  };
-  // summary.toml: at the end of the session, however it ends.
-  const auto write_summary = [&](const char* status, std::int64_t last) {
-    sum.status = status;
-    sum.last_step = last;
-    sum.total_steps = nsteps;
-    sum.totals = totals_now();
-    sum.threads = omp_get_max_threads();
-    sum.load_end = load_average();
-    write_file_atomic((dir / "summary.toml").string(), summary_toml(sum));
-  };
-  // A diverged run still says what it cost, up to `last`, the last step
-  // counted; a failure to write that does not hide the divergence.
-  const auto diverged = [&](std::int64_t last, const std::string& msg) {
-    try {
-      write_summary("diverged", last);
-    } catch (const std::exception&) {
-    }
-    return RunDiverged(msg);
-  };
-
-  auto timed_output = [&](auto&& f) {
-    const auto t = Clock::now();
-    f();
-    w.times[Stage::Output] += std::chrono::duration<double>(Clock::now() - t).count();
-  };
-  if (every_snap && !resume) timed_output([&] { snaps.write(w); });
-
-  // --dump-problem: the hook sees the problem of the step being taken
-  // (w.steps + 1) just before its solve.
-  auto dumped = [&](std::int64_t k) {
-    return std::find(opt.dump_steps.begin(), opt.dump_steps.end(), k) != opt.dump_steps.end();
-  };
-  if (!opt.dump_steps.empty())
-    w.set_problem_hook([&](const ContactProblem& p, const SolverParams& prm) {
-      const std::int64_t k = w.steps + 1;
-      if (!dumped(k)) return;
-      const std::string stem = (dir / fmt::format("problem_{}", k)).string();
-      write_contact_problem(p, prm, stem + ".cdp");
-      const bool cohesive = std::any_of(p.rows.begin(), p.rows.end(),
-                                        [](const ContactRow& r) { return r.adh != 0.0; });
-      if (!cohesive) write_problem(to_matrix(p), stem + ".dat");
-    });
-
-  std::int64_t k_end = nsteps;  // the last step taken (earlier if stopped by a signal)
-  for (std::int64_t k = k0 + 1; k <= nsteps; ++k) {
-    try {
-      w.step();
-    } catch (const std::runtime_error& e) {
-      // A step that cannot go on (e.g. a periodic cell shrunk below what
-      // detection needs): the run stops as a diverged one, its outputs kept.
-      throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): {}; series.csv holds the rows before it",
-                                    k, w.time, e.what()));
-    }
-    const StepStats& st = w.last();
-    if (const std::string bad = non_finite(w); !bad.empty())
-      throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): non-finite state: {}; series.csv "
-                                    "holds the rows before it{}", k, w.time, bad,
-                                    checkpoints ? ", checkpoint.bin (if written) the last good state" : ""));
-    const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps;
-    const bool stopping = g_stop != 0 || at_limit;
-    if (stopping) k_end = k;
-    if (dumped(k)) {
-      std::string text;
-      for (const ContactRow& r : w.rows()) text += fmt::format("{:a} {:a}\n", r.pn, r.pt);
-      write_file_atomic((dir / fmt::format("problem_{}.impulses", k)).string(), text);
-    }
-    iv.add(st);
-    if (shear) sh.add(w);
-    iter_total += st.solve.iterations;
-    sum.max_iterations = std::max(sum.max_iterations, st.solve.iterations);
-    sum.cap_hits += st.solve.cap_hit;
-    sum.max_residual = std::max(sum.max_residual, st.solve.residual_max);
-    sum.max_overlap = std::max(sum.max_overlap, st.max_overlap);
-    sum.max_overlap_small = std::max(sum.max_overlap_small, st.max_overlap_small);
-    tot.sweeps += st.solve.iterations;
-    tot.sweeps_max = std::max(tot.sweeps_max, double(st.solve.iterations));
-    tot.cap_steps += st.solve.cap_hit;
-    tot.residual_max = std::max(tot.residual_max, st.solve.residual_max);
-    tot.residual_last = st.solve.residual_max;
-    tot.overlap_max = std::max(tot.overlap_max, st.max_overlap);
-
-    if (k % every_row == 0 || k == nsteps || stopping) {
-      timed_output([&] {
-        const StageTimes& t = w.times;
-        std::vector<std::pair<std::string, double>> cols = {{"step", double(k)},
-                    {"time", w.time},
-                    {"contacts", double(st.contacts)},
-                    {"active", double(st.active)},
-                    {"iterations", double(iv.iter_sum) / iv.steps},
-                    {"iterations_max", double(iv.iter_max)},
-                    {"residual", iv.res_max},
-                    {"residual_mean", iv.res_mean_sum / iv.steps},
-                    {"cap_hit", double(iv.cap_hits)},
-                    {"max_overlap", iv.ov_max},
-                    {"mean_overlap", st.mean_overlap},
-                    {"max_overlap_small", iv.ov_small},
-                    {"kinetic_energy", w.kinetic_energy()},
-                    {"correction_work", iv.corr_work}};
-        for (int s = 0; s < kStages; ++s)
-          cols.emplace_back(std::string("t_") + kStageNames[s], t.t[s] - iv.t0.t[s]);
-        if (shear) {
-          // Contact stress (mean over the interval's steps), compression
-          // positive; p = (s1 + s2)/2, q = (s1 - s2)/2 from the symmetric part.
-          const Eigen::Matrix2d S = sh.sigma / sh.steps;
-          const double sxx = S(0, 0), syy = S(1, 1), sxy = 0.5 * (S(0, 1) + S(1, 0));
-          const obs::Tensor<2> St = {{{S(0, 0), S(0, 1)}, {S(1, 0), S(1, 1)}}};
-          const double p = obs::mean_2d(St), q = obs::deviator_2d(St);
-          const double V = w.cell.width * w.cell.height;
-          const double gd = w.shear_rate();
-          const obs::Coordination zc = coordination(w);
-          const Eigen::Matrix2d K = w.kinetic_stress();  // at the row's step
-          cols.insert(cols.end(), {{"strain", w.cell.strain},
-                      {"shear_rate", gd},
-                      {"sxx", sxx},
-                      {"sxy", S(0, 1)},
-                      {"syx", S(1, 0)},
-                      {"syy", syy},
-                      {"p", p},
-                      {"q", q},
-                      {"q_over_p", p > 0 ? q / p : 0.0},
-                      // tau / sigma_n, positive in the imposed sense (the
-                      // top moves +x, so sigma_xy < 0 compression-positive)
-                      {"shear_stress_ratio", syy > 0 ? -sxy / syy : 0.0},
-                      // with the whole normal stress, the one the control imposes
-                      {"inertial_number", syy + K(1, 1) > 0
-                                              ? gd * d_mean * std::sqrt(s.density / (syy + K(1, 1)))
-                                              : 0.0},
-                      {"packing_fraction", V > 0 ? packing_fraction(w.bodies, V) : 0.0},
-                      {"z", zc.z},
-                      {"non_rattler", zc.non_rattler},
-                      {"cell_width", w.cell.width},
-                      {"cell_height", w.cell.height},
-                      {"volume_strain_rate",
-                       w.time > t_prev ? std::log(V / v_prev) / (w.time - t_prev) : 0.0},
-                      {"kxx", K(0, 0)},
-                      {"kxy", K(0, 1)},
-                      {"kyy", K(1, 1)}});
-          v_prev = V;
-          t_prev = w.time;
-          sh = ShearInterval{};
-        }
-        for (const auto& [name, x] : cols)
-          if (!std::isfinite(x))
-            throw diverged(k, fmt::format("step {} (t = {:.6g} s): series column {} is {}; "
-                                          "series.csv holds the rows before it", k, w.time, name, x));
-        series.row(cols);
-        series.flush();
-      });
-      iv = Interval{};
-      iv.t0 = w.times;
-    }
-    if (every_snap && k % every_snap == 0) timed_output([&] { snaps.write(w); });
-    // After this step's outputs, so that a restart has them all. A resumed
-    // run keeps its checkpoint current even with checkpoints off.
-    const bool wall_due = ckpt_wall > 0 && k % every_row == 0 &&
-                          std::chrono::duration<double>(Clock::now() - last_ckpt).count() >= ckpt_wall;
-    if ((every_ckpt && k % every_ckpt == 0) || (every_ckpt_strain && k % every_ckpt_strain == 0) ||
-        wall_due || ((k == nsteps || stopping) && (checkpoints || resume))) {
-      timed_output([&] { save_checkpoint(ckpt, w, key, totals_now()); });
-      last_ckpt = Clock::now();
-    }
-    if (stopping) {
-      sum.stop_signal = g_stop;
-      sum.stopped_at_max_steps = at_limit && !g_stop;
-      break;
-    }
-
-    if (progress) {
-      const auto now = Clock::now();
-      if (now - last_print > std::chrono::milliseconds(500) || k == nsteps) {
-        last_print = now;
-        const double el = std::chrono::duration<double>(now - start).count();
-        const double eta = el / (k - k0) * (nsteps - k);
-        std::fprintf(stderr, "\r%5.1f%%  ETA %6.1fs  step %lld/%lld  contacts %d  iterations %d   ",
-                     100.0 * k / nsteps, eta, static_cast<long long>(k),
-                     static_cast<long long>(nsteps), st.contacts, st.solve.iterations);
-        std::fflush(stderr);
-      }
-    }
-  }
-  if (progress) std::fprintf(stderr, "\n");
-  sum.first_step = k0;
-  sum.steps = k_end - k0;
-  sum.total_steps = nsteps;
-  sum.mean_iterations = sum.steps ? double(iter_total) / sum.steps : 0.0;
-  sum.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
-  sum.kinetic_energy = w.kinetic_energy();
-  write_summary(sum.stop_signal ? "stopped" : sum.stopped_at_max_steps ? "max-steps" : "done", k_end);
-  return sum;
+RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
+  Engine2 e(w, s, opt);
+  return run_loop(e, plan_of(s, w.params().dt), opt);
 }
 
 }  // namespace cd

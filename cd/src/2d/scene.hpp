@@ -32,13 +32,14 @@ struct WallSpec {            // [[wall]]: a rigid segment with imposed velocity
 struct Scene {
   std::string name = "default";
   std::string source;        // file the scene came from (for messages)
+  int dimension = 2;         // 2: disks and polygons (this file); 3: spheres (3d/setup3.hpp)
 
   // [time]
   double dt = WorldParams{}.dt;  // time step (s)
   double duration = 0.5;     // simulated time (s)
 
-  // [gravity]
-  std::array<double, 2> gravity{0.0, -9.81};
+  // [gravity]: [gx, gy] in 2D, [gx, gy, gz] in 3D
+  std::vector<double> gravity{0.0, -9.81};
 
   // [contact]
   double mu = 0.4;           // particle-particle friction coefficient
@@ -79,6 +80,7 @@ struct Scene {
   // [box]: four static walls (width = 0: no box)
   double box_width = 0.0;
   double box_height = 0.0;
+  double box_depth = 0.0;    // 3D: y extent of the box (0 with width 0: fitted to the lattice)
 
   std::vector<DiskSpec> disks;
   std::vector<WallSpec> walls;

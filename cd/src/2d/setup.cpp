@@ -64,6 +64,15 @@ std::vector<double> generated_diameters(const Scene& s) {
   return d;
 }
 
+std::pair<double, double> diameter_bounds(const Scene& s) {
+  if (!s.diameters.empty())
+    return {*std::min_element(s.diameters.begin(), s.diameters.end()),
+            *std::max_element(s.diameters.begin(), s.diameters.end())};
+  double a, b;
+  diameter_range(s, a, b);
+  return {a, b};
+}
+
 double mean_diameter(const Scene& s) {
   double sum = 0;
   int n = 0;
@@ -143,6 +152,8 @@ void check_shear(const Scene& s) {
 // no more than kMaxSteps.
 constexpr double kMaxSteps = 1e9;
 
+}  // namespace
+
 void check_derived(const Scene& s) {
   auto fail = [](const std::string& m) { throw SceneError(m); };
   const double dt = time_step(s);
@@ -170,8 +181,6 @@ void check_derived(const Scene& s) {
     fail(fmt::format("the run would take less than one step: its duration ({} = {:.4g} s) is "
                      "shorter than the time step ({} = {:.4g} s)", T_from, T, dt_from, dt));
 }
-
-}  // namespace
 
 // A periodic cell given as 0 x 0 for generated particles: the smallest
 // square that holds them on the generator's loose lattice (pitch 1.02 d_max),
@@ -221,6 +230,8 @@ WorldParams world_params(const Scene& s0) {
 }
 
 World build_world(const Scene& s0) {
+  if (s0.dimension != 2)
+    throw SceneError(fmt::format("dimension = {}: build_world makes 2D worlds (3D: build_world3)", s0.dimension));
   const Scene s = with_auto_cell(s0);
   WorldParams wp = world_params(s);
   World w(wp);

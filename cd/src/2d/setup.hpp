@@ -3,6 +3,7 @@
 // their region and that no two bodies overlap at t = 0.
 #pragma once
 #include <stdexcept>
+#include <utility>
 
 #include "scene.hpp"
 #include "world.hpp"
@@ -17,6 +18,11 @@ struct SceneError : std::runtime_error {
 double mean_diameter(const Scene& s);
 
 WorldParams world_params(const Scene& s);
+
+// What the per-key rules cannot see, in both dimensions: a finite time step,
+// pull-off force and shear time scales, and a run of at least one step and
+// at most 1e9 steps. Throws SceneError naming the keys.
+void check_derived(const Scene& s);
 
 // Shear protocols: the imposed shear rate gamma-dot = I sqrt(p/rho)/d, the
 // pressure time t_p = d sqrt(rho/p); 0 when the scene imposes no pressure.
@@ -33,6 +39,10 @@ Scene with_auto_cell(const Scene& s);
 
 // Builds the world; throws SceneError naming the bodies at fault.
 World build_world(const Scene& s);
+
+// The smallest and largest diameter the scene's generated particles may
+// have: the size law's range, or the explicit list's extremes.
+std::pair<double, double> diameter_bounds(const Scene& s);
 
 // Diameters of the n generated disks (deterministic for a seed).
 std::vector<double> generated_diameters(const Scene& s);

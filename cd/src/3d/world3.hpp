@@ -14,6 +14,7 @@
 // into a template instance of the sweep.
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "bodies3.hpp"
@@ -72,6 +73,8 @@ class World3 {
     std::vector<Vec3> p;
   };
   const WarmStart& warm_start() const { return warm_; }
+  // Restores the warm-start memory (a checkpoint; checkpoint3.cpp).
+  void set_warm_start(WarmStart w) { warm_ = std::move(w); }
 
  private:
   void configure();

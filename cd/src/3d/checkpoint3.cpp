@@ -1,0 +1,70 @@
+#include "checkpoint3.hpp"
+
+#include <tuple>
+#include <utility>
+
+namespace cd {
+
+namespace {
+
+// Every Bodies3 array, listed once: the writer and the reader both walk
+// this list, so a new Bodies3 member is one line here.
+constexpr std::tuple kBodies3Arrays{
+    std::pair{"3d.vel", &Bodies3::vel},
+    std::pair{"3d.pos", &Bodies3::pos},
+    std::pair{"3d.orient", &Bodies3::orient},
+    std::pair{"3d.shape", &Bodies3::shape},
+    std::pair{"3d.radius", &Bodies3::radius},
+    std::pair{"3d.normal", &Bodies3::normal},
+    std::pair{"3d.mass", &Bodies3::mass},
+    std::pair{"3d.inertia", &Bodies3::inertia},
+    std::pair{"3d.driven", &Bodies3::driven},
+};
+// Bodies3 holds only vectors, so a member left out of the list shows here.
+static_assert(sizeof(Bodies3) ==
+                  std::tuple_size_v<decltype(kBodies3Arrays)> * sizeof(std::vector<char>),
+              "a Bodies3 member is missing from kBodies3Arrays (checkpoint3.cpp)");
+
+template <class B, class F>
+void for_each_array(B& b, F&& f) {
+  std::apply([&](const auto&... a) { (f(a.first, b.*(a.second)), ...); }, kBodies3Arrays);
+}
+
+}  // namespace
+
+void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
+                      const RunTotals& totals) {
+  ckpt::Writer o;
+  ckpt::begin(o, 3, scene_key, static_cast<std::int64_t>(w.steps), w.time, w.times);
+  for_each_array(w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
+  o.array("3d.warm.keys", w.warm_start().keys);
+  o.array("3d.warm.p", w.warm_start().p);
+  ckpt::finish(o, totals, path);
+}
+
+std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals) {
+  std::string data;
+  ckpt::Reader in{path, {}};
+  const ckpt::Header h = ckpt::open(path, data, in, 3, totals != nullptr);
+  Bodies3 b;
+  for_each_array(b, [&](std::string_view name, auto& v) { in.array(name, v); });
+  const std::size_t n = b.pos.size();
+  bool same = true;
+  for_each_array(b, [&](std::string_view, const auto& v) { same = same && v.size() == n; });
+  if (!same) in.fail("is corrupt (body arrays of different lengths)");
+  World3::WarmStart warm;
+  in.array("3d.warm.keys", warm.keys);
+  in.array("3d.warm.p", warm.p);
+  if (warm.keys.size() != warm.p.size()) in.fail("is corrupt (warm-start sizes differ)");
+  const RunTotals tot = ckpt::close(in, h);
+
+  w.bodies = std::move(b);
+  w.steps = h.steps;
+  w.time = h.time;
+  w.times = h.times;
+  w.set_warm_start(std::move(warm));
+  if (totals) *totals = tot;
+  return h.key;
+}
+
+}  // namespace cd

@@ -1,0 +1,150 @@
+#include "checkpoint_io.hpp"
+
+#include <bit>
+#include <charconv>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "files.hpp"
+
+namespace cd {
+
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "checkpoints store raw little-endian values");
+
+constexpr std::string_view kMagic = "CDLABCKP";
+
+// RunTotals' fields, in order: the name of its array, so that a build with
+// other totals refuses the file by name.
+constexpr const char* kTotalsNames[] = {"wall",         "cpu",           "sweeps",
+                                        "sweeps_max",   "cap_steps",     "residual_max",
+                                        "residual_last", "overlap_max",  "sessions"};
+static_assert(sizeof(RunTotals) == std::size(kTotalsNames) * sizeof(double),
+              "a RunTotals field is missing from kTotalsNames (checkpoint_io.cpp)");
+std::string totals_name() {
+  std::string s = "totals";
+  for (const char* n : kTotalsNames) s += std::string(":") + n;
+  return s;
+}
+
+// The name of the timers' array: the stage names, so that a checkpoint
+// from a build with another stage table is refused by name.
+std::string timers_name() {
+  std::string s = "times";
+  for (const char* n : kStageNames) s += std::string(":") + n;
+  return s;
+}
+
+}  // namespace
+
+std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h) {
+  for (const char c : bytes) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  return h;
+}
+
+namespace ckpt {
+
+void begin(Writer& o, int dimension, std::uint64_t key, std::int64_t steps, double time,
+           const StageTimes& times) {
+  o.buf += kMagic;
+  o.put(kVersion);
+  o.put(static_cast<std::uint32_t>(dimension));
+  o.put(key);
+  o.put(steps);
+  o.put(time);
+  o.array(timers_name(), std::vector<double>(times.t.begin(), times.t.end()));
+}
+
+void finish(Writer& o, const RunTotals& totals, const std::string& path) {
+  std::vector<double> t(std::size(kTotalsNames));
+  std::memcpy(t.data(), &totals, sizeof totals);
+  o.array(totals_name(), t);
+  o.put(fnv1a(o.buf));
+  write_file_atomic(path, o.buf);  // binary-safe: the string is written as is
+}
+
+Header open(const std::string& path, std::string& data, Reader& in, int dimension, bool resume) {
+  {
+    std::ifstream f(path, std::ios::binary);
+    std::ostringstream text;
+    if (f) text << f.rdbuf();
+    if (!f) throw CheckpointError(fmt::format("cannot read checkpoint '{}'", path));
+    data = std::move(text).str();
+  }
+  in.rest = data;
+  if (!kMagic.starts_with(in.rest.substr(0, kMagic.size()))) in.fail("is not a cdlab checkpoint");
+  in.need(kMagic.size(), "the magic string");
+  in.rest.remove_prefix(kMagic.size());
+  Header h;
+  h.version = in.get<std::uint32_t>("the version");
+  if (h.version == kStartVersion && resume)
+    in.fail(fmt::format("has format version {}, which holds no run totals (summary.toml); this "
+                        "build resumes versions {} and {} only", h.version, kOldVersion, kVersion));
+  if (h.version != kVersion && h.version != kOldVersion && h.version != kStartVersion)
+    in.fail(fmt::format("has format version {}; this build reads version {}", h.version, kVersion));
+  // The checksum first: a truncated or damaged file is named as such, not by
+  // whichever field happens to look wrong.
+  in.need(sizeof(std::uint64_t), "the header");
+  std::uint64_t sum;
+  std::memcpy(&sum, data.data() + data.size() - sizeof sum, sizeof sum);
+  if (sum != fnv1a(std::string_view(data).substr(0, data.size() - sizeof sum)))
+    in.fail("is truncated or corrupt (checksum mismatch)");
+  in.rest.remove_suffix(sizeof sum);
+
+  h.dimension = h.version >= 5 ? static_cast<int>(in.get<std::uint32_t>("the header")) : 2;
+  if (h.dimension != dimension)
+    in.fail(fmt::format("holds a {}D run (dimension = {}); this scene has dimension = {}",
+                        h.dimension, h.dimension, dimension));
+  h.key = in.get<std::uint64_t>("the header");
+  h.steps = in.get<std::int64_t>("the header");
+  h.time = in.get<double>("the header");
+  std::vector<double> t;
+  in.array(timers_name(), t);
+  if (t.size() != h.times.t.size()) in.fail("is corrupt (stage timers)");
+  std::copy(t.begin(), t.end(), h.times.t.begin());
+  return h;
+}
+
+RunTotals close(Reader& in, const Header& h) {
+  RunTotals tot;
+  if (h.version >= 4) {
+    std::vector<double> t;
+    in.array(totals_name(), t);
+    if (t.size() != std::size(kTotalsNames)) in.fail("is corrupt (run totals)");
+    std::memcpy(static_cast<void*>(&tot), t.data(), sizeof tot);
+  }
+  if (!in.rest.empty()) in.fail("has unexpected data after the last array");
+  return tot;
+}
+
+}  // namespace ckpt
+
+std::vector<std::string> truncate_series(const std::string& path, std::int64_t step) {
+  std::ifstream f(path, std::ios::binary);
+  std::string header, line, kept;
+  std::getline(f, header);
+  std::int64_t last = 0;  // step of the last row kept
+  while (std::getline(f, line)) {
+    std::int64_t k = -1;
+    std::from_chars(line.data(), line.data() + line.size(), k);  // "step" is the first column
+    // Rows after the checkpoint, including one cut short by the kill (whose
+    // step may read small): steps only grow.
+    if (k <= last || k > step) break;
+    kept += line + '\n';
+    last = k;
+  }
+  if (!header.starts_with("step,") || last != step)
+    throw CheckpointError(fmt::format("'{}' does not reach the checkpoint's step {}", path, step));
+  std::vector<std::string> names;
+  for (std::size_t a = 0, b; a <= header.size(); a = b + 1) {
+    b = std::min(header.find(',', a), header.size());
+    names.push_back(header.substr(a, b - a));
+  }
+  write_file_atomic(path, header + '\n' + kept);
+  return names;
+}
+
+}  // namespace cd

@@ -1,0 +1,155 @@
+// What the 2D and 3D checkpoints share (2d/checkpoint.hpp, 3d/checkpoint3.hpp):
+// the file's frame, its named arrays, the run's totals, the checksum, and the
+// series cut back on a restart.
+//
+// File format (version 5), little-endian, no padding:
+//   "CDLABCKP"                      8-byte magic
+//   u32 version
+//   u32 dimension                   2 or 3 (version 5; a version 3 or 4 file is 2D)
+//   u64 scene key                   opaque to this file (run loop: hash of the scene)
+//   i64 steps, f64 time
+//   arrays, each: u32 name length, name, u64 count, u32 element size, raw elements
+//     first the stage timers, one f64 per stage of core/stages.hpp, in an
+//     array named "times:" + the stage names joined by ':' (a build with
+//     other stages refuses the file); then the engine's arrays (its bodies,
+//     warm start, ...); then the run's totals (one f64 per RunTotals field,
+//     in an array named "totals:" + the field names joined by ':')
+//   u64 FNV-1a of every byte before it
+// A reader checks every size against the file and the checksum, and names the
+// file in any error.
+#pragma once
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "stages.hpp"
+
+namespace cd {
+
+struct CheckpointError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// The cost of a run so far, carried by its checkpoint so that a resumed run's
+// summary.toml (run loop) covers every session. Wall and CPU time count what
+// was spent up to the checkpoint: the work a kill loses after it is not
+// counted (the session that redoes it counts it).
+struct RunTotals {
+  double wall = 0;           // s of wall-clock time in the run loop, summed over sessions
+  double cpu = 0;            // s of CPU time of the process (user + system) in the run loop
+  double sweeps = 0;         // NLGS sweeps summed over the steps (exact below 2^53)
+  double sweeps_max = 0;     // most sweeps of one step
+  double cap_steps = 0;      // steps that stopped at solver.max_iter
+  double residual_max = 0;   // largest law residual of any step
+  double residual_last = 0;  // the last step's law residual
+  double overlap_max = 0;    // largest overlap, in mean diameters
+  double sessions = 0;       // cdsim calls that took steps of this run
+};
+
+// 64-bit FNV-1a (the checksum; also used for the scene key).
+std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 1469598103934665603ull);
+
+namespace ckpt {
+
+inline constexpr std::uint32_t kVersion = 5;       // written, and resumed
+inline constexpr std::uint32_t kOldVersion = 4;    // 2D without the dimension tag: resumed as 2D
+inline constexpr std::uint32_t kStartVersion = 3;  // 2D: the oldest read as a start sample
+
+// Elements are stored as their bytes; T must be a plain aggregate of
+// numbers (Eigen's fixed vectors and quaternions are, though not "trivially
+// copyable" by the standard's letter: their copies are byte copies).
+struct Writer {
+  std::string buf;
+
+  template <class T>
+  void put(const T& x) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    buf.append(reinterpret_cast<const char*>(&x), sizeof(T));
+  }
+  template <class T>
+  void array(std::string_view name, const std::vector<T>& v) {
+    put(static_cast<std::uint32_t>(name.size()));
+    buf += name;
+    put(static_cast<std::uint64_t>(v.size()));
+    put(static_cast<std::uint32_t>(sizeof(T)));
+    buf.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+};
+
+struct Reader {
+  const std::string& path;
+  std::string_view rest;
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw CheckpointError(fmt::format("checkpoint '{}' {}", path, why));
+  }
+  void need(std::size_t n, std::string_view what) const {
+    if (rest.size() < n) fail(fmt::format("is truncated (it ends inside {})", what));
+  }
+  template <class T>
+  T get(std::string_view what) {
+    need(sizeof(T), what);
+    T x;
+    std::memcpy(&x, rest.data(), sizeof(T));
+    rest.remove_prefix(sizeof(T));
+    return x;
+  }
+  template <class T>
+  void array(std::string_view name, std::vector<T>& v) {
+    const auto len = get<std::uint32_t>(name);
+    need(len, name);
+    if (rest.substr(0, len) != name)
+      fail(fmt::format("holds array '{}' where '{}' was expected (written by another build?)",
+                       rest.substr(0, std::min<std::size_t>(len, 40)), name));
+    rest.remove_prefix(len);
+    const auto n = get<std::uint64_t>(name);
+    const auto size = get<std::uint32_t>(name);
+    if (size != sizeof(T))
+      fail(fmt::format("stores '{}' with {}-byte elements, this build uses {} (written by "
+                       "another build?)", name, size, sizeof(T)));
+    if (n > rest.size() / sizeof(T)) fail(fmt::format("is truncated (it ends inside {})", name));
+    v.resize(n);
+    std::memcpy(static_cast<void*>(v.data()), rest.data(), n * sizeof(T));
+    rest.remove_prefix(n * sizeof(T));
+  }
+};
+
+struct Header {
+  std::uint32_t version = kVersion;
+  int dimension = 2;
+  std::uint64_t key = 0;
+  std::int64_t steps = 0;
+  double time = 0;
+  StageTimes times;
+};
+
+// The frame's start: magic, version, dimension, key, steps, time, timers.
+void begin(Writer& o, int dimension, std::uint64_t key, std::int64_t steps, double time,
+           const StageTimes& times);
+// The frame's end: the totals, the checksum; then the file, written
+// atomically (temporary file, then rename).
+void finish(Writer& o, const RunTotals& totals, const std::string& path);
+
+// Reads the whole file into `data` and its header, checking the magic, the
+// version, the checksum and the dimension (a checkpoint of the other
+// dimension is refused by name). `resume`: the file must hold run totals.
+// Leaves `in` (over `data`) at the engine's arrays, without the checksum.
+Header open(const std::string& path, std::string& data, Reader& in, int dimension, bool resume);
+// After the engine's arrays: the run's totals (none in a version 3 file),
+// then the end of the data.
+RunTotals close(Reader& in, const Header& h);
+
+}  // namespace ckpt
+
+// Cuts series.csv back to its header and the rows up to `step` (a killed run
+// may have written rows after its last checkpoint) and returns the column
+// names. Throws CheckpointError if the file does not reach `step`.
+std::vector<std::string> truncate_series(const std::string& path, std::int64_t step);
+
+}  // namespace cd
