@@ -13,15 +13,23 @@
 namespace cd {
 
 // The local law of a scene, fixed once (no test inside the sweep):
-// frictionless or round Coulomb, with or without adhesion. The local solve
-// is law3's exact solver for the sphere block diag(W_nn, W_tt, W_tt)
-// (solve_sphere3); u = W r + q with q the velocity the others leave.
-template <bool Friction, bool Cohesion>
+// frictionless or Coulomb, with or without adhesion, with or without
+// tangential offsets (Offsets: restitution or moving periodic images put
+// constant terms b_t into the tangential velocity the law sees; without them
+// b_t is never read, so such scenes compute exactly what they did before),
+// round or orthotropic cone (Orthotropic: |(s_t1/mu, s_t2/mu_b)| <= s_n,
+// solve_sphere3_ortho). The local solve is law3's exact solver for the
+// sphere block diag(W_nn, W_tt, W_tt); u = W r + q with q the velocity the
+// others leave.
+template <bool Friction, bool Cohesion, bool Offsets = false, bool Orthotropic = false>
 struct SphereLaw3 {
   static constexpr bool tangential = Friction;
+  static constexpr bool offsets = Offsets && Friction;
   static void solve(const SphereRow& r, const Vec3& q, Vec3& out) {
     const double a = Cohesion ? r.adh : 0.0;
-    if constexpr (Friction) {
+    if constexpr (Friction && Orthotropic) {
+      solve_sphere3_ortho(r.wnn, r.wtt, q, r.mu, r.mu_b, a, out);
+    } else if constexpr (Friction) {
       solve_sphere3(r.wnn, r.wtt, q, r.mu, a, out);
     } else {
       out = Vec3(std::max(-a, -q[0] / r.wnn), 0.0, 0.0);
@@ -46,7 +54,7 @@ struct BodyCoupling3 {
   // The row's relative velocity in its frame, with the law's offset.
   Vec3 velocity(const SphereRow& r) const {
     const Vec3 du = relative_velocity(r, vel[r.b1], vel[r.b2]);
-    return {r.n.dot(du) + r.bn, r.t1.dot(du), r.t2.dot(du)};
+    return {r.n.dot(du) + r.bn, r.t1.dot(du) + r.bt1, r.t2.dot(du) + r.bt2};
   }
 
   // One row update. Write1 = false when body 1 is driven (a wall): read,
@@ -61,6 +69,10 @@ struct BodyCoupling3 {
     if constexpr (L::tangential) {
       q[1] = r.t1.dot(du) - r.wtt * r.r[1];
       q[2] = r.t2.dot(du) - r.wtt * r.r[2];
+      if constexpr (L::offsets) {
+        q[1] += r.bt1;
+        q[2] += r.bt2;
+      }
     } else {
       q[1] = q[2] = 0.0;
     }
@@ -83,9 +95,9 @@ struct BodyCoupling3 {
 }  // namespace sweep
 
 // The law residual of a row (law3.hpp, rho = 1/W_nn) at the velocity its
-// coupling gives.
+// coupling gives (with the tangential offsets, which are 0 when unused).
 inline double row_residual(const sweep::BodyCoupling3& c, const SphereRow& r) {
-  return law_residual3(c.velocity(r), r.r, Cone3::round(r.mu), r.adh, 1.0 / r.wnn);
+  return law_residual3(c.velocity(r), r.r, Cone3{r.mu, r.mu_b}, r.adh, 1.0 / r.wnn);
 }
 
 }  // namespace cd
