@@ -569,3 +569,27 @@ TEST(Periodic3, IdenticalWithOneAndTwoThreads) {
   for (std::size_t k = 0; k < s1.size(); ++k) diff += s1[k] != s2[k];
   EXPECT_EQ(diff, 0u);
 }
+
+// A sphere placed two cells above a Lees-Edwards cell is brought in before
+// the first step: y - 2 L_y, x - 2 offset, v_x - 2 V (modulo L_x); then it
+// moves freely and the offset advances by V dt.
+TEST(Periodic3, SpherePlacedOutsideIsBroughtIn) {
+  WorldParams3 p;
+  p.dt = 1e-3;
+  p.cell = Vec3(0.1, 0.2, 0.3);
+  p.periodic = {true, true, true};
+  p.le_offset = 0.03;
+  p.le_velocity = 0.7;
+  World3 w(p);
+  const Vec3 x0(0.05, 0.13 + 2 * 0.2, 0.1), v0(0.2, -0.1, 0.05);
+  const int s = w.bodies.add_sphere(x0, 0.01, 1000, v0);
+  w.step();
+  const double vx = v0.x() - 2 * p.le_velocity;
+  double x = x0.x() - 2 * p.le_offset + vx * p.dt;
+  x -= 0.1 * std::floor(x / 0.1);
+  EXPECT_NEAR(w.bodies.vel[s].v.x(), vx, 1e-15);
+  EXPECT_NEAR(w.bodies.pos[s].x(), x, 1e-15);
+  EXPECT_NEAR(w.bodies.pos[s].y(), 0.13 + v0.y() * p.dt, 1e-15);
+  EXPECT_NEAR(w.bodies.pos[s].z(), 0.1 + v0.z() * p.dt, 1e-15);
+  EXPECT_NEAR(w.params().le_offset, 0.03 + 0.7 * p.dt, 1e-16);
+}

@@ -105,6 +105,9 @@ void World3::predict() {
   xm_.resize(n);
   qm_.resize(n);
   const bool par = static_cast<int>(n) >= prm_.solver.min_parallel / 2;
+  // Spheres placed outside a periodic cell are brought in first (the end
+  // of each step keeps them in), so that image counts stay small.
+  if (periodic_on_) wrap_into_cell(prm_.le_offset);
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t i = 0; i < n; ++i) {
     const BodyVel3& v = bodies.vel[i];
@@ -236,19 +239,24 @@ void World3::integrate() {
     bodies.orient[i] = rotate(qm_[i], v.w, h);
   }
   if (!periodic_on_) return;
-  // Back into the cell (spheres only), at the end-of-step offset: a sphere
-  // moved by ky images across y takes the images' shift and velocity.
   double off = prm_.le_offset + prm_.dt * prm_.le_velocity;
   if (prm_.periodic[0]) off -= prm_.cell.x() * std::floor(off / prm_.cell.x());
+  wrap_into_cell(off);
+  prm_.le_offset = off;
+}
+
+// Spheres back into the periodic cell at Lees-Edwards offset `off`: a
+// sphere moved by ky images across y takes the images' shift and velocity.
+void World3::wrap_into_cell(double off) {
+  const std::size_t n = bodies.size();
   const PeriodicCell3 c = cell_at(off);
 #pragma omp parallel for schedule(static) if (static_cast<int>(n) >= prm_.solver.min_parallel / 2)
   for (std::size_t i = 0; i < n; ++i) {
     if (bodies.shape[i] != Shape3::Sphere) continue;
     std::array<int, 3> k;
     bodies.pos[i] = c.wrap(bodies.pos[i], k);
-    bodies.vel[i].v.x() += k[1] * prm_.le_velocity;
+    if (k[1] != 0) bodies.vel[i].v.x() += k[1] * prm_.le_velocity;
   }
-  prm_.le_offset = off;
 }
 
 void World3::observe() {

@@ -122,6 +122,7 @@ class World3 {
   void observe();
 
   PeriodicCell3 cell_at(double offset) const;
+  void wrap_into_cell(double offset);
 
   WorldParams3 prm_;
   bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, periodic_on_ = false,
