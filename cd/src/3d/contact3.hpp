@@ -41,15 +41,23 @@ struct SphereRow {
   double wnn, wtt; // the Delassus block diag(wnn, wtt, wtt)
   double bn;       // constant normal velocity offset of the law (gap term,
                    // restitution, image velocity)
-  double bt1, bt2; // tangential offsets (restitution, image velocity); read
-                   // only by the laws with offsets (SphereLaw3<..., true>)
   Vec3 r;          // impulse over the step, frame components
   double mu;       // friction coefficient (round cone; orthotropic: along t1)
-  double mu_b;     // friction along t2 (= mu but in orthotropic scenes)
   double adh;      // adhesion impulse f_a dt (0 in non-cohesive scenes)
 
   Vec3 to_frame(const Vec3& x) const { return {n.dot(x), t1.dot(x), t2.dot(x)}; }
   Vec3 to_world(const Vec3& x) const { return x[0] * n + x[1] * t1 + x[2] * t2; }
+};
+
+// What a row needs only in scenes that ask for it: tangential offsets of
+// the law (tangential restitution, moving periodic images) and the second
+// coefficient of an orthotropic cone. Kept apart from the hot row, same
+// index, filled only in such scenes and read only by the law instances that
+// use it (coupling3.hpp), so that a scene without these options streams the
+// same rows through the sweep as before they existed.
+struct RowExtra3 {
+  double bt1 = 0.0, bt2 = 0.0;  // tangential offsets, frame components
+  double mu_b = 0.0;            // friction along t2 (= mu for a round cone)
 };
 
 // Cold record, same index as the row.

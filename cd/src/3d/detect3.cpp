@@ -18,9 +18,9 @@ void set_frame(SphereRow& row, int b1, int b2, const Vec3& n, const Vec3& c1, co
   row.c1 = c1;
   row.c2 = c2;
   row.wnn = row.wtt = 0.0;
-  row.bn = row.bt1 = row.bt2 = 0.0;
+  row.bn = 0.0;
   row.r = Vec3::Zero();
-  row.mu = row.mu_b = 0.0;
+  row.mu = 0.0;
   row.adh = 0.0;
 }
 

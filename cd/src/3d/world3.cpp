@@ -16,9 +16,9 @@ namespace {
 
 
 template <class L>
-SolveStats solve_with(std::vector<SphereRow>& rows, const Colouring& col, std::vector<BodyVel3>& vel,
-                      const SolverParams& prm) {
-  sweep::BodyCoupling3 c{vel.data()};
+SolveStats solve_with(std::vector<SphereRow>& rows, const std::vector<RowExtra3>& extra, const Colouring& col,
+                      std::vector<BodyVel3>& vel, const SolverParams& prm) {
+  sweep::BodyCoupling3 c{vel.data(), extra.empty() ? nullptr : extra.data(), rows.data()};
   std::vector<NoDof3>* nodofs = nullptr;
   return sweep::solve<L>(rows, col, c, prm, nodofs, {});
 }
@@ -69,8 +69,10 @@ void World3::configure() {
   if (adhesion_on_) alert_ = std::max(alert_, prm_.debond);
   const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0 ||
                         (prm_.orthotropic && (prm_.mu_b > 0.0 || prm_.mu_wall_b > 0.0));
-  // Tangential offsets: tangential restitution or moving images.
+  // Tangential offsets: tangential restitution or moving images; they and
+  // the orthotropic mu_b are the rows' RowExtra3.
   const bool offsets = prm_.e_t > 0.0 || moving_images_;
+  extras_on_ = friction && (offsets || prm_.orthotropic);
   solve_fn_ = friction ? pick_law<true>(adhesion_on_, offsets, prm_.orthotropic)
                        : pick_law<false>(adhesion_on_, false, false);
 }
@@ -131,6 +133,7 @@ void World3::build() {
   const bool par = static_cast<int>(nr) >= prm_.solver.min_parallel;
   const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
   const double a = adhesion_on_ ? prm_.adhesion * dt : 0.0;
+  extra_.assign(extras_on_ ? nr : 0, RowExtra3{});
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t k = 0; k < nr; ++k) {
     SphereRow& r = rows_[k];
@@ -146,12 +149,17 @@ void World3::build() {
     set_block(r, V[r.b1], V[r.b2]);
     const bool wall = bodies.driven[r.b1];
     r.mu = wall ? prm_.mu_wall : prm_.mu;
-    r.mu_b = prm_.orthotropic ? (wall ? prm_.mu_wall_b : prm_.mu_b) : r.mu;
+    RowExtra3* x = extras_on_ ? &extra_[k] : nullptr;
+    if (x) {
+      *x = RowExtra3{};
+      x->mu_b = prm_.orthotropic ? (wall ? prm_.mu_wall_b : prm_.mu_b) : r.mu;
+    }
     const double gap = info_[k].gap;
     // Gap term u_n + g_m/dt >= 0 for an open candidate (g_m > 0): the next
     // midpoint gap is g_m + dt u+_n >= 0 (2D's choice, method.md section 6);
     // an overlap separates at beta |g|/dt (beta = 0: pure CD).
     r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
+    r.adh = adhesion_on_ && gap <= prm_.debond ? a : 0.0;
     // A contact with a moving image of body 2 (Lees-Edwards, iy != 0): the
     // image moves at iy le_velocity e_x more than body 2, and that velocity
     // is part of the relative velocity the law sees.
@@ -159,8 +167,10 @@ void World3::build() {
     if (moving_images_ && info_[k].iy != 0) {
       vimg = Vec3(info_[k].iy * prm_.le_velocity, 0.0, 0.0);
       r.bn += r.n.dot(vimg);
-      r.bt1 = r.t1.dot(vimg);
-      r.bt2 = r.t2.dot(vimg);
+      if (x) {
+        x->bt1 = r.t1.dot(vimg);
+        x->bt2 = r.t2.dot(vimg);
+      }
     }
     // Restitution: the law on u+ + e u-, u- the relative velocity at the
     // start of the step (before gravity) in the midpoint frame, only
@@ -168,10 +178,11 @@ void World3::build() {
     if (restitution_on_) {
       const Vec3 u = relative_velocity(r, V[r.b1], V[r.b2]) + vimg;
       r.bn += prm_.e_n * std::min(r.n.dot(u), 0.0);
-      r.bt1 += prm_.e_t * r.t1.dot(u);
-      r.bt2 += prm_.e_t * r.t2.dot(u);
+      if (x) {
+        x->bt1 += prm_.e_t * r.t1.dot(u);
+        x->bt2 += prm_.e_t * r.t2.dot(u);
+      }
     }
-    r.adh = adhesion_on_ && gap <= prm_.debond ? a : 0.0;
     // Warm start: the previous impulse by contact key, on the new frame.
     const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
     if (it != warm_.keys.end() && *it == info_[k].key) {
@@ -188,13 +199,16 @@ void World3::colour() {
   const std::vector<std::int32_t>& perm = colouring_.perm;
   std::vector<SphereRow> r(rows_.size());
   std::vector<ContactInfo3> f(info_.size());
+  std::vector<RowExtra3> e(extra_.size());
 #pragma omp parallel for schedule(static) if (static_cast<int>(rows_.size()) >= prm_.solver.min_parallel)
   for (std::size_t k = 0; k < rows_.size(); ++k) {
     r[k] = rows_[perm[k]];
     f[k] = info_[perm[k]];
+    if (!e.empty()) e[k] = extra_[perm[k]];
   }
   rows_.swap(r);
   info_.swap(f);
+  extra_.swap(e);
 }
 
 void World3::solve() {
@@ -214,7 +228,7 @@ void World3::solve() {
     A.v -= A.inv_m * P;
     A.w -= A.inv_I * r.c1.cross(P);
   }
-  last_.solve = solve_fn_(rows_, colouring_, V, prm_.solver);
+  last_.solve = solve_fn_(rows_, extra_, colouring_, V, prm_.solver);
 
   // Keep the impulses (world frame) for the next step's warm start.
   const std::size_t nr = rows_.size();

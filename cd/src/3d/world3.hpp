@@ -91,8 +91,11 @@ class World3 {
 
   void step();
   const StepStats& last() const { return last_; }
-  // The last step's rows (solved) and their records, in colour order.
+  // The last step's rows (solved) and their records, in colour order
+  // (extras: empty unless the scene has tangential offsets or an
+  // orthotropic cone).
   const std::vector<SphereRow>& rows() const { return rows_; }
+  const std::vector<RowExtra3>& row_extras() const { return extra_; }
   const std::vector<ContactInfo3>& infos() const { return info_; }
 
   double kinetic_energy() const;    // translational + rotational, dynamic bodies
@@ -108,8 +111,8 @@ class World3 {
   const WarmStart& warm_start() const { return warm_; }
 
   // A scene's sweep instance (chosen in configure).
-  using SolveFn = SolveStats (*)(std::vector<SphereRow>&, const Colouring&, std::vector<BodyVel3>&,
-                                 const SolverParams&);
+  using SolveFn = SolveStats (*)(std::vector<SphereRow>&, const std::vector<RowExtra3>&, const Colouring&,
+                                 std::vector<BodyVel3>&, const SolverParams&);
 
  private:
   void configure();
@@ -126,7 +129,7 @@ class World3 {
 
   WorldParams3 prm_;
   bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, periodic_on_ = false,
-       moving_images_ = false;
+       moving_images_ = false, extras_on_ = false;
   double alert_ = 0.0;
   SolveFn solve_fn_ = nullptr;
   StepStats last_;
@@ -134,6 +137,7 @@ class World3 {
   std::vector<Quat> qm_;
   std::vector<SphereRow> rows_;
   std::vector<ContactInfo3> info_;
+  std::vector<RowExtra3> extra_;  // same index as rows_; empty unless extras_on_
   Colouring colouring_;
   CellGrid3 grid_;
   WarmStart warm_;
