@@ -12,6 +12,7 @@
 #include <map>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <tuple>
 
 #include <omp.h>
@@ -592,4 +593,24 @@ TEST(Periodic3, SpherePlacedOutsideIsBroughtIn) {
   EXPECT_NEAR(w.bodies.pos[s].y(), 0.13 + v0.y() * p.dt, 1e-15);
   EXPECT_NEAR(w.bodies.pos[s].z(), 0.1 + v0.z() * p.dt, 1e-15);
   EXPECT_NEAR(w.params().le_offset, 0.03 + 0.7 * p.dt, 1e-16);
+}
+
+// Refused: Lees-Edwards without periodic x and y, a periodic axis without a
+// length, and a periodic length below 2 (2 r_max + alert) (a pair could then
+// meet through two images).
+TEST(Periodic3, InconsistentCellsAreRefused) {
+  WorldParams3 p;
+  p.cell = Vec3(0.1, 0.1, 0.1);
+  p.periodic = {true, false, true};
+  p.le_velocity = 0.1;
+  EXPECT_THROW(World3 w(p), std::invalid_argument);
+  p.periodic = {true, true, false};
+  p.cell = Vec3(0.1, 0.0, 0.1);
+  EXPECT_THROW(World3 w(p), std::invalid_argument);
+  p.cell = Vec3(0.1, 0.1, 0.1);
+  p.alert = 0.0;
+  World3 w(p);
+  w.bodies.add_sphere(Vec3(0.01, 0.01, 0.01), 0.026, 1000);  // 2 (2 r) = 0.104 > 0.1
+  w.bodies.add_sphere(Vec3(0.05, 0.05, 0.05), 0.01, 1000);
+  EXPECT_THROW(w.step(), std::invalid_argument);
 }
