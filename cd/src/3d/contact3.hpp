@@ -39,13 +39,25 @@ struct SphereRow {
   Vec3 n, t1, t2;
   Vec3 c1, c2;     // lever arms (centre of body i to the contact point)
   double wnn, wtt; // the Delassus block diag(wnn, wtt, wtt)
-  double bn;       // constant normal velocity offset of the law (gap term)
+  double bn;       // constant normal velocity offset of the law (gap term,
+                   // restitution, image velocity)
   Vec3 r;          // impulse over the step, frame components
-  double mu;       // friction coefficient (round cone)
+  double mu;       // friction coefficient (round cone; orthotropic: along t1)
   double adh;      // adhesion impulse f_a dt (0 in non-cohesive scenes)
 
   Vec3 to_frame(const Vec3& x) const { return {n.dot(x), t1.dot(x), t2.dot(x)}; }
   Vec3 to_world(const Vec3& x) const { return x[0] * n + x[1] * t1 + x[2] * t2; }
+};
+
+// What a row needs only in scenes that ask for it: tangential offsets of
+// the law (tangential restitution, moving periodic images) and the second
+// coefficient of an orthotropic cone. Kept apart from the hot row, same
+// index, filled only in such scenes and read only by the law instances that
+// use it (coupling3.hpp), so that a scene without these options streams the
+// same rows through the sweep as before they existed.
+struct RowExtra3 {
+  double bt1 = 0.0, bt2 = 0.0;  // tangential offsets, frame components
+  double mu_b = 0.0;            // friction along t2 (= mu for a round cone)
 };
 
 // Cold record, same index as the row.
@@ -54,6 +66,9 @@ struct ContactInfo3 {
   double gap;         // signed gap at the midpoint configuration (< 0: overlap)
   Vec3 point;         // contact point (midpoint configuration)
   Vec3 branch;        // from the centre of body 1 to the centre of body 2 (plane: to the sphere's foot)
+  // Periodic image of body 2 the contact is with: its position is x2 + ix
+  // L_x e_x + iy (L_y e_y + le_offset e_x) + iz L_z e_z (0, 0, 0: itself).
+  std::int8_t ix = 0, iy = 0, iz = 0;
 };
 
 inline std::uint64_t contact_key3(std::int32_t b1, std::int32_t b2) {

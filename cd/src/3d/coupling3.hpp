@@ -13,15 +13,26 @@
 namespace cd {
 
 // The local law of a scene, fixed once (no test inside the sweep):
-// frictionless or round Coulomb, with or without adhesion. The local solve
-// is law3's exact solver for the sphere block diag(W_nn, W_tt, W_tt)
-// (solve_sphere3); u = W r + q with q the velocity the others leave.
-template <bool Friction, bool Cohesion>
+// frictionless or Coulomb, with or without adhesion, with or without
+// tangential offsets (Offsets: restitution or moving periodic images put
+// constant terms b_t into the tangential velocity the law sees; without them
+// b_t is never read, so such scenes compute exactly what they did before),
+// round or orthotropic cone (Orthotropic: |(s_t1/mu, s_t2/mu_b)| <= s_n,
+// solve_sphere3_ortho). Offsets and mu_b live in the row's RowExtra3 (e,
+// null for the instances that read neither). The local solve is law3's
+// exact solver for the sphere block diag(W_nn, W_tt, W_tt); u = W r + q with
+// q the velocity the others leave.
+template <bool Friction, bool Cohesion, bool Offsets = false, bool Orthotropic = false>
 struct SphereLaw3 {
   static constexpr bool tangential = Friction;
-  static void solve(const SphereRow& r, const Vec3& q, Vec3& out) {
+  static constexpr bool offsets = Offsets && Friction;
+  static constexpr bool orthotropic = Orthotropic && Friction;
+  static constexpr bool extra = offsets || orthotropic;  // reads RowExtra3
+  static void solve(const SphereRow& r, [[maybe_unused]] const RowExtra3* e, const Vec3& q, Vec3& out) {
     const double a = Cohesion ? r.adh : 0.0;
-    if constexpr (Friction) {
+    if constexpr (orthotropic) {
+      solve_sphere3_ortho(r.wnn, r.wtt, q, r.mu, e->mu_b, a, out);
+    } else if constexpr (Friction) {
       solve_sphere3(r.wnn, r.wtt, q, r.mu, a, out);
     } else {
       out = Vec3(std::max(-a, -q[0] / r.wnn), 0.0, 0.0);
@@ -42,11 +53,22 @@ namespace sweep {
 // Rows coupled through the velocities of their bodies (the 3D simulator).
 struct BodyCoupling3 {
   BodyVel3* vel;
+  // The rows' RowExtra3, same index as the rows from `base` (null in scenes
+  // without them).
+  const RowExtra3* extra = nullptr;
+  const SphereRow* base = nullptr;
 
-  // The row's relative velocity in its frame, with the law's offset.
+  const RowExtra3* extra_of(const SphereRow& r) const { return extra ? extra + (&r - base) : nullptr; }
+
+  // The row's relative velocity in its frame, with the law's offsets.
   Vec3 velocity(const SphereRow& r) const {
     const Vec3 du = relative_velocity(r, vel[r.b1], vel[r.b2]);
-    return {r.n.dot(du) + r.bn, r.t1.dot(du), r.t2.dot(du)};
+    Vec3 u(r.n.dot(du) + r.bn, r.t1.dot(du), r.t2.dot(du));
+    if (const RowExtra3* e = extra_of(r)) {
+      u[1] += e->bt1;
+      u[2] += e->bt2;
+    }
+    return u;
   }
 
   // One row update. Write1 = false when body 1 is driven (a wall): read,
@@ -55,17 +77,23 @@ struct BodyCoupling3 {
   void update(SphereRow& r, double& dp2, double& pabs) const {
     BodyVel3& A = vel[r.b1];
     BodyVel3& B = vel[r.b2];
+    const RowExtra3* e = nullptr;
+    if constexpr (L::extra) e = extra + (&r - base);
     const Vec3 du = relative_velocity(r, A, B);
     Vec3 q;
     q[0] = r.n.dot(du) + r.bn - r.wnn * r.r[0];
     if constexpr (L::tangential) {
       q[1] = r.t1.dot(du) - r.wtt * r.r[1];
       q[2] = r.t2.dot(du) - r.wtt * r.r[2];
+      if constexpr (L::offsets) {
+        q[1] += e->bt1;
+        q[2] += e->bt2;
+      }
     } else {
       q[1] = q[2] = 0.0;
     }
     Vec3 rn;
-    L::solve(r, q, rn);
+    L::solve(r, e, q, rn);
     const Vec3 dr = rn - r.r;
     r.r = rn;
     dp2 = dr.squaredNorm();
@@ -83,9 +111,10 @@ struct BodyCoupling3 {
 }  // namespace sweep
 
 // The law residual of a row (law3.hpp, rho = 1/W_nn) at the velocity its
-// coupling gives.
+// coupling gives, with its RowExtra3 when the scene has them.
 inline double row_residual(const sweep::BodyCoupling3& c, const SphereRow& r) {
-  return law_residual3(c.velocity(r), r.r, Cone3::round(r.mu), r.adh, 1.0 / r.wnn);
+  const RowExtra3* e = c.extra_of(r);
+  return law_residual3(c.velocity(r), r.r, Cone3{r.mu, e ? e->mu_b : r.mu}, r.adh, 1.0 / r.wnn);
 }
 
 }  // namespace cd

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <omp.h>
 
@@ -23,7 +24,65 @@ void set_frame(SphereRow& row, int b1, int b2, const Vec3& n, const Vec3& c1, co
   row.adh = 0.0;
 }
 
+// Every plane against every (non-driven) sphere, planes in index order.
+void plane_rows(const Bodies3& bodies, const std::vector<Vec3>& x, double alert,
+                const std::vector<int>& planes, const std::vector<int>& spheres,
+                std::vector<SphereRow>& rows, std::vector<ContactInfo3>& info) {
+  for (const int p : planes)
+    for (const int k : spheres) {
+      if (bodies.driven[k]) continue;
+      SphereRow row;
+      ContactInfo3 inf;
+      if (plane_sphere(p, k, x[p], bodies.normal[p], x[k], bodies.radius[k], alert, row, inf)) {
+        rows.push_back(row);
+        info.push_back(inf);
+      }
+    }
+}
+
+int floor_div(int a, int n) { return a >= 0 ? a / n : -((-a + n - 1) / n); }
+int wrap_index(int a, int n) { return a - n * floor_div(a, n); }
+
 }  // namespace
+
+Vec3 PeriodicCell3::nearest_image(const Vec3& x1, const Vec3& x2, std::array<int, 3>& k) const {
+  Vec3 d = x2 - x1;
+  k = {0, 0, 0};
+  // y first: its images carry the Lees-Edwards shift along x.
+  if (periodic[1]) {
+    k[1] = static_cast<int>(-std::round(d.y() / size.y()));
+    d.y() += k[1] * size.y();
+    d.x() += k[1] * le_offset;
+  }
+  if (periodic[0]) {
+    k[0] = static_cast<int>(-std::round(d.x() / size.x()));
+    d.x() += k[0] * size.x();
+  }
+  if (periodic[2]) {
+    k[2] = static_cast<int>(-std::round(d.z() / size.z()));
+    d.z() += k[2] * size.z();
+  }
+  return x1 + d;
+}
+
+Vec3 PeriodicCell3::wrap(const Vec3& x, std::array<int, 3>& k) const {
+  Vec3 y = x;
+  k = {0, 0, 0};
+  if (periodic[1]) {
+    k[1] = -static_cast<int>(std::floor((y.y() - origin.y()) / size.y()));
+    y.y() += k[1] * size.y();
+    y.x() += k[1] * le_offset;
+  }
+  if (periodic[0]) {
+    k[0] = -static_cast<int>(std::floor((y.x() - origin.x()) / size.x()));
+    y.x() += k[0] * size.x();
+  }
+  if (periodic[2]) {
+    k[2] = -static_cast<int>(std::floor((y.z() - origin.z()) / size.z()));
+    y.z() += k[2] * size.z();
+  }
+  return y;
+}
 
 bool sphere_sphere(int i, int j, const Vec3& xi, const Vec3& xj, double ri, double rj,
                    double alert, SphereRow& row, ContactInfo3& info) {
@@ -163,16 +222,180 @@ void detect3(const Bodies3& bodies, const std::vector<Vec3>& x, double alert, Ce
       info.insert(info.end(), grid.info_t[t].begin(), grid.info_t[t].end());
     }
   }
-  for (const int p : planes)
-    for (const int k : spheres) {
-      if (bodies.driven[k]) continue;
+  plane_rows(bodies, x, alert, planes, spheres, rows, info);
+}
+
+}  // namespace cd
+
+namespace cd {
+
+void detect3(const Bodies3& bodies, const std::vector<Vec3>& x, double alert, const PeriodicCell3& cell,
+             CellGrid3& grid, std::vector<SphereRow>& rows, std::vector<ContactInfo3>& info,
+             int min_parallel) {
+  if (!cell.any()) {
+    detect3(bodies, x, alert, grid, rows, info, min_parallel);
+    return;
+  }
+  rows.clear();
+  info.clear();
+  const int nb = static_cast<int>(bodies.size());
+  std::vector<int> spheres, planes;
+  spheres.reserve(nb);
+  double rmax = 0;
+  // Spheres are binned at an image inside the cell (xw); the narrow phase
+  // takes the nearest image from the positions themselves.
+  std::vector<Vec3> xw(nb, Vec3::Zero());
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (int i = 0; i < nb; ++i) {
+    if (bodies.shape[i] == Shape3::Plane) {
+      planes.push_back(i);
+    } else {
+      spheres.push_back(i);
+      rmax = std::max(rmax, bodies.radius[i]);
+      std::array<int, 3> k;
+      xw[i] = cell.wrap(x[i], k);
+      lo = lo.cwiseMin(xw[i]);
+      hi = hi.cwiseMax(xw[i]);
+    }
+  }
+  const int ns = static_cast<int>(spheres.size());
+  const double reach = 2 * rmax + alert;
+  for (int a = 0; a < 3; ++a)
+    if (cell.periodic[a] && !(cell.size[a] >= 2 * reach))
+      throw std::invalid_argument("detect3: a periodic length is below 2 (2 r_max + alert)");
+  const int nthreads = omp_get_max_threads();
+  grid.rows_t.resize(nthreads);
+  grid.info_t.resize(nthreads);
+  if (ns > 1) {
+    // Periodic axes: n = floor(L / h) cells of side L / n >= h over the
+    // cell; the others: cells of side h over the bounding box. h >= reach,
+    // coarsened as in the open grid so that cells stay ~2 a sphere at most.
+    std::array<int, 3> n;
+    Vec3 side, org;
+    auto layout = [&](double h) {
+      double cells = 1;
+      for (int a = 0; a < 3; ++a) {
+        if (cell.periodic[a]) {
+          n[a] = std::max(1, static_cast<int>(std::floor(cell.size[a] / h)));
+          side[a] = cell.size[a] / n[a];
+          org[a] = cell.origin[a];
+        } else {
+          n[a] = static_cast<int>((hi[a] - lo[a]) / h) + 1;
+          side[a] = h;
+          org[a] = lo[a];
+        }
+        cells *= n[a];
+      }
+      return cells;
+    };
+    double h = reach;
+    const double cap = 2.0 * ns + 64;
+    while (layout(h) > cap) h *= 1.25;
+    const int nx = n[0], ny = n[1], nz = n[2];
+    const int ncell = nx * ny * nz;
+    auto axis = [&](double v, int a) {
+      const int c = static_cast<int>(std::floor((v - org[a]) / side[a]));
+      return cell.periodic[a] ? wrap_index(c, n[a]) : std::clamp(c, 0, n[a] - 1);
+    };
+    grid.cell_start.assign(ncell + 1, 0);
+    grid.cell_of.resize(ns);
+    for (int a = 0; a < ns; ++a) {
+      const Vec3& p = xw[spheres[a]];
+      const int c = (axis(p.z(), 2) * ny + axis(p.y(), 1)) * nx + axis(p.x(), 0);
+      grid.cell_of[a] = c;
+      ++grid.cell_start[c + 1];
+    }
+    for (int c = 0; c < ncell; ++c) grid.cell_start[c + 1] += grid.cell_start[c];
+    grid.items.resize(ns);
+    {
+      std::vector<int> pos(grid.cell_start.begin(), grid.cell_start.end() - 1);
+      for (int a = 0; a < ns; ++a) grid.items[pos[grid.cell_of[a]]++] = spheres[a];
+    }
+    const std::vector<int>& cs = grid.cell_start;
+    const std::vector<int>& it = grid.items;
+    const bool le = cell.periodic[0] && cell.periodic[1] && cell.le_offset != 0.0;
+    const bool par = ns >= min_parallel / 2;
+    for (int t = 0; t < nthreads; ++t) {
+      grid.rows_t[t].clear();
+      grid.info_t[t].clear();
+    }
+#pragma omp parallel if (par)
+    {
+      const int t = omp_get_thread_num();
+      std::vector<SphereRow>& R = grid.rows_t[t];
+      std::vector<ContactInfo3>& I = grid.info_t[t];
+      std::vector<int> nbr;
       SphereRow row;
       ContactInfo3 inf;
-      if (plane_sphere(p, k, x[p], bodies.normal[p], x[k], bodies.radius[k], alert, row, inf)) {
-        rows.push_back(row);
-        info.push_back(inf);
-      }
+      auto pair = [&](int i, int j) {
+        if (bodies.driven[i] && bodies.driven[j]) return;
+        if (bodies.driven[j] && !bodies.driven[i]) std::swap(i, j);
+        std::array<int, 3> k;
+        const Vec3 xj = cell.nearest_image(x[i], x[j], k);
+        if (sphere_sphere(i, j, x[i], xj, bodies.radius[i], bodies.radius[j], alert, row, inf)) {
+          inf.ix = static_cast<std::int8_t>(k[0]);
+          inf.iy = static_cast<std::int8_t>(k[1]);
+          inf.iz = static_cast<std::int8_t>(k[2]);
+          R.push_back(row);
+          I.push_back(inf);
+        }
+      };
+      // The whole 27-cell stencil, wrapped along periodic axes and without
+      // repeats (a periodic axis of 1 or 2 cells maps several offsets onto
+      // one cell); a pair is taken from the cell of its lower-index sphere.
+      // Across the y boundary of a Lees-Edwards cell the neighbours' images
+      // are shifted by +-le_offset along x: the x cells are those within h
+      // of this cell's x range once shifted back (up to 4).
+#pragma omp for schedule(static)
+      for (int cz = 0; cz < nz; ++cz)
+        for (int cy = 0; cy < ny; ++cy)
+          for (int cx = 0; cx < nx; ++cx) {
+            const int c = (cz * ny + cy) * nx + cx;
+            if (cs[c] == cs[c + 1]) continue;
+            nbr.clear();
+            for (int oz = -1; oz <= 1; ++oz) {
+              int qz = cz + oz;
+              if (cell.periodic[2]) qz = wrap_index(qz, nz);
+              else if (qz < 0 || qz >= nz) continue;
+              for (int oy = -1; oy <= 1; ++oy) {
+                int qy = cy + oy;
+                int cross = 0;
+                if (cell.periodic[1]) {
+                  cross = floor_div(qy, ny);
+                  qy -= cross * ny;
+                } else if (qy < 0 || qy >= ny) {
+                  continue;
+                }
+                int x0 = cx - 1, x1 = cx + 1;
+                if (le && cross != 0) {
+                  const double s = cross * cell.le_offset;
+                  x0 = static_cast<int>(std::floor((cx * side[0] - h - s) / side[0]));
+                  x1 = static_cast<int>(std::floor(((cx + 1) * side[0] + h - s) / side[0]));
+                }
+                for (int qx = x0; qx <= x1; ++qx) {
+                  int px = qx;
+                  if (cell.periodic[0]) px = wrap_index(qx, nx);
+                  else if (qx < 0 || qx >= nx) continue;
+                  nbr.push_back((qz * ny + qy) * nx + px);
+                }
+              }
+            }
+            std::sort(nbr.begin(), nbr.end());
+            nbr.erase(std::unique(nbr.begin(), nbr.end()), nbr.end());
+            for (int a = cs[c]; a < cs[c + 1]; ++a) {
+              const int i = it[a];
+              for (const int d : nbr)
+                for (int b = cs[d]; b < cs[d + 1]; ++b)
+                  if (i < it[b]) pair(i, it[b]);
+            }
+          }
     }
+    for (int t = 0; t < nthreads; ++t) {
+      rows.insert(rows.end(), grid.rows_t[t].begin(), grid.rows_t[t].end());
+      info.insert(info.end(), grid.info_t[t].begin(), grid.info_t[t].end());
+    }
+  }
+  plane_rows(bodies, x, alert, planes, spheres, rows, info);
 }
 
 }  // namespace cd

@@ -259,6 +259,71 @@ inline Branch3 solve_sphere3(double wnn, double wtt, const Vec3& q, double mu, d
   return Branch3::Slide;
 }
 
+// Euclidean projection of y onto the ellipse {(x1/e1)^2 + (x2/e2)^2 <= 1}
+// (semi-axes e1, e2 > 0). Outside, the closest point is x_i = e_i^2 y_i /
+// (e_i^2 + t) with t > 0 the root of
+//     F(t) = (e1 y1 / (e1^2 + t))^2 + (e2 y2 / (e2^2 + t))^2 - 1,
+// decreasing and convex on t >= 0 with F(0) > 0: Newton from t = 0 climbs
+// monotonically to the root (the tangent of a convex function lies below
+// it). Safeguarded anyway: the root is bracketed by [0, |(e1 y1, e2 y2)|]
+// (there every term is <= (e_i y_i / t)^2, so F <= 0), and a Newton step
+// that leaves the bracket is replaced by bisection. Converges to round-off in
+// a handful of steps.
+inline Eigen::Vector2d project_ellipse(const Eigen::Vector2d& y, double e1, double e2) {
+  const double a1 = e1 * y[0], a2 = e2 * y[1];
+  const double z1 = y[0] / e1, z2 = y[1] / e2;
+  if (z1 * z1 + z2 * z2 <= 1.0) return y;
+  const double s1 = e1 * e1, s2 = e2 * e2;
+  double lo = 0.0, hi = std::hypot(a1, a2), t = 0.0;
+  for (int it = 0; it < 200; ++it) {
+    const double d1 = 1.0 / (s1 + t), d2 = 1.0 / (s2 + t);
+    const double f1 = a1 * d1, f2 = a2 * d2;
+    const double F = f1 * f1 + f2 * f2 - 1.0;
+    if (F == 0.0) break;
+    if (F > 0.0) lo = t;
+    else hi = t;
+    const double dF = -2.0 * (f1 * f1 * d1 + f2 * f2 * d2);
+    double tn = t - F / dF;
+    if (!(tn > lo && tn < hi)) tn = 0.5 * (lo + hi);
+    if (std::abs(tn - t) <= 4e-16 * t || hi - lo <= 4e-16 * hi) {
+      t = tn;
+      break;
+    }
+    t = tn;
+  }
+  return {s1 * y[0] / (s1 + t), s2 * y[1] / (s2 + t)};
+}
+
+// The sphere block diag(W_nn, W_tt, W_tt) with an orthotropic cone
+// |(s_t1/mu_a, s_t2/mu_b)| <= s_n. The normal impulse decouples as in
+// solve_sphere3. Sliding: u_t = W_tt (s_t - g) with g = -q_t / W_tt the stick
+// trial, and maximal dissipation puts -u_t in the normal cone of the ellipse
+// E = {|D^-1 s_t| <= s_n} at s_t, i.e. g - s_t is normal to E there: s_t is
+// the Euclidean projection of g onto E (project_ellipse). Not opposite to
+// u_t unless mu_a = mu_b. A zero coefficient leaves that axis frictionless
+// and the other a 1D clamp. tests/test_world3_physics.cpp checks it against
+// solve_local3.
+inline Branch3 solve_sphere3_ortho(double wnn, double wtt, const Vec3& q, double mu_a, double mu_b,
+                                   double a, Vec3& r) {
+  const double sn = std::max(0.0, a - q[0] / wnn);
+  r[0] = sn - a;
+  if (sn == 0.0) {
+    r[1] = r[2] = 0.0;
+    return Branch3::Open;
+  }
+  const Eigen::Vector2d g(-q[1] / wtt, -q[2] / wtt);
+  if (mu_a == 0.0 || mu_b == 0.0) {
+    const double la = mu_a * sn, lb = mu_b * sn;
+    r[1] = std::clamp(g[0], -la, la);
+    r[2] = std::clamp(g[1], -lb, lb);
+    return (r[1] == g[0] && r[2] == g[1]) ? Branch3::Stick : Branch3::Slide;
+  }
+  const Eigen::Vector2d s = project_ellipse(g, mu_a * sn, mu_b * sn);
+  r[1] = s[0];
+  r[2] = s[1];
+  return (s[0] == g[0] && s[1] == g[1]) ? Branch3::Stick : Branch3::Slide;
+}
+
 // Natural-map residual of the law at (u, r), in impulse units, with De
 // Saxce's modified velocity, written in the cone's own metric (the unit
 // cone after the change of variables above):

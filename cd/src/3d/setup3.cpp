@@ -26,8 +26,6 @@ void check_scene3(const Scene& s) {
   if (s.nsides.size() != 1 || s.nsides[0] != 0)
     fail("particles.nsides: 3D particles are spheres; use [0]");
   if (!s.region.empty()) fail("particles.region: 3D spheres are placed on the box's lattice; use []");
-  if (s.e_n != 0) fail(fmt::format("contact.e_n = {}: the 3D engine has no restitution yet; use 0", s.e_n));
-  if (s.e_t != 0) fail(fmt::format("contact.e_t = {}: the 3D engine has no restitution yet; use 0", s.e_t));
   if (!s.rotation) fail("contact.rotation = false: the 3D engine always integrates rotations");
   if (s.box_height != 0) fail(fmt::format("box.height = {}: the 3D box is open at the top; use 0", s.box_height));
   if ((s.box_width > 0) != (s.box_depth > 0))
@@ -66,6 +64,8 @@ WorldParams3 world_params3(const Scene& s) {
   p.overlap_correction = s.overlap_correction;
   p.adhesion = s.adhesion;
   p.debond = s.debond * p.d_ref;
+  p.e_n = s.e_n;  // restitution by mean velocities (method.md section 14)
+  p.e_t = s.e_t;
   p.solver.tol = s.tol;
   p.solver.residual_tol = s.residual_tol;
   p.solver.max_iter = s.max_iter;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 
 #include "colour_rows.hpp"
 #include "coupling3.hpp"
@@ -15,9 +16,9 @@ namespace {
 
 
 template <class L>
-SolveStats solve_with(std::vector<SphereRow>& rows, const Colouring& col, std::vector<BodyVel3>& vel,
-                      const SolverParams& prm) {
-  sweep::BodyCoupling3 c{vel.data()};
+SolveStats solve_with(std::vector<SphereRow>& rows, const std::vector<RowExtra3>& extra, const Colouring& col,
+                      std::vector<BodyVel3>& vel, const SolverParams& prm) {
+  sweep::BodyCoupling3 c{vel.data(), extra.empty() ? nullptr : extra.data(), rows.data()};
   std::vector<NoDof3>* nodofs = nullptr;
   return sweep::solve<L>(rows, col, c, prm, nodofs, {});
 }
@@ -34,18 +35,55 @@ Quat rotate(const Quat& q, const Vec3& w, double h) {
 
 }  // namespace
 
+// The sweep instance of a scene: each flag fixed here, once.
+template <bool F, bool C, bool O>
+World3::SolveFn pick_law(bool ortho) {
+  return ortho ? &solve_with<SphereLaw3<F, C, O, true>> : &solve_with<SphereLaw3<F, C, O, false>>;
+}
+template <bool F, bool C>
+World3::SolveFn pick_law(bool offsets, bool ortho) {
+  return offsets ? pick_law<F, C, true>(ortho) : pick_law<F, C, false>(ortho);
+}
+template <bool F>
+World3::SolveFn pick_law(bool cohesion, bool offsets, bool ortho) {
+  return cohesion ? pick_law<F, true>(offsets, ortho) : pick_law<F, false>(offsets, ortho);
+}
+
 void World3::configure() {
   gravity_on_ = prm_.gravity.squaredNorm() > 0.0;
   adhesion_on_ = prm_.adhesion > 0.0;
+  restitution_on_ = prm_.e_n > 0.0 || prm_.e_t > 0.0;
+  periodic_on_ = prm_.periodic[0] || prm_.periodic[1] || prm_.periodic[2];
+  for (int a = 0; a < 3; ++a)
+    if (prm_.periodic[a] && !(prm_.cell[a] > 0.0))
+      throw std::invalid_argument("WorldParams3: a periodic axis needs cell > 0");
+  const bool le = prm_.le_offset != 0.0 || prm_.le_velocity != 0.0;
+  if (le && !(prm_.periodic[0] && prm_.periodic[1]))
+    throw std::invalid_argument("WorldParams3: Lees-Edwards needs periodic x and y");
+  moving_images_ = le && prm_.le_velocity != 0.0;
   // Contacts within the alert distance enter the solver with the gap term
-  // u_n + g_m/dt >= 0, which closes gaps without overlap (as in 2D).
-  alert_ = prm_.alert;
+  // u_n + g_m/dt >= 0, which closes gaps without overlap (as in 2D). With
+  // restitution the law acts at effective contacts only (gap <= 0): a gap
+  // term would stop a body short of the contact and lose the impact speed.
+  alert_ = restitution_on_ ? 0.0 : prm_.alert;
   if (adhesion_on_) alert_ = std::max(alert_, prm_.debond);
-  const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
-  if (adhesion_on_)
-    solve_fn_ = friction ? &solve_with<SphereLaw3<true, true>> : &solve_with<SphereLaw3<false, true>>;
-  else
-    solve_fn_ = friction ? &solve_with<SphereLaw3<true, false>> : &solve_with<SphereLaw3<false, false>>;
+  const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0 ||
+                        (prm_.orthotropic && (prm_.mu_b > 0.0 || prm_.mu_wall_b > 0.0));
+  // Tangential offsets: tangential restitution or moving images; they and
+  // the orthotropic mu_b are the rows' RowExtra3.
+  const bool offsets = prm_.e_t > 0.0 || moving_images_;
+  extras_on_ = friction && (offsets || prm_.orthotropic);
+  solve_fn_ = friction ? pick_law<true>(adhesion_on_, offsets, prm_.orthotropic)
+                       : pick_law<false>(adhesion_on_, false, false);
+}
+
+PeriodicCell3 World3::cell_at(double offset) const {
+  PeriodicCell3 c;
+  c.origin = prm_.cell_origin;
+  c.size = prm_.cell;
+  c.periodic = prm_.periodic;
+  c.le_offset = offset;
+  return c;
 }
 
 void World3::step() {
@@ -69,6 +107,9 @@ void World3::predict() {
   xm_.resize(n);
   qm_.resize(n);
   const bool par = static_cast<int>(n) >= prm_.solver.min_parallel / 2;
+  // Spheres placed outside a periodic cell are brought in first (the end
+  // of each step keeps them in), so that image counts stay small.
+  if (periodic_on_) wrap_into_cell(prm_.le_offset);
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t i = 0; i < n; ++i) {
     const BodyVel3& v = bodies.vel[i];
@@ -78,7 +119,11 @@ void World3::predict() {
 }
 
 void World3::detect_stage() {
-  detect3(bodies, xm_, alert_, grid_, rows_, info_, prm_.solver.min_parallel);
+  if (periodic_on_)
+    detect3(bodies, xm_, alert_, cell_at(prm_.le_offset + 0.5 * prm_.dt * prm_.le_velocity), grid_, rows_,
+            info_, prm_.solver.min_parallel);
+  else
+    detect3(bodies, xm_, alert_, grid_, rows_, info_, prm_.solver.min_parallel);
 }
 
 void World3::build() {
@@ -88,17 +133,56 @@ void World3::build() {
   const bool par = static_cast<int>(nr) >= prm_.solver.min_parallel;
   const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
   const double a = adhesion_on_ ? prm_.adhesion * dt : 0.0;
+  extra_.assign(extras_on_ ? nr : 0, RowExtra3{});
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t k = 0; k < nr; ++k) {
     SphereRow& r = rows_[k];
+    if (prm_.orthotropic) {
+      // t1 along the friction axis projected on the tangent plane.
+      const Vec3 ta = prm_.axis_a - prm_.axis_a.dot(r.n) * r.n;
+      const double la = ta.norm();
+      if (la > 1e-12 * prm_.axis_a.norm()) {
+        r.t1 = ta / la;
+        r.t2 = r.n.cross(r.t1);
+      }
+    }
     set_block(r, V[r.b1], V[r.b2]);
-    r.mu = bodies.driven[r.b1] ? prm_.mu_wall : prm_.mu;
+    const bool wall = bodies.driven[r.b1];
+    r.mu = wall ? prm_.mu_wall : prm_.mu;
+    RowExtra3* x = extras_on_ ? &extra_[k] : nullptr;
+    if (x) {
+      *x = RowExtra3{};
+      x->mu_b = prm_.orthotropic ? (wall ? prm_.mu_wall_b : prm_.mu_b) : r.mu;
+    }
     const double gap = info_[k].gap;
     // Gap term u_n + g_m/dt >= 0 for an open candidate (g_m > 0): the next
     // midpoint gap is g_m + dt u+_n >= 0 (2D's choice, method.md section 6);
     // an overlap separates at beta |g|/dt (beta = 0: pure CD).
     r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
     r.adh = adhesion_on_ && gap <= prm_.debond ? a : 0.0;
+    // A contact with a moving image of body 2 (Lees-Edwards, iy != 0): the
+    // image moves at iy le_velocity e_x more than body 2, and that velocity
+    // is part of the relative velocity the law sees.
+    Vec3 vimg = Vec3::Zero();
+    if (moving_images_ && info_[k].iy != 0) {
+      vimg = Vec3(info_[k].iy * prm_.le_velocity, 0.0, 0.0);
+      r.bn += r.n.dot(vimg);
+      if (x) {
+        x->bt1 = r.t1.dot(vimg);
+        x->bt2 = r.t2.dot(vimg);
+      }
+    }
+    // Restitution: the law on u+ + e u-, u- the relative velocity at the
+    // start of the step (before gravity) in the midpoint frame, only
+    // approaching normal velocities restituted.
+    if (restitution_on_) {
+      const Vec3 u = relative_velocity(r, V[r.b1], V[r.b2]) + vimg;
+      r.bn += prm_.e_n * std::min(r.n.dot(u), 0.0);
+      if (x) {
+        x->bt1 += prm_.e_t * r.t1.dot(u);
+        x->bt2 += prm_.e_t * r.t2.dot(u);
+      }
+    }
     // Warm start: the previous impulse by contact key, on the new frame.
     const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
     if (it != warm_.keys.end() && *it == info_[k].key) {
@@ -115,13 +199,16 @@ void World3::colour() {
   const std::vector<std::int32_t>& perm = colouring_.perm;
   std::vector<SphereRow> r(rows_.size());
   std::vector<ContactInfo3> f(info_.size());
+  std::vector<RowExtra3> e(extra_.size());
 #pragma omp parallel for schedule(static) if (static_cast<int>(rows_.size()) >= prm_.solver.min_parallel)
   for (std::size_t k = 0; k < rows_.size(); ++k) {
     r[k] = rows_[perm[k]];
     f[k] = info_[perm[k]];
+    if (!e.empty()) e[k] = extra_[perm[k]];
   }
   rows_.swap(r);
   info_.swap(f);
+  extra_.swap(e);
 }
 
 void World3::solve() {
@@ -141,7 +228,7 @@ void World3::solve() {
     A.v -= A.inv_m * P;
     A.w -= A.inv_I * r.c1.cross(P);
   }
-  last_.solve = solve_fn_(rows_, colouring_, V, prm_.solver);
+  last_.solve = solve_fn_(rows_, extra_, colouring_, V, prm_.solver);
 
   // Keep the impulses (world frame) for the next step's warm start.
   const std::size_t nr = rows_.size();
@@ -164,6 +251,25 @@ void World3::integrate() {
     const BodyVel3& v = bodies.vel[i];
     bodies.pos[i] = xm_[i] + h * v.v;
     bodies.orient[i] = rotate(qm_[i], v.w, h);
+  }
+  if (!periodic_on_) return;
+  double off = prm_.le_offset + prm_.dt * prm_.le_velocity;
+  if (prm_.periodic[0]) off -= prm_.cell.x() * std::floor(off / prm_.cell.x());
+  wrap_into_cell(off);
+  prm_.le_offset = off;
+}
+
+// Spheres back into the periodic cell at Lees-Edwards offset `off`: a
+// sphere moved by ky images across y takes the images' shift and velocity.
+void World3::wrap_into_cell(double off) {
+  const std::size_t n = bodies.size();
+  const PeriodicCell3 c = cell_at(off);
+#pragma omp parallel for schedule(static) if (static_cast<int>(n) >= prm_.solver.min_parallel / 2)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (bodies.shape[i] != Shape3::Sphere) continue;
+    std::array<int, 3> k;
+    bodies.pos[i] = c.wrap(bodies.pos[i], k);
+    if (k[1] != 0) bodies.vel[i].v.x() += k[1] * prm_.le_velocity;
   }
 }
 

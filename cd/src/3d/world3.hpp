@@ -2,17 +2,22 @@
 // stage table of core/stages.hpp (the 3D sibling of 2d/world.hpp; midpoint
 // Moreau-Jean scheme, method.md sections 6 and 14):
 //   predict    x_m = x + dt/2 v-, q_m = exp(dt/2 w-) q (unit quaternion)
-//   detect     contacts at the midpoint configuration (detect3.hpp)
-//   build      W blocks, gap terms, friction, adhesion, warm start
+//   detect     contacts at the midpoint configuration (detect3.hpp),
+//              through periodic images in a periodic cell
+//   build      frames (orthotropic axes), W blocks, gap terms, image
+//              velocities, restitution, friction, adhesion, warm start
 //   colour     rows in colour order (core/colour_rows.hpp)
 //   solve      gravity, warm start into the velocities, NLGS
 //              (core/sweep.hpp through BodyCoupling3), impulses kept for
 //              the next warm start
-//   integrate  x+ = x_m + dt/2 v+, q+ = exp(dt/2 w+) q_m
+//   integrate  x+ = x_m + dt/2 v+, q+ = exp(dt/2 w+) q_m; back into a
+//              periodic cell, the Lees-Edwards offset advanced
 //   observe    contacts, active contacts, overlaps
-// The law (frictionless, Coulomb, cohesive or not) is fixed once per scene
-// into a template instance of the sweep.
+// The law (frictionless, Coulomb round or orthotropic, cohesive or not, with
+// or without tangential offsets) is fixed once per scene into a template
+// instance of the sweep.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -39,6 +44,35 @@ struct WorldParams3 {
   double adhesion = 0.0, debond = 0.0;
   double d_ref = 1.0;  // length scale for overlaps (mean diameter)
   SolverParams solver;
+
+  // Restitution by mean velocities (Moreau's impact law, method.md section
+  // 14): the law acts on u+ + e u-, u- the relative velocity at the start of
+  // the step, with b_n += e_n min(u-_n, 0), b_t += e_t u-_t. On (e_n > 0 or
+  // e_t > 0) the alert distance is 0: the law acts at effective contacts
+  // (gap <= 0) only, as in 2D. 0: off, at no cost.
+  double e_n = 0.0, e_t = 0.0;
+
+  // Orthotropic Coulomb (off unless `orthotropic`): every row's t1 is
+  // axis_a projected on its tangent plane (t2 = n x t1), and the cone is
+  // |(s_t1/mu_a, s_t2/mu_b)| <= s_n with (mu_a, mu_b) = (mu, mu_b) between
+  // spheres and (mu_wall, mu_wall_b) on walls. A tangent plane normal to
+  // axis_a keeps the default frame.
+  bool orthotropic = false;
+  Vec3 axis_a = Vec3::UnitX();
+  double mu_b = 0.0, mu_wall_b = 0.0;
+
+  // Periodic cell (off unless some periodic[a]): along a periodic axis the
+  // spheres meet the images of the others and are brought back into
+  // [cell_origin, cell_origin + cell) at the end of each step. Lees-Edwards
+  // (periodic x and y): the images across y, at +-cell.y, are shifted along x
+  // by +-le_offset and move at +-le_velocity along x (shear along x,
+  // gradient along y); a sphere brought back across y has its x and v_x
+  // shifted with them. le_offset is the current shift: each step advances it
+  // by le_velocity dt (kept in [0, cell.x)). Each periodic length must be
+  // >= 2 (2 r_max + alert).
+  Vec3 cell_origin = Vec3::Zero(), cell = Vec3::Zero();
+  std::array<bool, 3> periodic{false, false, false};
+  double le_offset = 0.0, le_velocity = 0.0;
 };
 
 class World3 {
@@ -58,8 +92,11 @@ class World3 {
 
   void step();
   const StepStats& last() const { return last_; }
-  // The last step's rows (solved) and their records, in colour order.
+  // The last step's rows (solved) and their records, in colour order
+  // (extras: empty unless the scene has tangential offsets or an
+  // orthotropic cone).
   const std::vector<SphereRow>& rows() const { return rows_; }
+  const std::vector<RowExtra3>& row_extras() const { return extra_; }
   const std::vector<ContactInfo3>& infos() const { return info_; }
 
   double kinetic_energy() const;    // translational + rotational, dynamic bodies
@@ -76,6 +113,10 @@ class World3 {
   // Restores the warm-start memory (a checkpoint; checkpoint3.cpp).
   void set_warm_start(WarmStart w) { warm_ = std::move(w); }
 
+  // A scene's sweep instance (chosen in configure).
+  using SolveFn = SolveStats (*)(std::vector<SphereRow>&, const std::vector<RowExtra3>&, const Colouring&,
+                                 std::vector<BodyVel3>&, const SolverParams&);
+
  private:
   void configure();
   void predict();
@@ -86,10 +127,12 @@ class World3 {
   void integrate();
   void observe();
 
-  using SolveFn = SolveStats (*)(std::vector<SphereRow>&, const Colouring&, std::vector<BodyVel3>&,
-                                 const SolverParams&);
+  PeriodicCell3 cell_at(double offset) const;
+  void wrap_into_cell(double offset);
+
   WorldParams3 prm_;
-  bool gravity_on_ = false, adhesion_on_ = false;
+  bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, periodic_on_ = false,
+       moving_images_ = false, extras_on_ = false;
   double alert_ = 0.0;
   SolveFn solve_fn_ = nullptr;
   StepStats last_;
@@ -97,6 +140,7 @@ class World3 {
   std::vector<Quat> qm_;
   std::vector<SphereRow> rows_;
   std::vector<ContactInfo3> info_;
+  std::vector<RowExtra3> extra_;  // same index as rows_; empty unless extras_on_
   Colouring colouring_;
   CellGrid3 grid_;
   WarmStart warm_;
