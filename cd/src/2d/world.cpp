@@ -254,13 +254,28 @@ void World::integrate() {
 // smallest mass-weighted displacement that removes the fraction beta_p of
 // every overlap; dt times it goes into the midpoint positions (and the
 // cell), never into the velocities: no kinetic energy is put in. Run only
-// when some contact overlaps; at most kProjectionSweeps sweeps.
+// on steps where some overlap reaches kProjectionTrigger of its pair's
+// smaller diameter (the solve costs sweeps, and on every step it would keep
+// a jammed sample's main solve from settling: measured, 313 instead of 210
+// sweeps a step at ratio 4, N = 300); at most kProjectionSweeps sweeps.
 void World::project_overlaps() {
   constexpr int kProjectionSweeps = 100;
   last_.projection_work = 0.0;
   const std::size_t nr = prob_.rows.size();
-  if (std::none_of(info_.begin(), info_.end(), [](const ContactInfo& f) { return f.gap < 0.0; }))
-    return;
+  // Only when some overlap reaches kProjectionTrigger of the smaller grain's
+  // diameter of its pair (a wall's grain's): below it, overlaps are left.
+  constexpr double kProjectionTrigger = 1e-3;
+  bool due = false;
+  for (std::size_t k = 0; k < nr && !due; ++k) {
+    if (info_[k].gap >= 0.0) continue;
+    const ContactRow& r = prob_.rows[k];
+    const bool s1 = bodies.shape[r.b1] == Shape::Segment, s2 = bodies.shape[r.b2] == Shape::Segment;
+    const double d = 2.0 * (s1 ? bodies.radius[r.b2]
+                               : s2 ? bodies.radius[r.b1]
+                                    : std::min(bodies.radius[r.b1], bodies.radius[r.b2]));
+    due = -info_[k].gap >= kProjectionTrigger * d;
+  }
+  if (!due) return;
   const double beta = prm_.overlap_projection, dt = prm_.dt;
   ContactProblem& q = proj_;
   q.rows = prob_.rows;

@@ -74,7 +74,8 @@ struct WorldParams {
   // overlapping contact by beta_p times its midpoint overlap and close no
   // open one, the cell's lengths free; the positions (and cell) move by dt
   // times them, the velocities not at all, so it puts no kinetic energy in
-  // (World::project_overlaps). The contact forces' work on those
+  // (World::project_overlaps). Only on steps where some overlap reaches
+  // 1e-3 of its pair's smaller diameter. The contact forces' work on those
   // displacements, sum f_n dt u_n, is StepStats::projection_work. 0: off.
   double overlap_projection = 0.0;
   // Adhesion-shifted Signorini law (method.md section 2): pull-off force f_a
