@@ -90,7 +90,7 @@ const std::vector<Case>& cases() {
        120, 0x97cc3d83742e16b8ull},
       {"prep_controlled", "shear-prep.toml", {"particles.n=120", "shear.width=0.0165",
                                               "shear.height=0.0185", "solver.tol=1e-3"},
-       400, 0x7fb983da159de3bcull},
+       700, 0xfa84acc4596fbaafull},
       {"lees_edwards", "shear-prep.toml",
        {"particles.n=120", "shear.width=0.0165", "shear.height=0.0185", "shear.isotropic=false",
         "shear.inertial_number=0.1", "solver.tol=1e-3",

@@ -73,14 +73,15 @@ void LeesEdwardsCell::set_dofs(World& w) const {
   const CellState& cm = w.cm_;
   const CellState& cell = w.cell;
   // With max_strain_rate, the free velocity of a length L is bounded below
-  // by -max_strain_rate L (a controlled compaction rate), and by half the
-  // alert distance a step: the images then approach the grains across the
-  // boundary by less than the alert distance in a step, so those contacts
-  // are detected before they close, whatever the cell's size.
+  // by -max_strain_rate L (a controlled compaction rate), and by a quarter
+  // of the alert distance a step: the images then approach the grains
+  // across the boundary by well under the alert distance in a step, so those
+  // contacts are detected before they close, and the grains they hit move
+  // (and spin) no faster, whatever the cell's size.
   const double inf = std::numeric_limits<double>::infinity();
   const double rate = c.max_strain_rate;
   const auto floor = [&](double L) {
-    return rate > 0.0 ? -std::min(rate * L, 0.5 * w.alert_ / w.prm_.dt) : -inf;
+    return rate > 0.0 ? -std::min(rate * L, 0.25 * w.alert_ / w.prm_.dt) : -inf;
   };
   dofs.push_back(w.make_dof(cell.hdot, (c.pressure - K(1, 1)) * cm.width, cm.width, floor(cm.height)));
   if (c.isotropic)

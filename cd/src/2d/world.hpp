@@ -51,7 +51,7 @@ struct CellParams {
   bool isotropic = false;
   // > 0 (LeesEdwards with a pressure): a length dof L (height, width) may
   // shrink at most at this strain rate, -dL/dt <= max_strain_rate L (1/s),
-  // and by at most half the alert distance a step. The bound acts on the
+  // and by at most a quarter of the alert distance a step. The bound acts on the
   // dof's free velocity v0 (the imposed stress's impulse): a brake on the
   // pressure-driven collapse, which the contacts, pushing the cell apart,
   // never undo. 0: no bound.
