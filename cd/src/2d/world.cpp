@@ -257,7 +257,9 @@ void World::integrate() {
 // on steps where some overlap reaches kProjectionTrigger of its pair's
 // smaller diameter (the solve costs sweeps, and on every step it would keep
 // a jammed sample's main solve from settling: measured, 313 instead of 210
-// sweeps a step at ratio 4, N = 300); at most kProjectionSweeps sweeps.
+// main-solve sweeps a step at ratio 4, N = 300, beta_p = 0.2); at most
+// kProjectionSweeps sweeps, which are not in StepStats (their time is in
+// the integrate stage's).
 void World::project_overlaps() {
   constexpr int kProjectionSweeps = 100;
   last_.projection_work = 0.0;
