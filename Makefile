@@ -14,6 +14,8 @@ DEB_PKGS := g++ cmake make pkg-config libeigen3-dev libgsl-dev libfftw3-dev \
             libbenchmark-dev gnuplot-nox libfclib-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
+
+.PHONY: prep-overlap
 .PHONY: all deps build run test bench regress accuracy-cost accuracy-shear tensile clean help analyze-inertial analyze-inertial-ladder analyze-cohesive analyze-angularity scene-doc figures frozen-shear
 
 all: build
@@ -35,6 +37,7 @@ help:
 	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
 	@echo "make frozen-shear   steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into $(FROZEN)/ [FS_N=1000]"
 	@echo "make regress        re-run the reference campaign, refit mu(I), compare with tests/data/regress/"
+	@echo "make prep-overlap   ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N (1000): fails if an overlap reaches 0.01 d_small"
 	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity"
 	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
 
@@ -119,6 +122,22 @@ accuracy-cost: build
 # Cohesion against the time step (docs/accuracy.md, "Cohesion and the time step").
 tensile: build
 	$(BUILD)/cd/bench/tensile --out outputs/tensile $(if $(QUICK),--quick)
+
+# ---- Overlaps of the preparation (docs/shear.md) ------------------------------
+# The validation beside tests/test_prep_overlap.cpp's small hard cases: full
+# preparations (configs/shear-prep.toml, cell sized for the grains) at N =
+# PO_N, one thread each, every step's largest overlap / the smaller grain
+# checked against 0.01. About 1 (disks) to 4 (hexagons) minutes each at 1000.
+PO_N ?= 1000
+prep-overlap: build
+	@for set in "particles.nsides=[0] particles.size_ratio=4" "particles.nsides=[6] particles.size_ratio=4" \
+	            "particles.nsides=[3,6,0] particles.size_ratio=5"; do \
+	  echo "== $$set"; \
+	  OMP_NUM_THREADS=1 CDLAB_PREP_SET="particles.n=$(PO_N) shear.width=0 shear.height=0 $$set" \
+	    $(BUILD)/tests/test_prep_overlap --gtest_also_run_disabled_tests --gtest_filter='*Diagnose*' \
+	    > $(BUILD)/prep-overlap.log 2>&1; st=$$?; \
+	  grep -E '^prep:|Failure|actual' $(BUILD)/prep-overlap.log; [ $$st = 0 ] || exit 1; \
+	done
 
 # ---- Campaigns (docs/shear.md) ----------------------------------------------
 # Each run is a make target whose product is its folder (marked complete by

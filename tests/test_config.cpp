@@ -35,15 +35,15 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 }
 
 void compare(const Scene& x, const Scene& y, bool same) {
-  const auto& [name, source, dimension, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, adhesion, debond, tol,
+  const auto& [name, source, dimension, dt, duration, gravity, mu, mu_wall, e_n, e_t, alert, rotation, overlap_correction, overlap_projection, adhesion, debond, tol,
                max_iter, residual_tol, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
                box_width, box_height, box_depth, disks, walls, series_interval, snapshot_interval,
                checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, pressure,
-               inertial_number, cell_mass, isotropic, strain, dt_tp, start, cohesion_number] = x;
+               inertial_number, cell_mass, isotropic, compaction_rate, strain, dt_tp, start, cohesion_number] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dimension); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
-  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(adhesion); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(threads);
+  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(overlap_projection); CHECK_FIELD(adhesion); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(threads);
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
   CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
@@ -51,7 +51,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(checkpoint_interval); CHECK_FIELD(checkpoint_strain); CHECK_FIELD(checkpoint_wall);
   CHECK_FIELD(quiet);
   CHECK_FIELD(shear_mode); CHECK_FIELD(cell_width); CHECK_FIELD(cell_height); CHECK_FIELD(pressure);
-  CHECK_FIELD(inertial_number); CHECK_FIELD(cell_mass); CHECK_FIELD(isotropic); CHECK_FIELD(strain);
+  CHECK_FIELD(inertial_number); CHECK_FIELD(cell_mass); CHECK_FIELD(isotropic); CHECK_FIELD(compaction_rate); CHECK_FIELD(strain);
   CHECK_FIELD(dt_tp); CHECK_FIELD(start); CHECK_FIELD(cohesion_number);
   if (same) {
     ASSERT_EQ(disks.size(), y.disks.size());
@@ -76,6 +76,7 @@ Scene nondefault() {
   s.alert = 0.05;
   s.rotation = false;
   s.overlap_correction = 0.25;
+  s.overlap_projection = 0.3;
   s.adhesion = 2.5e-3;
   s.debond = 0.02;
   s.tol = 1e-6;
@@ -110,6 +111,7 @@ Scene nondefault() {
   s.inertial_number = 0.01;
   s.cell_mass = 2.0;
   s.isotropic = true;
+  s.compaction_rate = 0.02;
   s.strain = 3.0;
   s.dt_tp = 0.1;
   s.start = "prep/checkpoint.bin";
@@ -210,6 +212,8 @@ TEST(Errors, NonFiniteNumbers) {
       {"[contact]\nmu_wall = nan", "x.toml:2:1: contact.mu_wall = nan: must be a finite number"},
       {"[solver]\ntol = inf", "x.toml:2:1: solver.tol = inf: must be a finite number"},
       {"[shear]\nstrain = inf", "x.toml:2:1: shear.strain = inf: must be a finite number"},
+      {"[shear]\ncompaction_rate = nan", "x.toml:2:1: shear.compaction_rate = nan: must be a finite number"},
+      {"[contact]\noverlap_projection = inf", "x.toml:2:1: contact.overlap_projection = inf: must be a finite number"},
       {"[gravity]\ng = [0, -inf]", "x.toml:2:1: gravity.g: element 1 is -inf: must be finite numbers"},
       {"[gravity]\ng = [nan, -9.81]", "x.toml:2:1: gravity.g: element 0 is nan: must be finite numbers"},
       {"[[disk]]\npos = [0, 0]\nradius = inf", "x.toml:3:1: disk[0].radius = inf: must be a finite number"},
@@ -225,6 +229,8 @@ TEST(Errors, ValueOutOfRange) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"[contact]\ne_n = 1.5", "x.toml:2:1: contact.e_n = 1.5: must be in [0, 1]"},
       {"[contact]\ne_t = -0.1", "x.toml:2:1: contact.e_t = -0.1: must be in [0, 1]"},
+      {"[contact]\noverlap_projection = 1.5", "x.toml:2:1: contact.overlap_projection = 1.5: must be in [0, 1]"},
+      {"[shear]\ncompaction_rate = -0.01", "x.toml:2:1: shear.compaction_rate = -0.01: must be in [0, 1]"},
       {"[contact]\nmu = -0.1", "x.toml:2:1: contact.mu = -0.1: must be >= 0"},
       {"[time]\ndt = 0", "x.toml:2:1: time.dt = 0: must be > 0"},
       {"[time]\nduration = -1", "x.toml:2:1: time.duration = -1: must be >= 0"},
@@ -371,9 +377,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 46 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 50 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 48u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 50u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

@@ -81,11 +81,21 @@ const std::vector<Case>& cases() {
        with(kSmallPile, {"contact.adhesion=2e-4", "contact.debond=0.02"}), 150, 0x3ab28c3c445bc922ull},
       {"hexagons", "hexagons.toml", kSmallPile, 150, 0x8cf1cfeb9dcbc25dull},
       {"mixture", "mixture.toml", kSmallPile, 150, 0x992ed57c1a8cdd34ull},
+      // The free collapse under p (no compaction bound, no projection), as
+      // shear-prep.toml was before it set shear.compaction_rate and
+      // contact.overlap_projection; prep_controlled is the scene as it is.
       {"compaction", "shear-prep.toml", {"particles.n=120", "shear.width=0.0165",
-                                         "shear.height=0.0185", "solver.tol=1e-3"}, 120, 0x97cc3d83742e16b8ull},
+                                         "shear.height=0.0185", "solver.tol=1e-3",
+                                         "shear.compaction_rate=0", "contact.overlap_projection=0"},
+       120, 0x97cc3d83742e16b8ull},
+      {"prep_controlled", "shear-prep.toml", {"particles.n=120", "shear.width=0.0165",
+                                              "shear.height=0.0185", "solver.tol=1e-3"},
+       700, 0xfa84acc4596fbaafull},
       {"lees_edwards", "shear-prep.toml",
        {"particles.n=120", "shear.width=0.0165", "shear.height=0.0185", "shear.isotropic=false",
-        "shear.inertial_number=0.1", "solver.tol=1e-3"}, 120, 0xa8911de31c1bebdbull},
+        "shear.inertial_number=0.1", "solver.tol=1e-3",
+        // a shear run: without the preparation's compaction bound and projection
+        "shear.compaction_rate=0", "contact.overlap_projection=0"}, 120, 0xa8911de31c1bebdbull},
       // The walls scenes changed with the mu_wall fix (a driven body is now
       // body 1 of its contacts: the glued grains' contacts are reversed,
       // the same physics in other round-off). Before it: 0xfaf171a2af56d23f
@@ -109,7 +119,7 @@ TEST_P(StateHash, IsUnchangedByRefactors) {
   EXPECT_EQ(h, c.expected) << c.name;
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, StateHash, testing::Range<std::size_t>(0, 11),
+INSTANTIATE_TEST_SUITE_P(Scenes, StateHash, testing::Range<std::size_t>(0, 12),
                          [](const testing::TestParamInfo<std::size_t>& i) {
                            return std::string(cases()[i.param].name);
                          });

@@ -1,6 +1,8 @@
 #include "boundary.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "world.hpp"
 
@@ -70,8 +72,20 @@ void LeesEdwardsCell::set_dofs(World& w) const {
   const Eigen::Matrix2d K = w.kinetic_stress();
   const CellState& cm = w.cm_;
   const CellState& cell = w.cell;
-  dofs.push_back(w.make_dof(cell.hdot, (c.pressure - K(1, 1)) * cm.width, cm.width));
-  if (c.isotropic) dofs.push_back(w.make_dof(cell.wdot, (c.pressure - K(0, 0)) * cm.height, cm.height));
+  // With max_strain_rate, the free velocity of a length L is bounded below
+  // by -max_strain_rate L (a controlled compaction rate), and by a quarter
+  // of the alert distance a step: the images then approach the grains
+  // across the boundary by well under the alert distance in a step, so those
+  // contacts are detected before they close, and the grains they hit move
+  // (and spin) no faster, whatever the cell's size.
+  const double inf = std::numeric_limits<double>::infinity();
+  const double rate = c.max_strain_rate;
+  const auto floor = [&](double L) {
+    return rate > 0.0 ? -std::min(rate * L, 0.25 * w.alert_ / w.prm_.dt) : -inf;
+  };
+  dofs.push_back(w.make_dof(cell.hdot, (c.pressure - K(1, 1)) * cm.width, cm.width, floor(cm.height)));
+  if (c.isotropic)
+    dofs.push_back(w.make_dof(cell.wdot, (c.pressure - K(0, 0)) * cm.height, cm.height, floor(cm.width)));
   for (std::size_t k = 0; k < w.prob_.rows.size(); ++k) {
     const ContactInfo& f = w.info_[k];
     const ContactRow& r = w.prob_.rows[k];
@@ -151,6 +165,17 @@ void LeesEdwardsCell::integrate(World& w, double h) const {
       bodies.vel[i].vy -= uy;
     }
   }
+}
+
+void LeesEdwardsCell::pseudo_dofs(std::vector<BoundaryDof>& dofs) const {
+  for (BoundaryDof& d : dofs) d.v0 = d.v = 0.0;
+}
+
+void LeesEdwardsCell::apply_pseudo_dofs(World& w, const std::vector<BoundaryDof>& dofs,
+                                        double dt) const {
+  if (dofs.empty()) return;
+  w.cm_.height += dt * dofs[0].v;
+  if (dofs.size() > 1) w.cm_.width += dt * dofs[1].v;
 }
 
 // ---- wall-driven shear --------------------------------------------------

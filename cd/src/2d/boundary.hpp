@@ -13,9 +13,11 @@
 // Each hook is called by one stage of World::step (world.cpp), named after it.
 #pragma once
 #include <variant>
+#include <vector>
 
 #include "bodies.hpp"
 #include "contact.hpp"
+#include "contact_problem.hpp"
 
 namespace cd {
 
@@ -35,6 +37,8 @@ struct NoBoundary {
   void set_dofs(World&) const {}
   void take_dofs(World&) const {}
   void integrate(World&, double /*h*/) const {}
+  void pseudo_dofs(std::vector<BoundaryDof>& d) const { d.clear(); }
+  void apply_pseudo_dofs(World&, const std::vector<BoundaryDof>&, double) const {}
 };
 
 struct LeesEdwardsCell {
@@ -52,6 +56,11 @@ struct LeesEdwardsCell {
   void set_dofs(World& w) const;
   void take_dofs(World& w) const;
   void integrate(World& w, double h) const;
+  // Overlap projection (World::project_overlaps): the cell's lengths take
+  // part unloaded (free velocity 0), and their pseudo-velocities times dt
+  // go into the midpoint cell.
+  void pseudo_dofs(std::vector<BoundaryDof>& d) const;
+  void apply_pseudo_dofs(World& w, const std::vector<BoundaryDof>& d, double dt) const;
 };
 
 struct WallShear {
@@ -66,6 +75,9 @@ struct WallShear {
   void set_dofs(World& w) const;
   void take_dofs(World& w) const;
   void integrate(World& w, double h) const;
+  // Overlap projection: the top wall is held (no dof).
+  void pseudo_dofs(std::vector<BoundaryDof>& d) const { d.clear(); }
+  void apply_pseudo_dofs(World&, const std::vector<BoundaryDof>&, double) const {}
 };
 
 using Boundary = std::variant<NoBoundary, LeesEdwardsCell, WallShear>;

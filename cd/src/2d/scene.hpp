@@ -49,6 +49,7 @@ struct Scene {
   double alert = 0.1;        // alert distance, in mean diameters
   bool rotation = WorldParams{}.rotation;  // integrate rotations
   double overlap_correction = 0.0;  // beta: overlaps separate at beta |gap|/dt (0: none)
+  double overlap_projection = 0.0;  // beta_p: centres moved apart by beta_p |gap| a step (0: none)
   double adhesion = 0.0;     // pull-off force f_a (N); 0: no cohesion
   double debond = 0.01;      // debonding distance delta_a, in mean diameters
 
@@ -101,6 +102,7 @@ struct Scene {
   double inertial_number = 0.0;     // imposed I: gamma-dot = I sqrt(p/rho) / d
   double cell_mass = 0.1;           // mass of the height (width) dof, in total particle mass
   bool isotropic = false;           // compaction: the width is a dof too (periodic, I = 0)
+  double compaction_rate = 0.0;     // > 0: cell lengths shrink at most at this rate x 1/t_p
   double strain = 0.0;              // > 0: run until this shear strain (overrides duration)
   double dt_tp = 0.0;               // > 0: dt = dt_tp x t_p, t_p = d sqrt(rho/p)
   std::string start;                // checkpoint.bin of a preparation run to start from

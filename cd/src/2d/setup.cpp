@@ -122,9 +122,9 @@ void check_shear(const Scene& s) {
   }
   if (s.dt_tp > 0 && s.pressure <= 0) fail("shear.dt_tp > 0 needs shear.pressure > 0 (t_p = d sqrt(rho/p))");
   if (!shear) {
-    if (s.inertial_number > 0 || s.isotropic || !s.start.empty() || s.strain > 0)
-      fail("shear.inertial_number, shear.isotropic, shear.strain and shear.start need shear.mode "
-           "\"periodic\" or \"walls\"");
+    if (s.inertial_number > 0 || s.isotropic || !s.start.empty() || s.strain > 0 || s.compaction_rate > 0)
+      fail("shear.inertial_number, shear.isotropic, shear.strain, shear.start and "
+           "shear.compaction_rate need shear.mode \"periodic\" or \"walls\"");
     return;
   }
   // 0 x 0: a periodic cell sized for the generated particles (with_auto_cell)
@@ -142,6 +142,9 @@ void check_shear(const Scene& s) {
   if (s.isotropic && (s.shear_mode != "periodic" || s.inertial_number > 0))
     fail("shear.isotropic (compaction) needs shear.mode = \"periodic\" and shear.inertial_number = 0");
   if (s.strain > 0 && s.inertial_number <= 0) fail("shear.strain > 0 needs shear.inertial_number > 0");
+  if (s.compaction_rate > 0 && (s.shear_mode != "periodic" || s.pressure <= 0))
+    fail("shear.compaction_rate > 0 needs shear.mode = \"periodic\" and shear.pressure > 0 (it "
+         "bounds the rate of the cell's pressure-controlled lengths)");
   if (!s.start.empty() && s.shear_mode != "periodic")
     fail("shear.start needs shear.mode = \"periodic\" (a walls run places its own grains "
          "between its walls)");
@@ -211,6 +214,7 @@ WorldParams world_params(const Scene& s0) {
   p.d_ref = mean_diameter(s);
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
+  p.overlap_projection = s.overlap_projection;
   p.adhesion = s.cohesion_number > 0 ? s.cohesion_number * s.pressure * p.d_ref : s.adhesion;
   p.debond = s.debond * p.d_ref;
   if (s.shear_mode != "none") {
@@ -220,6 +224,8 @@ WorldParams world_params(const Scene& s0) {
     c.pressure = s.pressure;
     c.isotropic = s.isotropic;
     c.shear_rate = shear_rate(s);
+    const double tp = pressure_time(s);
+    c.max_strain_rate = s.compaction_rate > 0 && tp > 0 ? s.compaction_rate / tp : 0.0;
     // c.mass: set by build_world, which knows the particles' mass
   }
   p.solver.tol = s.tol;

@@ -17,6 +17,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "bodies.hpp"
@@ -48,6 +49,13 @@ struct CellParams {
   double pressure = 0.0;       // imposed normal stress (N/m); 0: height fixed
   double mass = 0.0;           // mass of the height (and width) dof (kg)
   bool isotropic = false;
+  // > 0 (LeesEdwards with a pressure): a length dof L (height, width) may
+  // shrink at most at this strain rate, -dL/dt <= max_strain_rate L (1/s),
+  // and by at most a quarter of the alert distance a step. The bound acts on the
+  // dof's free velocity v0 (the imposed stress's impulse): a brake on the
+  // pressure-driven collapse, which the contacts, pushing the cell apart,
+  // never undo. 0: no bound.
+  double max_strain_rate = 0.0;
 };
 
 struct WorldParams {
@@ -61,6 +69,15 @@ struct WorldParams {
   // it gives persists, so it injects energy; its work p_n beta |g|/dt, an
   // upper bound of that energy, is reported in StepStats::correction_work.
   double overlap_correction = 0.0;
+  // Overlap projection beta_p: after each solve, a frictionless solve of the
+  // same contacts for pseudo-velocities (split impulse) that open every
+  // overlapping contact by beta_p times its midpoint overlap and close no
+  // open one, the cell's lengths free; the positions (and cell) move by dt
+  // times them, the velocities not at all, so it puts no kinetic energy in
+  // (World::project_overlaps). Only on steps where some overlap reaches
+  // 1e-3 of its pair's smaller diameter. The contact forces' work on those
+  // displacements, sum f_n dt u_n, is StepStats::projection_work. 0: off.
+  double overlap_projection = 0.0;
   // Adhesion-shifted Signorini law (method.md section 2): pull-off force f_a
   // on every contact whose midpoint gap is <= debond (absolute); 0: none.
   double adhesion = 0.0, debond = 0.0;
@@ -167,7 +184,10 @@ class World {
   void restitution_offsets(const B& b);
   // A boundary dof of mass cell.mass loaded by `load` (imposed stress x
   // length), at velocity v_start at the step's start; coupling row k to it.
-  BoundaryDof make_dof(double v_start, double load, double length) const;
+  // v_floor: a lower bound of the dof's free velocity (max_strain_rate).
+  BoundaryDof make_dof(double v_start, double load, double length,
+                       double v_floor = -std::numeric_limits<double>::infinity()) const;
+  void project_overlaps();
   void couple_dof(BoundaryDof& d, std::size_t k, double an, double at, double v_start);
 
   WorldParams prm_;
@@ -181,6 +201,7 @@ class World {
   StepStats last_;
   std::vector<Vec2> xm_;
   std::vector<double> thm_;
+  ContactProblem proj_;    // project_overlaps' pseudo-velocity problem
   ContactProblem prob_;  // rows, colouring, dofs, law (velocities during the solve)
   std::vector<ContactInfo> info_;
   CellGrid grid_;

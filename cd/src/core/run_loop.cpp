@@ -70,7 +70,7 @@ struct Interval {
   int cap_hits = 0;
   double res_max = 0, res_mean_sum = 0;
   double ov_max = 0, ov_small = 0;
-  double corr_work = 0;
+  double corr_work = 0, proj_work = 0;
   StageTimes t0;
 
   void add(const StepStats& s) {
@@ -83,6 +83,7 @@ struct Interval {
     ov_max = std::max(ov_max, s.max_overlap);
     ov_small = std::max(ov_small, s.max_overlap_small);
     corr_work += s.correction_work;
+    proj_work += s.projection_work;
   }
 };
 
@@ -273,7 +274,8 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
                     {"mean_overlap", st.mean_overlap},
                     {"max_overlap_small", iv.ov_small},
                     {"kinetic_energy", w.kinetic_energy()},
-                    {"correction_work", iv.corr_work}};
+                    {"correction_work", iv.corr_work},
+                    {"projection_work", iv.proj_work}};
         for (int s = 0; s < kStages; ++s)
           cols.emplace_back(std::string("t_") + kStageNames[s], t.t[s] - iv.t0.t[s]);
         w.add_columns(cols);
