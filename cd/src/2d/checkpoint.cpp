@@ -40,18 +40,13 @@ static_assert(sizeof(Bodies) ==
                   std::tuple_size_v<decltype(kBodiesArrays)> * sizeof(std::vector<char>),
               "a Bodies member is missing from kBodiesArrays (checkpoint.cpp)");
 
-template <class B, class F>
-void for_each_array(B& b, F&& f) {
-  std::apply([&](const auto&... a) { (f(a.first, b.*(a.second)), ...); }, kBodiesArrays);
-}
-
 }  // namespace
 
 void save_checkpoint(const std::string& path, const World& w, std::uint64_t scene_key,
                      const RunTotals& totals) {
   ckpt::Writer o;
   ckpt::begin(o, 2, scene_key, static_cast<std::int64_t>(w.steps), w.time, w.times);
-  for_each_array(w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
+  ckpt::for_each_array(kBodiesArrays, w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
   o.array("warm.keys", w.warm_start().keys);
   o.array("warm.p", w.warm_start().p);
   o.array("cell", std::vector<CellState>{w.cell});
@@ -63,7 +58,7 @@ std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* tota
   ckpt::Reader in{path, {}};
   const ckpt::Header h = ckpt::open(path, data, in, 2, totals != nullptr);
   Bodies b;
-  for_each_array(b, [&](std::string_view name, auto& v) { in.array(name, v); });
+  ckpt::for_each_array(kBodiesArrays, b, [&](std::string_view name, auto& v) { in.array(name, v); });
   World::WarmStart warm;
   in.array("warm.keys", warm.keys);
   in.array("warm.p", warm.p);

@@ -1,6 +1,7 @@
 #include "output.hpp"
 
 #include "polygon.hpp"
+#include "vtk_files.hpp"
 
 #include <unistd.h>
 
@@ -42,25 +43,6 @@ vtkNew<A> make_array(const char* name, int comps, vtkIdType n) {
 template <class... A>
 void add_arrays(vtkFieldData* fd, A&... arrays) {
   (fd->AddArray(arrays), ...);
-}
-
-// Writes to a temporary name, then renames, so ParaView never opens a
-// partial file.
-void write_vtp(vtkPolyData* pd, const std::string& path) {
-  const std::string tmp = tmp_name(path);
-  vtkNew<vtkXMLPolyDataWriter> w;
-  w->SetInputData(pd);
-  w->SetFileName(tmp.c_str());
-  w->SetDataModeToAppended();
-  w->EncodeAppendedDataOff();  // raw binary, not base64
-  w->SetCompressorTypeToZLib();
-  w->SetHeaderTypeToUInt64();  // no 4 GB limit on a data block
-  if (w->Write() != 1 || w->GetErrorCode() != 0) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw OutputError(fmt::format("cannot write '{}'", path));
-  }
-  rename_into_place(tmp, path);
 }
 
 vtkSmartPointer<vtkPolyData> particles(const World& w) {
@@ -218,17 +200,6 @@ vtkSmartPointer<vtkPolyData> walls(const World& w) {
   return pd;
 }
 
-std::string pvd(const std::vector<std::pair<double, std::string>>& frames, const char* stem) {
-  std::string s =
-      "<?xml version=\"1.0\"?>\n"
-      "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      "  <Collection>\n";
-  for (const auto& [t, num] : frames)
-    s += fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}_{}.vtp\"/>\n",
-                     t, stem, num);
-  s += "  </Collection>\n</VTKFile>\n";
-  return s;
-}
 
 }  // namespace
 
@@ -245,7 +216,7 @@ void Snapshots::write(const World& w) {
   // place, so they never list a missing file.
   frames_.emplace_back(w.time, num);
   for (const char* stem : {"particles", "contacts", "walls", "shapes"})
-    write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd(frames_, stem));
+    write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd_collection(frames_, stem));
   ++n_;
 }
 

@@ -25,18 +25,13 @@ static_assert(sizeof(Bodies3) ==
                   std::tuple_size_v<decltype(kBodies3Arrays)> * sizeof(std::vector<char>),
               "a Bodies3 member is missing from kBodies3Arrays (checkpoint3.cpp)");
 
-template <class B, class F>
-void for_each_array(B& b, F&& f) {
-  std::apply([&](const auto&... a) { (f(a.first, b.*(a.second)), ...); }, kBodies3Arrays);
-}
-
 }  // namespace
 
 void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
                       const RunTotals& totals) {
   ckpt::Writer o;
   ckpt::begin(o, 3, scene_key, static_cast<std::int64_t>(w.steps), w.time, w.times);
-  for_each_array(w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
+  ckpt::for_each_array(kBodies3Arrays, w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
   o.array("3d.warm.keys", w.warm_start().keys);
   o.array("3d.warm.p", w.warm_start().p);
   ckpt::finish(o, totals, path);
@@ -47,10 +42,10 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
   ckpt::Reader in{path, {}};
   const ckpt::Header h = ckpt::open(path, data, in, 3, totals != nullptr);
   Bodies3 b;
-  for_each_array(b, [&](std::string_view name, auto& v) { in.array(name, v); });
+  ckpt::for_each_array(kBodies3Arrays, b, [&](std::string_view name, auto& v) { in.array(name, v); });
   const std::size_t n = b.pos.size();
   bool same = true;
-  for_each_array(b, [&](std::string_view, const auto& v) { same = same && v.size() == n; });
+  ckpt::for_each_array(kBodies3Arrays, b, [&](std::string_view, const auto& v) { same = same && v.size() == n; });
   if (!same) in.fail("is corrupt (body arrays of different lengths)");
   World3::WarmStart warm;
   in.array("3d.warm.keys", warm.keys);

@@ -1,4 +1,5 @@
 #include "output3.hpp"
+#include "vtk_files.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -18,29 +19,6 @@
 #include "files.hpp"
 
 namespace cd {
-
-namespace {
-
-// Writes to a temporary name, then renames, so ParaView never opens a
-// partial file.
-void write_vtp3(vtkPolyData* pd, const std::string& path) {
-  const std::string tmp = tmp_name(path);
-  vtkNew<vtkXMLPolyDataWriter> wr;
-  wr->SetInputData(pd);
-  wr->SetFileName(tmp.c_str());
-  wr->SetDataModeToAppended();
-  wr->EncodeAppendedDataOff();
-  wr->SetCompressorTypeToZLib();
-  wr->SetHeaderTypeToUInt64();
-  if (wr->Write() != 1 || wr->GetErrorCode() != 0) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw OutputError(fmt::format("cannot write '{}'", path));
-  }
-  rename_into_place(tmp, path);
-}
-
-}  // namespace
 
 void write_spheres_vtp(const World3& w, const std::string& path) {
   const Bodies3& b = w.bodies;
@@ -86,7 +64,7 @@ void write_spheres_vtp(const World3& w, const std::string& path) {
     pd->GetPointData()->AddArray(a);
   pd->GetPointData()->SetActiveScalars("radius");
 
-  write_vtp3(pd, path);
+  write_vtp(pd, path);
 }
 
 int contact_status3(const SphereRow& r) {
@@ -152,24 +130,8 @@ void write_contacts3_vtp(const World3& w, const std::string& path) {
                           static_cast<vtkDataArray*>(b1.Get()), static_cast<vtkDataArray*>(b2.Get())})
     pd->GetCellData()->AddArray(a);
   pd->GetCellData()->SetActiveScalars("fn");
-  write_vtp3(pd, path);
+  write_vtp(pd, path);
 }
-
-namespace {
-
-std::string pvd3(const std::vector<std::pair<double, std::string>>& frames, const char* stem) {
-  std::string s =
-      "<?xml version=\"1.0\"?>\n"
-      "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      "  <Collection>\n";
-  for (const auto& [t, num] : frames)
-    s += fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}_{}.vtp\"/>\n",
-                     t, stem, num);
-  s += "  </Collection>\n</VTKFile>\n";
-  return s;
-}
-
-}  // namespace
 
 void Snapshots3::write(const World3& w) {
   namespace fs = std::filesystem;
@@ -181,7 +143,7 @@ void Snapshots3::write(const World3& w) {
   // place, so they never list a missing file.
   frames_.emplace_back(w.time, num);
   for (const char* stem : {"spheres", "contacts"})
-    write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd3(frames_, stem));
+    write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd_collection(frames_, stem));
   ++n_;
 }
 

@@ -1,0 +1,21 @@
+// VTK files of both engines: one .vtp written atomically (a temporary name,
+// then renamed, so ParaView never opens a partial file), and the .pvd
+// collection that lists a stem's frames with their times.
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+class vtkPolyData;
+
+namespace cd {
+
+// Appended raw binary, zlib-compressed, 64-bit headers (no 4 GB limit on a
+// data block). Throws OutputError naming `path` when it cannot be written.
+void write_vtp(vtkPolyData* pd, const std::string& path);
+
+// The .pvd text listing <stem>_<num>.vtp for every (time, num) of `frames`.
+std::string pvd_collection(const std::vector<std::pair<double, std::string>>& frames,
+                           const char* stem);
+
+}  // namespace cd
