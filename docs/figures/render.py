@@ -10,11 +10,12 @@
 # EGL, no OSMesa), so it needs an X server, and its Python package
 # (python3-paraview) conflicts with python3-vtk9, which libvtk9-dev needs, so
 # the Makefile unpacks it beside the build instead of installing it.
+import os
 import sys
 
-from paraview.simple import (Calculator, CellDatatoPointData, ColorBy, CreateView,
-                             ExtractSurface, GetColorTransferFunction, GetScalarBar, OpenDataFile,
-                             Render, SaveScreenshot, Show, Threshold, Tube)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from chains import show_chains  # noqa: E402
+from paraview.simple import CreateView, OpenDataFile, Render, SaveScreenshot, Show  # noqa: E402
 
 run, png = sys.argv[1], sys.argv[2]
 W, H = 1200, 840  # pixels; the default pile is 40 d wide and ~27 d high
@@ -56,49 +57,8 @@ wd.LineWidth = 3.0
 # linearly with f_n: from 0.02 mm for the weakest to 0.3 mm (0.3 d_mean)
 # for the strongest.
 contacts, _ = last_frame("contacts")
-data_range = contacts.CellData["fn"].GetRange()
-fmax = data_range[1]
-loaded = Threshold(Input=contacts)
-loaded.Scalars = ["CELLS", "fn"]
-try:  # ParaView 5.10+: lower/upper thresholds
-    loaded.LowerThreshold = 1e-6 * fmax
-    loaded.UpperThreshold = fmax
-except AttributeError:
-    loaded.ThresholdRange = [1e-6 * fmax, fmax]
-# Threshold gives an unstructured grid; Tube needs polydata. Each contact
-# line has its own two points, so point data is the line's f_n exactly.
-points = CellDatatoPointData(Input=ExtractSurface(Input=loaded))
-mN = Calculator(Input=points)  # labels in mN read better than 1e-3 N
-mN.ResultArrayName = "fn_mN"
-mN.Function = "1000*fn"
-tubes = Tube(Input=mN)
-tubes.Scalars = ["POINTS", "fn_mN"]
-tubes.Vectors = [None, ""]
-tubes.VaryRadius = "By Scalar"
-tubes.Radius = 2e-5
-tubes.RadiusFactor = 15.0
-tubes.NumberofSides = 12
-td = Show(tubes, view)
-ColorBy(td, ("POINTS", "fn_mN"))
-lut = GetColorTransferFunction("fn_mN")
-lut.ApplyPreset("Inferno (matplotlib)", True)
-lut.InvertTransferFunction()  # light for weak contacts, dark for the chains
-lut.RescaleTransferFunction(0.0, 1000 * fmax)
-td.SetScalarBarVisibility(view, True)
-bar = GetScalarBar(lut, view)
-bar.Title = "contact normal force f_n (mN)"
-bar.ComponentTitle = ""
-bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
-bar.TitleFontSize = 18
-bar.LabelFontSize = 16
-bar.RangeLabelFormat = "%-#.2f"
-bar.UseCustomLabels = 1
-bar.CustomLabels = [0.5 * k for k in range(1, int(2000 * fmax))]
-bar.LabelFormat = "%-#.1f"
-bar.WindowLocation = "Any Location"
-bar.Orientation = "Horizontal"
-bar.Position = [0.30, 0.02]
-bar.ScalarBarLength = 0.40
+fmax = contacts.CellData["fn"].GetRange()[1]
+show_chains(view, contacts, radius=2e-5, radius_factor=15.0, fmax=fmax, label_step=0.5)
 
 # Frame the pile, not the whole box (the box is 70 d high for the initial
 # lattice), with a band at the bottom for the colour bar.

@@ -9,12 +9,13 @@
 # RUN_DIR holds spheres.pvd and contacts.pvd (cdsim's 3D snapshots); the
 # last snapshot is drawn. `make figures` calls this under xvfb-run (see
 # render.py for why ParaView is run that way).
+import os
 import sys
 
-from paraview.simple import (Calculator, CellDatatoPointData, ColorBy, CreateView,
-                             ExtractSurface, GetColorTransferFunction, GetScalarBar, Glyph,
-                             OpenDataFile, Render, SaveScreenshot, Show, Sphere, Threshold, Tube,
-                             Clip)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from chains import show_chains  # noqa: E402
+from paraview.simple import (Clip, CreateView, Glyph, OpenDataFile, Render,  # noqa: E402
+                             SaveScreenshot, Show, Sphere)
 
 run, png = sys.argv[1], sys.argv[2]
 W, H = 1200, 900
@@ -70,42 +71,7 @@ gd.Opacity = 0.35
 
 contacts, _ = last_frame("contacts")
 fmax = contacts.CellData["fn"].GetRange()[1]
-loaded = Threshold(Input=front_half(contacts))
-loaded.Scalars = ["CELLS", "fn"]
-try:
-    loaded.LowerThreshold = 1e-6 * fmax
-    loaded.UpperThreshold = fmax
-except AttributeError:
-    loaded.ThresholdRange = [1e-6 * fmax, fmax]
-points = CellDatatoPointData(Input=ExtractSurface(Input=loaded))
-mN = Calculator(Input=points)
-mN.ResultArrayName = "fn_mN"
-mN.Function = "1000*fn"
-tubes = Tube(Input=mN)
-tubes.Scalars = ["POINTS", "fn_mN"]
-tubes.Vectors = [None, ""]
-tubes.VaryRadius = "By Scalar"
-tubes.Radius = 1.5e-4
-tubes.RadiusFactor = 12.0
-tubes.NumberofSides = 10
-td = Show(tubes, view)
-ColorBy(td, ("POINTS", "fn_mN"))
-lut = GetColorTransferFunction("fn_mN")
-lut.ApplyPreset("Inferno (matplotlib)", True)
-lut.InvertTransferFunction()
-lut.RescaleTransferFunction(0.0, 1000 * fmax)
-td.SetScalarBarVisibility(view, True)
-bar = GetScalarBar(lut, view)
-bar.Title = "contact normal force f_n (mN)"
-bar.ComponentTitle = ""
-bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
-bar.TitleFontSize = 18
-bar.LabelFontSize = 16
-bar.RangeLabelFormat = "%-#.0f"
-bar.WindowLocation = "Any Location"
-bar.Orientation = "Horizontal"
-bar.Position = [0.30, 0.02]
-bar.ScalarBarLength = 0.40
+show_chains(view, front_half(contacts), radius=1.5e-4, radius_factor=12.0, fmax=fmax)
 
 # An oblique view from the cut side, slightly above the pile.
 Render(view)
