@@ -1,0 +1,189 @@
+// The observables of a tri-periodic 3D cell (issue 13 item 1): the contact
+// stress sum f (x) l / V with branch vectors through periodic and
+// Lees-Edwards images, its invariants, the kinetic stress about the mean
+// shear flow, and the series columns built from them (run3.hpp:
+// cell_columns3). Every expected value is analytic: a perfectly inelastic
+// frictionless impact between equal spheres that touch at the step's start
+// stops their approach in one step with the impulse P = (m/2) u_n, so the
+// step's force on each contact is P/dt along n exactly. The branch vector
+// is the one of the step's contact, at the midpoint configuration (method.md
+// section 6): the centres have closed by dt/2 times their approach speed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <string>
+
+#include "run3.hpp"
+#include "world3.hpp"
+
+using namespace cd;
+
+namespace {
+
+std::map<std::string, double> as_map(const Columns& c) {
+  std::map<std::string, double> m;
+  for (const auto& [k, v] : c) m[k] = v;
+  return m;
+}
+
+WorldParams3 cell_params(const Vec3& L) {
+  WorldParams3 p;
+  p.dt = 1e-4;
+  p.mu = 0.0;
+  p.alert = 0.0;
+  p.solver.tol = 1e-14;
+  p.solver.max_iter = 1000;
+  p.cell = L;
+  p.periodic = {true, true, true};
+  return p;
+}
+
+}  // namespace
+
+// A simple-cubic lattice of 4 x 3 x 3 touching spheres (diameter d, pitch d)
+// fills the cell [0, 4d) x [0, 3d) x [0, 3d). Sphere i along x moves at
+// v_x = -(-1)^i v: spheres 1 and 2 approach each other, and so do sphere 3
+// and the image of sphere 0 at +4d (a contact through the x image); the
+// other x pairs separate and the y, z neighbours move together. Each
+// approaching pair takes P = m v, f = m v / dt along x, with branch vector
+// +l e_x, l = d - v dt at the midpoint (through the image: not the -3d
+// between the two centres). So
+//     sigma_xx = 18 pairs x f l / V = m v l / (2 dt d^3),
+// every other component 0; p = sigma_xx / 3; q = sigma_xx (uniaxial).
+// Every sphere has exactly one force-bearing contact: all are rattlers
+// (z = 0, non_rattler = 0). The packing fraction is pi/6.
+TEST(Cell3Observables, SimpleCubicImpactStressThroughXImage) {
+  const double d = 0.01, r = d / 2, rho = 2600, v = 0.05;
+  WorldParams3 p = cell_params(Vec3(4 * d, 3 * d, 3 * d));
+  World3 w(p);
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i)
+        w.bodies.add_sphere(Vec3((i + 0.5) * d, (j + 0.5) * d, (k + 0.5) * d), r, rho,
+                            Vec3(i % 2 == 0 ? -v : v, 0, 0));
+  const double m = w.bodies.mass[0];
+  w.step();
+  // Every approaching pair has stopped.
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) EXPECT_NEAR(w.bodies.vel[i].v.norm(), 0.0, 1e-12 * v);
+  const double V = 36 * d * d * d;
+  EXPECT_DOUBLE_EQ(w.cell_volume(), V);
+  const Eigen::Matrix3d S = w.contact_stress();
+  const double sxx = m * v * (d - v * p.dt) / (2 * p.dt * d * d * d);
+  EXPECT_NEAR(S(0, 0), sxx, 1e-12 * sxx);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (i + j > 0) {
+        EXPECT_NEAR(S(i, j), 0.0, 1e-12 * sxx) << i << j;
+      }
+  // 18 bearing contacts, half of them through the x image.
+  int bearing = 0, through_image = 0;
+  for (std::size_t k = 0; k < w.rows().size(); ++k)
+    if (w.rows()[k].r[0] > 0) {
+      ++bearing;
+      through_image += w.infos()[k].ix != 0;
+    }
+  EXPECT_EQ(bearing, 18);
+  EXPECT_EQ(through_image, 9);
+
+  const auto c = as_map(cell_columns3(w, S, rho, d));
+  EXPECT_NEAR(c.at("sxx"), sxx, 1e-12 * sxx);
+  EXPECT_NEAR(c.at("p"), sxx / 3, 1e-12 * sxx);
+  EXPECT_NEAR(c.at("q"), sxx, 1e-12 * sxx);
+  EXPECT_NEAR(c.at("q_over_p"), 3.0, 1e-12);
+  EXPECT_EQ(c.at("shear_stress_ratio"), 0.0);  // sigma_yy = 0
+  EXPECT_EQ(c.at("shear_rate"), 0.0);
+  EXPECT_NEAR(c.at("packing_fraction"), std::numbers::pi / 6, 1e-14);
+  EXPECT_EQ(c.at("z"), 0.0);
+  EXPECT_EQ(c.at("non_rattler"), 0.0);
+  EXPECT_DOUBLE_EQ(c.at("cell_width"), 4 * d);
+  EXPECT_DOUBLE_EQ(c.at("cell_height"), 3 * d);
+  EXPECT_DOUBLE_EQ(c.at("cell_depth"), 3 * d);
+  // At rest after the impacts: no kinetic stress.
+  for (const char* k : {"kxx", "kxy", "kxz", "kyy", "kyz", "kzz"}) EXPECT_NEAR(c.at(k), 0.0, 1e-20) << k;
+  EXPECT_EQ(c.size(), 1 + 9 + 8 + 3 + 6u);
+}
+
+// Two spheres in contact through the Lees-Edwards image: A near the top of
+// the cell, B near the bottom, the cell's y images shifted by le_offset
+// along x (at rest: le_velocity 0). B's image above A sits at branch
+// d n (n out of the xy plane), and A moves towards it at u along n. The
+// frictionless inelastic impact gives P = (m/2) u, the midpoint branch is
+// l = (d - u dt/2) n, so sigma = (P/dt) l n n^T / V: a full tensor with
+// sigma_xy = sigma_yx, and mu = -sigma_xy/sigma_yy = -n_x/n_y.
+TEST(Cell3Observables, TwoSphereContactThroughLeesEdwardsImage) {
+  const double d = 0.01, r = d / 2, rho = 2600, u = 0.03;
+  const Vec3 L(5 * d, 4 * d, 3 * d);
+  WorldParams3 p = cell_params(L);
+  p.le_offset = 1.7 * d;
+  World3 w(p);
+  const Vec3 n = Vec3(-0.5, 0.8, 0.3).normalized();  // n_x < 0: mu > 0
+  const Vec3 xa(2.5 * d, L.y() - 0.7 * d, 1.5 * d);
+  const Vec3 img = xa + d * n;  // B's image, above the cell
+  const Vec3 xb = img - Vec3(p.le_offset, L.y(), 0);
+  w.bodies.add_sphere(xa, r, rho, u * n);
+  w.bodies.add_sphere(xb, r, rho);
+  const double m = w.bodies.mass[0];
+  w.step();
+  ASSERT_EQ(w.rows().size(), 1u);
+  EXPECT_NE(w.infos()[0].iy, 0);
+  const double V = L.x() * L.y() * L.z();
+  const double f = 0.5 * m * u / p.dt;
+  const Eigen::Matrix3d S = w.contact_stress();
+  const double l = d - 0.5 * u * p.dt;
+  const Eigen::Matrix3d expect = f * l * n * n.transpose() / V;
+  const double scale = f * l / V;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(S(i, j), expect(i, j), 1e-10 * scale) << i << j;
+  const auto c = as_map(cell_columns3(w, S, rho, d));
+  EXPECT_NEAR(c.at("p"), scale / 3, 1e-10 * scale);  // tr(n n^T) = 1
+  EXPECT_NEAR(c.at("shear_stress_ratio"), -n.x() / n.y(), 1e-9);
+  EXPECT_GT(c.at("shear_stress_ratio"), 0.0);
+  EXPECT_NEAR(c.at("syz"), expect(1, 2), 1e-10 * scale);
+  // One contact each: both rattlers.
+  EXPECT_EQ(c.at("non_rattler"), 0.0);
+  // Momentum: both spheres leave at u/2 along n.
+  EXPECT_NEAR((w.bodies.vel[0].v - 0.5 * u * n).norm(), 0.0, 1e-10 * u);
+  EXPECT_NEAR((w.bodies.vel[1].v - 0.5 * u * n).norm(), 0.0, 1e-10 * u);
+}
+
+// The kinetic stress removes the mean shear flow gd y e_x and the mean
+// velocity: spheres (apart, no contacts) on the flow v_x = gd y, plus a
+// drift c shared by all, plus +-delta e_z and +-eps e_y in pairs, give
+// K_zz = N m delta^2 / V, K_yy = N m eps^2 / V, K_yz = N m delta eps / V
+// (same signs in a pair), the x components 0; the inertial_number column is
+// gd d sqrt(rho / (S_yy + K_yy)).
+TEST(Cell3Observables, KineticStressAboutTheShearFlow) {
+  const double d = 0.01, r = d / 2, rho = 2600, gd = 3.0, delta = 0.02, eps = 0.01;
+  const Vec3 L(6 * d, 6 * d, 6 * d);
+  WorldParams3 p = cell_params(L);
+  p.le_velocity = gd * L.y();
+  World3 w(p);
+  EXPECT_DOUBLE_EQ(w.shear_rate(), gd);
+  const Vec3 drift(0.1, -0.05, 0.07);
+  int N = 0;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) {
+      const double s = (j + k) % 2 == 0 ? 1.0 : -1.0;
+      const Vec3 x((0.5 + 2 * k) * d, (0.5 + 2 * j) * d, (1.0 + 2 * ((j + k) % 3)) * d);
+      w.bodies.add_sphere(x, r, rho, drift + Vec3(gd * x.y(), s * eps, s * delta));
+      ++N;
+    }
+  // The +- pairs: 5 of +1 and 4 of -1; the mean removes the odd one's share.
+  const double m = w.bodies.mass[0], V = L.prod();
+  double mean_s = 0;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) mean_s += ((j + k) % 2 == 0 ? 1.0 : -1.0) / N;
+  const double var = 1.0 - mean_s * mean_s;  // <s^2> - <s>^2
+  const Eigen::Matrix3d K = w.kinetic_stress();
+  const double kzz = N * m * delta * delta * var / V;
+  EXPECT_NEAR(K(2, 2), kzz, 1e-12 * kzz);
+  EXPECT_NEAR(K(1, 1), N * m * eps * eps * var / V, 1e-12 * kzz);
+  EXPECT_NEAR(K(1, 2), N * m * eps * delta * var / V, 1e-12 * kzz);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(K(0, i), 0.0, 1e-12 * kzz) << i;
+  const Eigen::Matrix3d S = Eigen::Vector3d(0, 50.0, 0).asDiagonal();
+  const auto c = as_map(cell_columns3(w, S, rho, d));
+  EXPECT_NEAR(c.at("inertial_number"), gd * d * std::sqrt(rho / (50.0 + K(1, 1))), 1e-12);
+  EXPECT_DOUBLE_EQ(c.at("shear_rate"), gd);
+}
