@@ -1,4 +1,4 @@
-// The observables of a tri-periodic 3D cell (issue 13 item 1): the contact
+// The tri-periodic 3D cell (issue 13). Item 1, the observables: the contact
 // stress sum f (x) l / V with branch vectors through periodic and
 // Lees-Edwards images, its invariants, the kinetic stress about the mean
 // shear flow, and the series columns built from them (run3.hpp:
@@ -8,14 +8,22 @@
 // step's force on each contact is P/dt along n exactly. The branch vector
 // is the one of the step's contact, at the midpoint configuration (method.md
 // section 6): the centres have closed by dt/2 times their approach speed.
+// Item 2: the scene of a cell (placement, refusals, a run's columns).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
+#include <random>
 #include <numbers>
 #include <string>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli_util.hpp"
 #include "run3.hpp"
+#include "setup3.hpp"
 #include "world3.hpp"
 
 using namespace cd;
@@ -186,4 +194,175 @@ TEST(Cell3Observables, KineticStressAboutTheShearFlow) {
   const auto c = as_map(cell_columns3(w, S, rho, d));
   EXPECT_NEAR(c.at("inertial_number"), gd * d * std::sqrt(rho / (50.0 + K(1, 1))), 1e-12);
   EXPECT_DOUBLE_EQ(c.at("shear_rate"), gd);
+}
+
+// ---------------------------------------------------------------- scenes
+
+namespace {
+
+Scene cell_scene(int n) {
+  Scene s;
+  s.dimension = 3;
+  s.gravity = {0, 0, 0};
+  s.shear_mode = "periodic";
+  s.n = n;
+  s.d_mean = 0.01;
+  s.size_ratio = 1.5;
+  s.density = 2600;
+  s.dt = 1e-4;
+  s.duration = 2e-3;
+  s.mu = 0.3;
+  s.alert = 0.05;
+  s.series_interval = 2e-4;
+  return s;
+}
+
+// Smallest gap between two spheres over all pairs, through the nearest
+// periodic image (brute force).
+double min_gap(const World3& w) {
+  const Vec3 L = w.params().cell;
+  double g = INFINITY;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i)
+    for (std::size_t j = i + 1; j < w.bodies.size(); ++j) {
+      Vec3 d = w.bodies.pos[j] - w.bodies.pos[i];
+      for (int a = 0; a < 3; ++a) d[a] -= L[a] * std::round(d[a] / L[a]);
+      g = std::min(g, d.norm() - w.bodies.radius[i] - w.bodies.radius[j]);
+    }
+  return g;
+}
+
+}  // namespace
+
+// shear.mode = "periodic" in a dimension = 3 scene: a tri-periodic cell,
+// 0 x 0 x 0 the cube of side k pitch (k = ceil(N^(1/3)) = 6 for 150, pitch
+// 1.02 d_max), no walls, the spheres inside it, none touching another or an
+// image (the jitter stays within the slack), at rest. With no gravity and
+// nothing in contact, 20 steps leave every sphere where it was, and the
+// series columns show zero stress and the packing fraction sum(pi d^3/6)/V.
+TEST(Cell3Scene, PeriodicSceneIsATriPeriodicCellOfLooseSpheres) {
+  const Scene s = cell_scene(150);
+  World3 w = build_world3(s);
+  const auto [d_min, d_max] = diameter_bounds(s);
+  const double side = 6 * 1.02 * d_max * (1 + 1e-9);  // the 1e-9: floor(side / pitch) = 6
+  const WorldParams3& p = w.params();
+  EXPECT_TRUE(p.periodic[0] && p.periodic[1] && p.periodic[2]);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(p.cell[a], side, 1e-12 * side) << a;
+  EXPECT_EQ(p.gravity, Vec3::Zero());
+  ASSERT_EQ(w.bodies.size(), 150u);
+  double vol = 0;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    EXPECT_EQ(w.bodies.shape[i], Shape3::Sphere);
+    EXPECT_GE(2 * w.bodies.radius[i], d_min * (1 - 1e-12));
+    EXPECT_LE(2 * w.bodies.radius[i], d_max * (1 + 1e-12));
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_GT(w.bodies.pos[i][a], w.bodies.radius[i]) << i;
+      EXPECT_LT(w.bodies.pos[i][a], side - w.bodies.radius[i]) << i;
+    }
+    vol += std::numbers::pi / 6 * std::pow(2 * w.bodies.radius[i], 3);
+  }
+  const double g0 = min_gap(w);
+  EXPECT_GT(g0, 0.0);
+  std::printf("150 spheres: cell %.4g m, packing fraction %.4f, smallest gap %.3g d_mean\n", side,
+              vol / (side * side * side), g0 / s.d_mean);
+  const std::vector<Vec3> x0 = w.bodies.pos;
+  for (int k = 0; k < 20; ++k) w.step();
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) EXPECT_EQ(w.bodies.pos[i], x0[i]) << i;
+  const auto c = as_map(cell_columns3(w, w.contact_stress(), s.density, s.d_mean));
+  EXPECT_NEAR(c.at("packing_fraction"), vol / (side * side * side), 1e-12);
+  EXPECT_EQ(c.at("p"), 0.0);
+  EXPECT_EQ(c.at("z"), 0.0);
+
+  // Lengths given: the cell is those.
+  Scene g = s;
+  g.cell_width = 0.08;
+  g.cell_height = 0.07;
+  g.cell_depth = 0.09;
+  const World3 wg = build_world3(g);
+  EXPECT_EQ(wg.params().cell, Vec3(0.08, 0.07, 0.09));
+  EXPECT_GT(min_gap(wg), 0.0);
+}
+
+// What a 3D cell does not have yet is refused by key (SceneError: cdsim
+// exits 2, as Scene3.BadInputIsRefusedNamingTheKey checks through cdsim).
+TEST(Cell3Scene, UnsupportedKeysAreRefusedByName) {
+  const auto refused = [](Scene s, const std::string& key) {
+    try {
+      check_scene3(s);
+      ADD_FAILURE() << key << " accepted";
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
+  Scene s = cell_scene(100);
+  EXPECT_NO_THROW(check_scene3(s));
+  { Scene t = s; t.pressure = 100; refused(t, "shear.pressure"); }
+  { Scene t = s; t.inertial_number = 0.1; refused(t, "shear.inertial_number"); }
+  { Scene t = s; t.isotropic = true; refused(t, "shear.isotropic"); }
+  { Scene t = s; t.compaction_rate = 0.01; refused(t, "shear.compaction_rate"); }
+  { Scene t = s; t.strain = 1; refused(t, "shear.strain"); }
+  { Scene t = s; t.dt_tp = 0.01; refused(t, "shear.dt_tp"); }
+  { Scene t = s; t.start = "x/checkpoint.bin"; refused(t, "shear.start"); }
+  { Scene t = s; t.cohesion_number = 1; refused(t, "contact.cohesion_number"); }
+  { Scene t = s; t.checkpoint_strain = 1; refused(t, "output.checkpoint_strain"); }
+  { Scene t = s; t.gravity = {0, 0, -9.81}; refused(t, "gravity.g"); }
+  { Scene t = s; t.box_width = t.box_depth = 0.1; refused(t, "box.width"); }
+  { Scene t = s; t.cell_width = 0.1; refused(t, "shear.depth"); }
+  { Scene t = s; t.cell_width = t.cell_height = 0.1; t.cell_depth = 0.025; refused(t, "shear.depth = 0.025"); }
+  { Scene t = s; t.cell_width = t.cell_height = t.cell_depth = 0.04; refused(t, "particles.n = 100"); }
+  { Scene t = s; t.shear_mode = "walls"; refused(t, "shear.mode"); }
+  { Scene t = s; t.shear_mode = "none"; t.cell_depth = 0.1; refused(t, "depth"); }
+}
+
+// A cdsim-style run of a cell (run3 through the shared run loop) writes the
+// cell's columns into series.csv. The spheres get a random velocity each
+// (a granular gas, no contacts at first): in a closed periodic cell the
+// total momentum is conserved to round-off and the kinetic stress of the
+// last row equals the one computed from the final state; the trace of the
+// contact stress is >= 0 (frictional inelastic contacts only push).
+TEST(Cell3Scene, RunWritesTheCellColumns) {
+  const Scene s = cell_scene(64);
+  World3 w = build_world3(s);
+  std::mt19937_64 g(7);
+  std::normal_distribution<double> N(0.0, 0.2);
+  Vec3 P0 = Vec3::Zero();
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    w.bodies.vel[i].v = Vec3(N(g), N(g), N(g));
+    P0 += w.bodies.mass[i] * w.bodies.vel[i].v;
+  }
+  const auto dir = cdtest::scratch_dir("test_cell3", "run");
+  RunOptions opt;
+  opt.out = dir.string();
+  opt.quiet = true;
+  opt.fresh = true;
+  run3(w, s, opt);
+  Vec3 P = Vec3::Zero();
+  double pm = 0;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    P += w.bodies.mass[i] * w.bodies.vel[i].v;
+    pm += w.bodies.mass[i] * 0.2;
+  }
+  EXPECT_LT((P - P0).norm(), 1e-12 * pm);
+  std::ifstream f(dir / "series.csv");
+  std::string head, line, last;
+  std::getline(f, head);
+  int rows = 0;
+  while (std::getline(f, line)) last = line, ++rows;
+  EXPECT_EQ(rows, 10);
+  std::vector<std::string> names, vals;
+  for (std::istringstream h(head); std::getline(h, line, ',');) names.push_back(line);
+  for (std::istringstream h(last); std::getline(h, line, ',');) vals.push_back(line);
+  ASSERT_EQ(names.size(), vals.size());
+  std::map<std::string, double> row;
+  for (std::size_t i = 0; i < names.size(); ++i) row[names[i]] = std::stod(vals[i]);
+  for (const char* k : {"sxx", "sxy", "sxz", "syx", "syy", "syz", "szx", "szy", "szz", "p", "q", "q_over_p",
+                        "shear_stress_ratio", "inertial_number", "packing_fraction", "z", "non_rattler",
+                        "cell_width", "cell_height", "cell_depth", "kxx", "kxy", "kxz", "kyy", "kyz", "kzz"})
+    EXPECT_TRUE(row.count(k)) << k;
+  const Eigen::Matrix3d K = w.kinetic_stress();
+  EXPECT_NEAR(row["kxx"], K(0, 0), 1e-6 * K.trace());
+  EXPECT_NEAR(row["kyz"], K(1, 2), 1e-6 * K.trace());
+  EXPECT_GT(K.trace(), 0.0);
+  EXPECT_GE(row["p"], 0.0);
+  EXPECT_NEAR(row["p"], (row["sxx"] + row["syy"] + row["szz"]) / 3, 1e-6 * std::abs(row["p"]) + 1e-300);
+  std::printf("gas: %d rows, last p = %.4g Pa, K_tr/3 = %.4g Pa\n", rows, row["p"], K.trace() / 3);
 }
