@@ -8,7 +8,7 @@
 // step's force on each contact is P/dt along n exactly. The branch vector
 // is the one of the step's contact, at the midpoint configuration (method.md
 // section 6): the centres have closed by dt/2 times their approach speed.
-// Item 2: the scene of a cell (placement, refusals, a run's columns).
+// Item 2: the scene of a cell (placement, refusals, a run's columns); and a 3D checkpoint carrying the cell.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -22,6 +22,7 @@
 #include <sstream>
 
 #include "cli_util.hpp"
+#include "checkpoint3.hpp"
 #include "run3.hpp"
 #include "setup3.hpp"
 #include "world3.hpp"
@@ -365,4 +366,60 @@ TEST(Cell3Scene, RunWritesTheCellColumns) {
   EXPECT_GE(row["p"], 0.0);
   EXPECT_NEAR(row["p"], (row["sxx"] + row["syy"] + row["szz"]) / 3, 1e-6 * std::abs(row["p"]) + 1e-300);
   std::printf("gas: %d rows, last p = %.4g Pa, K_tr/3 = %.4g Pa\n", rows, row["p"], K.trace() / 3);
+}
+
+// ---------------------------------------------------------------- checkpoint
+
+// A 3D checkpoint carries the cell's state: a sheared gas (Lees-Edwards
+// images moving at gd L_y, le_offset advancing every step) stopped after 40
+// steps and continued from its checkpoint in a world rebuilt from the scene
+// (le_offset 0 there) ends bit-identical to 80 steps never stopped,
+// le_offset included. Without the cell in the checkpoint the resumed run
+// starts from offset 0 and the images, hence the contacts, differ. A
+// checkpoint of a cell is refused by a world without one.
+TEST(Cell3Checkpoint, ResumesTheLeesEdwardsOffset) {
+  const Scene s = cell_scene(64);
+  const auto make = [&] {
+    World3 w = build_world3(s);
+    WorldParams3 p = w.params();
+    p.le_velocity = 40.0 * p.cell.y();  // gd = 40 /s
+    w.set_params(p);
+    std::mt19937_64 g(3);
+    std::normal_distribution<double> N(0.0, 0.3);
+    for (std::size_t i = 0; i < w.bodies.size(); ++i) w.bodies.vel[i].v = Vec3(N(g), N(g), N(g));
+    return w;
+  };
+  World3 a = make();
+  for (int k = 0; k < 80; ++k) a.step();
+  World3 b = make();
+  for (int k = 0; k < 40; ++k) b.step();
+  const auto dir = cdtest::scratch_dir("test_cell3", "ckpt");
+  const std::string path = (dir / "checkpoint.bin").string();
+  save_checkpoint3(path, b, 42);
+  World3 c = make();
+  EXPECT_EQ(c.params().le_offset, 0.0);
+  EXPECT_EQ(load_checkpoint3(path, c), 42u);
+  EXPECT_EQ(c.params().le_offset, b.params().le_offset);
+  EXPECT_NE(c.params().le_offset, 0.0);
+  for (int k = 0; k < 40; ++k) c.step();
+  EXPECT_EQ(c.params().le_offset, a.params().le_offset);
+  bool contacts = false;
+  for (std::size_t i = 0; i < a.bodies.size(); ++i) {
+    EXPECT_EQ(c.bodies.pos[i], a.bodies.pos[i]) << i;
+    EXPECT_EQ(c.bodies.vel[i].v, a.bodies.vel[i].v) << i;
+  }
+  for (const SphereRow& r : a.rows()) contacts = contacts || r.r[0] > 0;
+  EXPECT_TRUE(contacts);  // the gas collides: the comparison sees the images
+  std::printf("le_offset after 80 steps: %.6g m (cell %.4g m)\n", a.params().le_offset, a.params().cell.x());
+
+  Scene box = s;
+  box.shear_mode = "none";
+  box.gravity = {0, 0, -9.81};
+  World3 d = build_world3(box);
+  try {
+    load_checkpoint3(path, d);
+    ADD_FAILURE() << "a cell's checkpoint loaded into a box";
+  } catch (const CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("periodic along"), std::string::npos) << e.what();
+  }
 }
