@@ -380,7 +380,8 @@ TEST(Scene3, BadInputIsRefusedNamingTheKey) {
   refused("--set box.width=0.05 --set box.depth=0.2", {"box.width = 0.05", "needs >= 0.11"});
   refused("--set 'particles.nsides=[0,6]'", {"particles.nsides", "spheres"});
   refused("--set 'particles.region=[0,0,1,1]'", {"particles.region"});
-  refused("--set shear.mode=\\\"periodic\\\"", {"shear.mode"});
+  refused("--set shear.mode=\\\"periodic\\\"", {"gravity.g", "no floor"});
+  refused("--set shear.mode=\\\"walls\\\"", {"shear.mode", "tri-periodic"});
   refused("--set particles.n=0", {"particles.n"});
   refused("--dump-problem 3", {"--dump-problem", "dimension = 3"});
 }

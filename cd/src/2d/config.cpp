@@ -150,6 +150,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"shear", "mode", &Scene::shear_mode, "", shear_mode(), "boundary protocol: none; periodic (bi-periodic Lees-Edwards cell, height a dof at imposed pressure); walls (rough walls of glued grains, periodic in x, top wall at imposed velocity and pressure)"},
       {"shear", "width", &Scene::cell_width, "m", ge(0), "cell width (period in x)"},
       {"shear", "height", &Scene::cell_height, "m", ge(0), "initial cell height (periodic) or gap between the wall grains' centres (walls)"},
+      {"shear", "depth", &Scene::cell_depth, "m", ge(0), "3D only: the periodic cell's length along z (vorticity direction; width along x is the shear direction, height along y the gradient); width, height and depth all 0: the cube that holds the generated spheres on a loose lattice"},
       {"shear", "pressure", &Scene::pressure, "N/m", ge(0), "imposed normal stress sigma_yy (2D: force per length)"},
       {"shear", "inertial_number", &Scene::inertial_number, "", ge(0), "imposed inertial number I: shear rate = I sqrt(p/rho)/d (walls: top wall speed = shear rate x current gap); 0: no shear"},
       {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width) degree of freedom, in units of the particles' total mass"},
@@ -497,6 +498,10 @@ Scene read_scene(const toml::value& root, const std::string& path) {
     out.add(child(child(root, "box"), "depth"), "depth",
             fmt::format("box.depth = {}: only a dimension = 3 scene has a depth",
                         text(s.box_depth, false)));
+  if (s.dimension == 2 && s.cell_depth > 0)
+    out.add(child(child(root, "shear"), "depth"), "depth",
+            fmt::format("shear.depth = {}: only a dimension = 3 scene has a depth",
+                        text(s.cell_depth, false)));
   if (s.dimension == 2 && (s.box_width > 0) != (s.box_height > 0))
     out.add(child(root, "box"), "box",
             fmt::format("box.width = {}, box.height = {}: must be both 0 (no box) or both > 0",

@@ -98,6 +98,7 @@ struct Scene {
   std::string shear_mode = "none";  // "none" | "periodic" (Lees-Edwards) | "walls"
   double cell_width = 0.0;          // cell width (m)
   double cell_height = 0.0;         // initial cell height / wall gap (m)
+  double cell_depth = 0.0;          // 3D periodic cell: its length along z (m)
   double pressure = 0.0;            // imposed normal stress (N/m)
   double inertial_number = 0.0;     // imposed I: gamma-dot = I sqrt(p/rho) / d
   double cell_mass = 0.1;           // mass of the height (width) dof, in total particle mass

@@ -1,6 +1,10 @@
 #include "checkpoint3.hpp"
 
+#include <stdexcept>
 #include <tuple>
+#include <vector>
+
+#include <fmt/format.h>
 #include <utility>
 
 namespace cd {
@@ -34,6 +38,9 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
   ckpt::for_each_array(kBodies3Arrays, w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
   o.array("3d.warm.keys", w.warm_start().keys);
   o.array("3d.warm.p", w.warm_start().p);
+  const WorldParams3& p = w.params();
+  o.array("3d.cell", std::vector<double>{p.cell.x(), p.cell.y(), p.cell.z(), p.le_offset, double(p.periodic[0]),
+                                         double(p.periodic[1]), double(p.periodic[2])});
   ckpt::finish(o, totals, path);
 }
 
@@ -51,8 +58,25 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
   in.array("3d.warm.keys", warm.keys);
   in.array("3d.warm.p", warm.p);
   if (warm.keys.size() != warm.p.size()) in.fail("is corrupt (warm-start sizes differ)");
+  std::vector<double> cell;
+  in.array("3d.cell", cell);
+  if (cell.size() != 7) in.fail("is corrupt (the cell's state is not 7 numbers)");
+  WorldParams3 p = w.params();
+  for (int a = 0; a < 3; ++a)
+    if ((cell[4 + a] != 0.0) != p.periodic[a])
+      in.fail(fmt::format("holds a cell periodic along (x, y, z) = ({:d}, {:d}, {:d}); this scene's is ({:d}, "
+                          "{:d}, {:d})", cell[4] != 0.0, cell[5] != 0.0, cell[6] != 0.0, p.periodic[0],
+                          p.periodic[1], p.periodic[2]));
   const RunTotals tot = ckpt::close(in, h);
 
+  p.cell = Vec3(cell[0], cell[1], cell[2]);
+  p.le_offset = cell[3];
+  try {
+    World3 probe(p);  // checks the cell without touching w
+  } catch (const std::invalid_argument& e) {
+    in.fail(fmt::format("holds a cell this scene cannot take ({})", e.what()));
+  }
+  w.set_params(p);
   w.bodies = std::move(b);
   w.steps = h.steps;
   w.time = h.time;

@@ -4,8 +4,10 @@
 //
 // The file's frame is core/checkpoint_io.hpp's with dimension 3; between the
 // timers and the totals it holds one array per Bodies3 member ("3d.vel",
-// "3d.pos", ...), then "3d.warm.keys" and "3d.warm.p". A 2D checkpoint is
-// refused by its dimension tag, naming both dimensions.
+// "3d.pos", ...), then "3d.warm.keys", "3d.warm.p" and "3d.cell": the
+// periodic cell's state, {L_x, L_y, L_z, le_offset, periodic x, y, z (0/1)}
+// (all 0 without a cell). A 2D checkpoint is refused by its dimension tag,
+// naming both dimensions.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -19,8 +21,10 @@ namespace cd {
 void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
                       const RunTotals& totals = {});
 
-// Reads a checkpoint into w (its parameters are kept) and returns the stored
-// scene key; with `totals`, also the run's totals. w is changed only if the
+// Reads a checkpoint into w: its parameters are kept but for the cell's
+// state (lengths and Lees-Edwards offset), which the checkpoint's replace;
+// a checkpoint whose periodic axes differ from w's is refused. Returns the
+// stored scene key; with `totals`, also the run's totals. w is changed only if the
 // whole file is valid; otherwise throws CheckpointError naming the file.
 std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals = nullptr);
 

@@ -18,6 +18,14 @@ WorldParams3 world_params3(const Scene& s);
 
 // The world: a floor and four side walls, the generated spheres on the
 // lattice (particles.n, the size law or the explicit diameters).
+// shear.mode = "periodic": build_cell3.
 World3 build_world3(const Scene& s);
+
+// A tri-periodic cell (shear.mode = "periodic"; docs/3d.md): L_x, L_y, L_z
+// = shear.width, height, depth (all 0: the cube that holds the spheres),
+// the generated spheres at rest on a jittered cubic lattice of pitch 1.02
+// d_max, none touching. No walls, no gravity; the lengths are fixed (the
+// imposed stress of the 2D protocols is refused by key).
+World3 build_cell3(const Scene& s);
 
 }  // namespace cd

@@ -309,6 +309,55 @@ double World3::kinetic_energy() const {
   return e;
 }
 
+std::vector<obs::Contact<3>> World3::contact_forces() const {
+  std::vector<obs::Contact<3>> cs;
+  cs.reserve(rows_.size());
+  const double inv_dt = 1.0 / prm_.dt;
+  for (std::size_t k = 0; k < rows_.size(); ++k) {
+    const SphereRow& r = rows_[k];
+    const Vec3 ft = (r.r[1] * r.t1 + r.r[2] * r.t2) * inv_dt;
+    const Vec3& l = info_[k].branch;
+    cs.push_back({r.b1, r.b2, {r.n.x(), r.n.y(), r.n.z()}, r.r[0] * inv_dt, {ft.x(), ft.y(), ft.z()},
+                  {l.x(), l.y(), l.z()}});
+  }
+  return cs;
+}
+
+double World3::cell_volume() const {
+  const bool tri = prm_.periodic[0] && prm_.periodic[1] && prm_.periodic[2];
+  return tri ? prm_.cell.x() * prm_.cell.y() * prm_.cell.z() : 0.0;
+}
+
+double World3::shear_rate() const { return prm_.periodic[1] ? prm_.le_velocity / prm_.cell.y() : 0.0; }
+
+Eigen::Matrix3d World3::contact_stress(double volume) const {
+  const double V = volume > 0.0 ? volume : cell_volume();
+  const auto s = obs::contact_stress<3>(contact_forces(), V > 0.0 ? V : 1.0);
+  Eigen::Matrix3d m;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m(i, j) = s[i][j];
+  return m;
+}
+
+Eigen::Matrix3d World3::kinetic_stress() const {
+  Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
+  const double V = cell_volume();
+  if (V <= 0.0) return k;
+  const double gd = shear_rate();
+  double m = 0.0;
+  Vec3 mv = Vec3::Zero();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies.is_dynamic(i)) continue;
+    Vec3 u = bodies.vel[i].v;
+    u.x() -= gd * (bodies.pos[i].y() - prm_.cell_origin.y());
+    m += bodies.mass[i];
+    mv += bodies.mass[i] * u;
+    k += bodies.mass[i] * u * u.transpose();
+  }
+  if (m > 0.0) k -= mv * mv.transpose() / m;  // about the mean: sum m (u - <u>)(u - <u>)^T
+  return k / V;
+}
+
 double World3::potential_energy() const {
   double e = 0;
   for (std::size_t i = 0; i < bodies.size(); ++i)

@@ -25,6 +25,7 @@
 #include "bodies3.hpp"
 #include "contact3.hpp"
 #include "detect3.hpp"
+#include "observables.hpp"
 #include "solver.hpp"
 #include "stages.hpp"
 
@@ -101,6 +102,23 @@ class World3 {
 
   double kinetic_energy() const;    // translational + rotational, dynamic bodies
   double potential_energy() const;  // -m g.x summed over dynamic bodies
+
+  // Observables of the last step (method.md section 10, core/observables.hpp).
+  // The rows as obs::Contact<3>: force r/dt on body 2 (world frame), branch
+  // vector from the centre of body 1 to the centre of the image of body 2
+  // that is touched (a plane's: to the sphere's foot).
+  std::vector<obs::Contact<3>> contact_forces() const;
+  // L_x L_y L_z of a tri-periodic cell; 0 unless x, y and z are all periodic.
+  double cell_volume() const;
+  // Shear rate of the Lees-Edwards cell: le_velocity / L_y (0 without).
+  double shear_rate() const;
+  // Contact stress sigma_ij = (1/V) sum_c f_i l_j, compression positive;
+  // V = cell_volume() unless volume > 0 (no volume at all: stress times V).
+  Eigen::Matrix3d contact_stress(double volume = 0.0) const;
+  // Kinetic stress (1/V) sum m u u^T over dynamic bodies, u = v - gd y e_x
+  // minus its mass mean (gd = shear_rate(): the mean shear flow removed);
+  // zero without a tri-periodic cell.
+  Eigen::Matrix3d kinetic_stress() const;
 
   // Warm-start memory: the previous step's impulses (world frame, on body
   // 2) by contact key (sorted). Re-projected on the new frame when reused,

@@ -183,6 +183,17 @@ double deviator_2d(const Tensor<2>& t) {
   const double d = 0.5 * (t[0][0] - t[1][1]), s = 0.5 * (t[0][1] + t[1][0]);
   return std::hypot(d, s);
 }
+double mean_3d(const Tensor<3>& t) { return (t[0][0] + t[1][1] + t[2][2]) / 3.0; }
+double deviator_3d(const Tensor<3>& t) {
+  const double p = mean_3d(t);
+  double ss = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double s = 0.5 * (t[i][j] + t[j][i]) - (i == j ? p : 0.0);
+      ss += s * s;
+    }
+  return std::sqrt(1.5 * ss);
+}
 
 #define CD_OBS_INSTANTIATE(D)                                                                    \
   template Tensor<D> contact_stress<D>(std::span<const Contact<D>>, double);                    \

@@ -180,5 +180,10 @@ Tensor<D> fabric_tensor(std::span<const Contact<D>> cs, double f_eps = -1);
 // 2D invariants of a tensor's symmetric part: (s1 + s2)/2 and (s1 - s2)/2.
 double mean_2d(const Tensor<2>& t);
 double deviator_2d(const Tensor<2>& t);
+// 3D invariants of a tensor's symmetric part: p = tr/3 and the von Mises
+// q = sqrt(3/2 s:s), s the deviator of the symmetric part (q = s1 - s3
+// when s2 = s3, a triaxial test's deviator).
+double mean_3d(const Tensor<3>& t);
+double deviator_3d(const Tensor<3>& t);
 
 }  // namespace cd::obs
