@@ -8,10 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <set>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -38,7 +36,7 @@ struct PrepRecord {
   int worst_step = 0;
 };
 
-PrepRecord run_prep(cd::World& w, const cd::Scene& s, long nsteps, bool verbose = false) {
+PrepRecord run_prep(cd::World& w, const cd::Scene& s, long nsteps) {
   PrepRecord r;
   const double tp = cd::pressure_time(s), dt = w.params().dt;
   const double alert = w.params().alert;
@@ -70,13 +68,6 @@ PrepRecord run_prep(cd::World& w, const cd::Scene& s, long nsteps, bool verbose 
     r.cap += st.solve.cap_hit;
     r.sweeps += st.solve.iterations;
     ++r.steps;
-    if (verbose && (k % 100 == 0 || k == nsteps))
-      std::printf("step %5ld  W %.4g H %.4g  rate %.3g/t_p  approach %.3g alert  ov %.3g  "
-                  "it %d  contacts %d  KE %.3g\n",
-                  k, w.cell.width, w.cell.height,
-                  std::max(std::abs(w.cell.wdot) / w.cell.width, std::abs(w.cell.hdot) / w.cell.height) * tp,
-                  ldot * dt / alert, st.max_overlap_small, st.solve.iterations, st.contacts,
-                  w.kinetic_energy());
   }
   return r;
 }
@@ -93,35 +84,6 @@ double seconds_since(const std::chrono::steady_clock::time_point& t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-std::vector<std::string> split_env(const char* name) {
-  std::vector<std::string> v;
-  if (const char* e = std::getenv(name)) {
-    std::istringstream in(e);
-    std::string t;
-    while (in >> t) v.push_back(t);
-  }
-  return v;
-}
-
-}  // namespace
-
-// Not run by ctest: a preparation of configs/shear-prep.toml with the
-// overrides in CDLAB_PREP_SET (whitespace-separated section.key=value),
-// printing what it did every 100 steps and failing if an overlap reached
-// 0.01 of the smaller grain (make prep-overlap runs it at N = 1000). By hand:
-//   CDLAB_PREP_SET='particles.n=300 particles.size_ratio=4 shear.width=0 shear.height=0'
-//     build/tests/test_prep_overlap --gtest_also_run_disabled_tests --gtest_filter='*Diagnose*'
-TEST(PrepDiagnose, DISABLED_Diagnose) {
-  const cd::Scene s = cd::load_scene(kSrc + "/configs/shear-prep.toml", split_env("CDLAB_PREP_SET"));
-  cd::World w = cd::build_world(s);
-  const long n = std::lround(cd::run_duration(s) / w.params().dt);
-  const auto t0 = std::chrono::steady_clock::now();
-  const PrepRecord r = run_prep(w, s, n, true);
-  print("prep", r, seconds_since(t0));
-  EXPECT_LE(r.ov_max, 0.01) << "step " << r.worst_step;
-}
-
-namespace {
 
 // The preparation of configs/shear-prep.toml at d_max/d_min = 4 (uniform by
 // area, the cell sized for the grains), n grains of the given shapes.
