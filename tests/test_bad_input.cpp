@@ -86,6 +86,11 @@ TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
   expect_refused("--set 'gravity.g=[nan,-9.81]'", {"gravity.g", "nan"});
   expect_refused("--set solver.tol=inf", {"solver.tol"});
   expect_refused("--set contact.adhesion=inf", {"contact.adhesion"});
+  // The orthotropic cone needs a 2D tangent plane: 3D only.
+  expect_refused("--set contact.mu_b=0.5", {"contact.mu_b", "dimension = 3"});
+  expect_refused("--set contact.mu_wall_b=0.5", {"contact.mu_wall_b", "dimension = 3"});
+  expect_refused("--set 'contact.axis_a=[0,1,0]'", {"contact.axis_a", "dimension = 3"});
+  expect_refused("--set contact.mu_b=nan", {"contact.mu_b"});
   // t_p = d sqrt(rho/p): a huge dt_tp makes a step longer than the run.
   const std::string shear =
       "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 20\n[time]\nduration = 0.01\n"

@@ -192,6 +192,51 @@ TEST(Scene3, RestitutionOfTheSceneReachesTheEngine) {
   EXPECT_NEAR(v_out, -0.5 * v_in, 1e-12 * std::abs(v_in));
 }
 
+// contact.mu_b and contact.axis_a of a 3D scene reach the engine: a sphere
+// on the floor of a wide box under gravity tilted along x (g_x = 12, g_z =
+// -9.81 m/s^2), mu = 0.2 along axis_a and mu_b = 0.6 across it (the floor
+// is a wall: mu_wall and mu_wall_b < 0 take mu and mu_b). Along the 0.2
+// axis tan(theta) = 1.22 > 7/2 mu = 0.7: the sphere slides, its centre
+// accelerating at g_x - mu |g_z| (10.04 m/s^2); along the 0.6 axis 7/2 mu =
+// 2.1 > 1.22: it rolls without slipping at 5/7 g_x (8.57 m/s^2). After the
+// landing (0.5 mm drop) the discrete velocity gains exactly a dt a step: to
+// 1e-9 over 100 steps; no velocity across the slope (the slip is along a
+// principal axis of the ellipse).
+TEST(Scene3, OrthotropicFrictionOfTheSceneReachesTheEngine) {
+  const auto accel = [](const std::string& axis, double& vy) {
+    const Scene s = parse_scene(
+        "dimension = 3\n[gravity]\ng = [12.0, 0.0, -9.81]\n[time]\ndt = 1e-3\n"
+        "[contact]\nmu = 0.2\nmu_b = 0.6\naxis_a = " + axis + "\n"
+        "[box]\nwidth = 1.0\ndepth = 1.0\n"
+        "[particles]\ndiameters = [0.01]\ndensity = 2600.0\n", "ortho.toml");
+    const WorldParams3 p = world_params3(s);
+    EXPECT_TRUE(p.orthotropic);
+    EXPECT_EQ(p.mu_b, 0.6);
+    EXPECT_EQ(p.mu_wall_b, 0.6);
+    EXPECT_NEAR(p.axis_a.norm(), 1.0, 1e-15);
+    World3 w = build_world3(s);
+    for (int k = 0; k < 50; ++k) w.step();  // lands within ~10 steps
+    const double v0 = w.bodies.vel.back().v.x();
+    for (int k = 0; k < 100; ++k) w.step();
+    vy = w.bodies.vel.back().v.y();
+    return (w.bodies.vel.back().v.x() - v0) / 0.1;
+  };
+  double vy = 1.0;
+  EXPECT_NEAR(accel("[2.0, 0.0, 0.0]", vy), 12.0 - 0.2 * 9.81, 1e-9 * 12.0);  // slides
+  EXPECT_NEAR(vy, 0.0, 1e-12);
+  EXPECT_NEAR(accel("[0.0, 1.0, 0.0]", vy), 5.0 / 7.0 * 12.0, 1e-9 * 12.0);  // rolls
+  EXPECT_NEAR(vy, 0.0, 1e-12);
+  // Walls: an explicit mu_wall makes them isotropic unless mu_wall_b is given.
+  const auto params = [](const std::string& extra) {
+    return world_params3(parse_scene("dimension = 3\n[gravity]\ng = [0.0, 0.0, -9.81]\n[contact]\nmu = 0.2\n" +
+                                     extra + "[particles]\ndiameters = [0.01]\n", "w.toml"));
+  };
+  EXPECT_FALSE(params("").orthotropic);
+  EXPECT_EQ(params("mu_b = 0.5\nmu_wall = 0.3\n").mu_wall_b, 0.3);
+  EXPECT_EQ(params("mu_b = 0.5\nmu_wall = 0.3\nmu_wall_b = 0.1\n").mu_wall_b, 0.1);
+  EXPECT_EQ(params("mu_wall_b = 0.1\n").mu_b, 0.2);  // walls alone orthotropic
+}
+
 // pile3d at N = 300 through cdsim: the pile comes to rest (kinetic energy
 // below 1e-4 m_total g d_mean at 0.6 s, after the ~0.12 s fall; a settled
 // run measured 6e-8 J against m g d = 0.014 J) with overlaps bounded by
@@ -383,5 +428,8 @@ TEST(Scene3, BadInputIsRefusedNamingTheKey) {
   refused("--set shear.mode=\\\"periodic\\\"", {"gravity.g", "no floor"});
   refused("--set shear.mode=\\\"walls\\\"", {"shear.mode", "tri-periodic"});
   refused("--set particles.n=0", {"particles.n"});
+  refused("--set 'contact.axis_a=[0,0,0]'", {"contact.axis_a", "non-zero"});
+  refused("--set 'contact.axis_a=[1,0]'", {"contact.axis_a"});
+  refused("--set 'contact.axis_a=[1,0,inf]'", {"contact.axis_a", "finite"});
   refused("--dump-problem 3", {"--dump-problem", "dimension = 3"});
 }

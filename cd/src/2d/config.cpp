@@ -115,6 +115,9 @@ const std::vector<Param<Scene>>& scene_params() {
       {"gravity", "g", &Scene::gravity, "m/s^2", vector_of(2, 3), "gravity vector: [gx, gy] in 2D, [gx, gy, gz] in 3D (z up)"},
       {"contact", "mu", &Scene::mu, "", ge(0), "particle-particle friction coefficient"},
       {"contact", "mu_wall", &Scene::mu_wall, "", any(), "particle-wall friction coefficient; < 0: same as mu"},
+      {"contact", "mu_b", &Scene::mu_b, "", any(), "3D only: orthotropic Coulomb friction, the elliptic cone |(r_a/mu, r_b/mu_b)| <= r_n: mu_b is the friction coefficient across contact.axis_a (mu along it); < 0: off (the round cone of mu)"},
+      {"contact", "mu_wall_b", &Scene::mu_wall_b, "", any(), "3D only: the orthotropic cone on walls, across axis_a (mu_wall along it); < 0: mu_b when mu_wall < 0 (walls as spheres), else mu_wall (walls isotropic)"},
+      {"contact", "axis_a", &Scene::axis_a, "", vector_of(3, 3), "3D only: the direction a of the orthotropic law, fixed in the world; each contact's t1 is its projection on the tangent plane (a contact whose normal is along axis_a keeps its default frame); any non-zero length"},
       {"contact", "e_n", &Scene::e_n, "", in(0, 1), "normal restitution coefficient"},
       {"contact", "e_t", &Scene::e_t, "", in(0, 1), "tangential restitution coefficient"},
       {"contact", "alert", &Scene::alert, "d_mean", ge(0), "alert distance of contact detection, in mean diameters"},
@@ -498,6 +501,18 @@ Scene read_scene(const toml::value& root, const std::string& path) {
     out.add(child(child(root, "box"), "depth"), "depth",
             fmt::format("box.depth = {}: only a dimension = 3 scene has a depth",
                         text(s.box_depth, false)));
+  if (s.dimension == 2 && (s.mu_b >= 0 || s.mu_wall_b >= 0))
+    out.add(child(child(root, "contact"), s.mu_b >= 0 ? "mu_b" : "mu_wall_b"), s.mu_b >= 0 ? "mu_b" : "mu_wall_b",
+            fmt::format("contact.{} = {}: an orthotropic (elliptic) cone needs a 2D tangent plane, "
+                        "only a dimension = 3 scene has one", s.mu_b >= 0 ? "mu_b" : "mu_wall_b",
+                        text(s.mu_b >= 0 ? s.mu_b : s.mu_wall_b, false)));
+  if (s.axis_a.size() == 3 && s.dimension == 3 && s.axis_a[0] == 0 && s.axis_a[1] == 0 && s.axis_a[2] == 0)
+    out.add(child(child(root, "contact"), "axis_a"), "axis_a",
+            "contact.axis_a = [0, 0, 0]: the orthotropic direction needs a non-zero length");
+  if (s.dimension == 2 && s.axis_a != std::vector<double>{1.0, 0.0, 0.0})
+    out.add(child(child(root, "contact"), "axis_a"), "axis_a",
+            fmt::format("contact.axis_a = {}: only a dimension = 3 scene has an orthotropic cone",
+                        text(s.axis_a, false)));
   if (s.dimension == 2 && s.cell_depth > 0)
     out.add(child(child(root, "shear"), "depth"), "depth",
             fmt::format("shear.depth = {}: only a dimension = 3 scene has a depth",

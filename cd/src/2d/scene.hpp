@@ -44,6 +44,11 @@ struct Scene {
   // [contact]
   double mu = 0.4;           // particle-particle friction coefficient
   double mu_wall = -1.0;     // particle-wall friction (< 0: same as mu)
+  // 3D orthotropic Coulomb (elliptic cone, method.md section 14): mu along
+  // axis_a's projection on the tangent plane, mu_b across it; < 0: off.
+  double mu_b = -1.0;
+  double mu_wall_b = -1.0;   // on walls (< 0: mu_b if mu_wall < 0, else mu_wall)
+  std::vector<double> axis_a = {1.0, 0.0, 0.0};
   double e_n = 0.0;          // normal restitution
   double e_t = 0.0;          // tangential restitution
   double alert = 0.1;        // alert distance, in mean diameters

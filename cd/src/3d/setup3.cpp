@@ -149,6 +149,13 @@ WorldParams3 world_params3(const Scene& s0) {
   p.gravity = Vec3(s.gravity[0], s.gravity[1], s.gravity[2]);
   p.mu = s.mu;
   p.mu_wall = s.mu_w();
+  // Orthotropic Coulomb: on when mu_b or mu_wall_b is set (>= 0).
+  if (s.mu_b >= 0 || s.mu_wall_b >= 0) {
+    p.orthotropic = true;
+    p.axis_a = Vec3(s.axis_a[0], s.axis_a[1], s.axis_a[2]).normalized();
+    p.mu_b = s.mu_b >= 0 ? s.mu_b : s.mu;
+    p.mu_wall_b = s.mu_wall_b >= 0 ? s.mu_wall_b : (s.mu_wall < 0 ? p.mu_b : s.mu_wall);
+  }
   p.d_ref = mean_diameter(s);
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
