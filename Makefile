@@ -16,7 +16,7 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 
 .PHONY: prep-overlap
-.PHONY: all deps build run test bench regress accuracy-cost accuracy-shear tensile clean help analyze-inertial analyze-inertial-ladder analyze-cohesive analyze-angularity scene-doc figures frozen-shear
+.PHONY: all deps build run test bench regress accuracy-cost accuracy-shear tensile clean help analyze-inertial analyze-inertial-ladder analyze-pressure analyze-pressure-ladder analyze-cohesive analyze-angularity scene-doc figures frozen-shear
 
 all: build
 
@@ -34,6 +34,7 @@ help:
 	@echo "make figures        regenerate docs/figures/ (installs ParaView's pvbatch and xvfb if missing; not part of make test)"
 	@echo "make campaign-inertial|campaign-cohesive|campaign-angularity [N=200 STRAIN=2 P=100 ...]"
 	@echo "make campaign-inertial-ladder  the inertial values from the highest I down, each from the point above"
+	@echo "make campaign-pressure[-ladder]  steady shear at PRESSURE_I under each p of PRESSURE_P (ladder: lowest p up)"
 	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
 	@echo "make frozen-shear   steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into $(FROZEN)/ [FS_N=1000]"
 	@echo "make regress        re-run the reference campaign, refit mu(I), compare with tests/data/regress/"
@@ -185,9 +186,10 @@ SIZE_DIST  ?= uniform_area
 # 0.005 d of relative sliding per step (dt <= 0.005 t_p / I).
 dt_tp = $(shell awk 'BEGIN { x = 0.005 / $(1); printf "%.4g", x < 0.05 ? x : 0.05 }')
 # 100 series rows per unit strain: 0.01 / shear rate = 0.01 t_p / I.
-series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt(2.6 / $(P)) / $(1) }')
+# (A second argument, when given, is the pressure instead of P.)
+series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt(2.6 / $(or $(2),$(P))) / $(1) }')
 # A contact snapshot every 0.2 strain (fabric, cdanalysis fabric / report).
-snapshot_dt = $(shell awk 'BEGIN { printf "%.6g", 0.2e-3 * sqrt(2.6 / $(P)) / $(1) }')
+snapshot_dt = $(shell awk 'BEGIN { printf "%.6g", 0.2e-3 * sqrt(2.6 / $(or $(2),$(P))) / $(1) }')
 # Checkpoints every CKPT_STRAIN of shear strain and at most every CKPT_WALL
 # seconds of wall clock (at the next series row), so that a kill loses little
 # (docs/shear.md). Preparations have no strain: the wall clock alone.
@@ -259,6 +261,35 @@ $(CAMPAIGNS)/inertial-ladder/I_%/.done: $$(call ladder_start,$$*)/.done
 	  --set shear.start='"$(call ladder_start,$*)/checkpoint.bin"' --set shear.pressure=$(P) \
 	  --set shear.inertial_number=$* --set shear.strain=$(LADDER_STRAIN) --set shear.dt_tp=$(call dt_tp,$*) \
 	  --set output.series_interval=$(call series_dt,$*) --set output.snapshot_interval=$(call snapshot_dt,$*)
+	touch $@
+
+# The pressure series (make campaign-pressure, campaign-pressure-ladder): steady
+# shear at PRESSURE_I under each p of PRESSURE_P, the critical-state
+# compaction law e(p) of `cdanalysis fit compaction` (make analyze-pressure).
+# Fresh runs start from the sample compacted at P (the cell finds each p);
+# the ladder runs the values from the lowest p up, each from the end state of
+# the point below (a loading path), the lowest from the sample. The time step
+# is dt_tp in each run's own t_p = d sqrt(rho/p), so every run takes the
+# same number of steps per unit strain.
+PRESSURE_P ?= 10 30 100 300 1000
+PRESSURE_I ?= 0.01
+pressure_runs := $(foreach p,$(PRESSURE_P),$(CAMPAIGNS)/pressure/p_$(p))
+pressure_ladder_runs := $(foreach p,$(PRESSURE_P),$(CAMPAIGNS)/pressure-ladder/p_$(p))
+pressure_below = $(shell printf '%s\n' $(PRESSURE_P) | sort -gr | awk -v p=$(1) 'f { print; exit } $$1 == p { f = 1 }')
+pressure_start = $(if $(call pressure_below,$(1)),$(CAMPAIGNS)/pressure-ladder/p_$(call pressure_below,$(1)),$(CAMPAIGNS)/prep/ns_0)
+pressure_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --set solver.tol=$(SHEAR_TOL) \
+	  --set shear.start='"$(2)/checkpoint.bin"' --set shear.pressure=$(1) \
+	  --set shear.inertial_number=$(PRESSURE_I) --set shear.dt_tp=$(call dt_tp,$(PRESSURE_I)) \
+	  --set output.series_interval=$(call series_dt,$(PRESSURE_I),$(1)) \
+	  --set output.snapshot_interval=$(call snapshot_dt,$(PRESSURE_I),$(1))
+.PHONY: campaign-pressure campaign-pressure-ladder
+campaign-pressure: $(addsuffix /.done,$(pressure_runs))
+campaign-pressure-ladder: $(addsuffix /.done,$(pressure_ladder_runs))
+$(CAMPAIGNS)/pressure/p_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
+	$(call pressure_run,$*,$(CAMPAIGNS)/prep/ns_0) --set shear.strain=$(STRAIN)
+	touch $@
+$(CAMPAIGNS)/pressure-ladder/p_%/.done: $$(call pressure_start,$$*)/.done
+	$(call pressure_run,$*,$(call pressure_start,$*)) --set shear.strain=$(LADDER_STRAIN)
 	touch $@
 
 # eta_<eta>_I_<I>: f_a = eta p d; eta = 0 are the reference runs of the fit.
@@ -381,6 +412,10 @@ analyze-inertial: build
 analyze-cohesive: build
 	$(CDA) report $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive
 	$(CDA) fit cohesion $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive/cohesion --toml $(ANALYSIS)/cohesive/cohesion.toml
+
+analyze-pressure analyze-pressure-ladder: analyze-%: build
+	$(CDA) report $(CAMPAIGNS)/$* --out $(ANALYSIS)/$*
+	$(CDA) fit compaction $(CAMPAIGNS)/$* --out $(ANALYSIS)/$*/compaction --toml $(ANALYSIS)/$*/compaction.toml
 
 analyze-inertial-ladder: build
 	$(CDA) report $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder
