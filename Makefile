@@ -231,10 +231,14 @@ $(CAMPAIGNS)/prep/ns_%/.done: | build
 # steady shear": 1e-3 keeps mu*, phi and z of disks at I >= 1e-2 within the
 # error bars of 1e-5 at a quarter of 1e-4's cost; I = 1e-3 not yet measured).
 SHEAR_TOL ?= 1e-4
-shear_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --set solver.tol=$(SHEAR_TOL) \
-	  --set shear.start='"$(CAMPAIGNS)/prep/ns_$(2)/checkpoint.bin"' --set particles.nsides=[$(2)] --set shear.pressure=$(P) \
-	  --set shear.inertial_number=$(1) --set shear.strain=$(STRAIN) --set shear.dt_tp=$(call dt_tp,$(1)) \
-	  --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=$(call snapshot_dt,$(1))
+# One shear run of every campaign (fresh, ladder, pressure series): $(1) I,
+# $(2) the run folder it starts from, $(3) p, $(4) strain.
+shear_cmd = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --set solver.tol=$(SHEAR_TOL) \
+	  --set shear.start='"$(2)/checkpoint.bin"' --set shear.pressure=$(3) \
+	  --set shear.inertial_number=$(1) --set shear.strain=$(4) --set shear.dt_tp=$(call dt_tp,$(1)) \
+	  --set output.series_interval=$(call series_dt,$(1),$(3)) --set output.snapshot_interval=$(call snapshot_dt,$(1),$(3))
+# A fresh run: $(1) I, $(2) the shape (its compacted sample).
+shear_run = $(call shear_cmd,$(1),$(CAMPAIGNS)/prep/ns_$(2),$(P),$(STRAIN)) --set particles.nsides=[$(2)]
 
 $(CAMPAIGNS)/inertial/I_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
 	$(call shear_run,$*,0)
@@ -257,10 +261,7 @@ ladder_start = $(if $(call ladder_above,$(1)),$(CAMPAIGNS)/inertial-ladder/I_$(c
 campaign-inertial-ladder: $(addsuffix /.done,$(ladder_runs))
 .SECONDEXPANSION:
 $(CAMPAIGNS)/inertial-ladder/I_%/.done: $$(call ladder_start,$$*)/.done
-	$(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) \
-	  --set shear.start='"$(call ladder_start,$*)/checkpoint.bin"' --set shear.pressure=$(P) \
-	  --set shear.inertial_number=$* --set shear.strain=$(LADDER_STRAIN) --set shear.dt_tp=$(call dt_tp,$*) \
-	  --set output.series_interval=$(call series_dt,$*) --set output.snapshot_interval=$(call snapshot_dt,$*)
+	$(call shear_cmd,$*,$(call ladder_start,$*),$(P),$(LADDER_STRAIN))
 	touch $@
 
 # The pressure series (make campaign-pressure, campaign-pressure-ladder): steady
@@ -277,19 +278,15 @@ pressure_runs := $(foreach p,$(PRESSURE_P),$(CAMPAIGNS)/pressure/p_$(p))
 pressure_ladder_runs := $(foreach p,$(PRESSURE_P),$(CAMPAIGNS)/pressure-ladder/p_$(p))
 pressure_below = $(shell printf '%s\n' $(PRESSURE_P) | sort -gr | awk -v p=$(1) 'f { print; exit } $$1 == p { f = 1 }')
 pressure_start = $(if $(call pressure_below,$(1)),$(CAMPAIGNS)/pressure-ladder/p_$(call pressure_below,$(1)),$(CAMPAIGNS)/prep/ns_0)
-pressure_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --set solver.tol=$(SHEAR_TOL) \
-	  --set shear.start='"$(2)/checkpoint.bin"' --set shear.pressure=$(1) \
-	  --set shear.inertial_number=$(PRESSURE_I) --set shear.dt_tp=$(call dt_tp,$(PRESSURE_I)) \
-	  --set output.series_interval=$(call series_dt,$(PRESSURE_I),$(1)) \
-	  --set output.snapshot_interval=$(call snapshot_dt,$(PRESSURE_I),$(1))
+pressure_run = $(call shear_cmd,$(PRESSURE_I),$(2),$(1),$(3))
 .PHONY: campaign-pressure campaign-pressure-ladder
 campaign-pressure: $(addsuffix /.done,$(pressure_runs))
 campaign-pressure-ladder: $(addsuffix /.done,$(pressure_ladder_runs))
 $(CAMPAIGNS)/pressure/p_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
-	$(call pressure_run,$*,$(CAMPAIGNS)/prep/ns_0) --set shear.strain=$(STRAIN)
+	$(call pressure_run,$*,$(CAMPAIGNS)/prep/ns_0,$(STRAIN))
 	touch $@
 $(CAMPAIGNS)/pressure-ladder/p_%/.done: $$(call pressure_start,$$*)/.done
-	$(call pressure_run,$*,$(call pressure_start,$*)) --set shear.strain=$(LADDER_STRAIN)
+	$(call pressure_run,$*,$(call pressure_start,$*),$(LADDER_STRAIN))
 	touch $@
 
 # eta_<eta>_I_<I>: f_a = eta p d; eta = 0 are the reference runs of the fit.
