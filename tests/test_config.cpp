@@ -71,6 +71,9 @@ Scene nondefault() {
   s.gravity = {0.1, -9.80665, 0.5};
   s.mu = 0.3;
   s.mu_wall = 0.7;
+  s.mu_b = 0.45;
+  s.mu_wall_b = 0.55;
+  s.axis_a = {0.0, 2.0, 0.0};
   s.e_n = 0.2;
   s.e_t = 1.0;
   s.alert = 0.05;
