@@ -20,6 +20,7 @@
 #include "analysis/src/fit.hpp"
 #include "analysis/src/report.hpp"
 #include "analysis/src/run.hpp"
+#include "analysis/src/scene_info.hpp"
 #include "analysis/src/trends.hpp"
 
 namespace fs = std::filesystem;
@@ -107,7 +108,7 @@ int main(int argc, char** argv) {
   double volume = -1;
   fabric->add_option("run", run, "run folder (holding contacts_NNNNN.vtp)")->required();
   fabric->add_option("--snapshot", snapshot, "snapshot index (negative: from the end)")->capture_default_str();
-  fabric->add_option("--bins", bins, "angular bins over [0, pi)")
+  fabric->add_option("--bins", bins, "angular bins over [0, pi) (2D; 3D runs use the tensors)")
       ->check(CLI::Range(4, 36000))
       ->capture_default_str();
   fabric->add_option("--volume", volume, "volume (area) V for the stress, > 0; default: stress times V")
@@ -238,6 +239,42 @@ int main(int argc, char** argv) {
         if (!plot_series(out, "series_" + column, series, x, column, &r.stats.window))
           fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
       }
+    } else if (fabric->parsed() && run_dimension(run) == 3) {
+      if (!out.empty())
+        throw AnalysisError(fmt::format("fabric --out (polar plots of the angular profiles) is 2D only: '{}' is "
+                                        "a 3D run (dimension = 3 in its scene.toml)", run));
+      const auto f = run_fabric3(run, snapshot, volume);
+      const auto pr = principal(f.stress.s);
+      fmt::print("snapshot   {}\ncontacts   {} ({} force-bearing)\n", f.file, f.contacts, f.physical_contacts);
+      fmt::print("stress     p {:.6g}  q {:.6g}  q/p {:.4f}  (q = (s1 - s3)/3)  q_vm/p {:.4f}  mu {:.4f}  "
+                 "skew {:.3g}{}\n",
+                 f.stress.p(), f.stress.q(), f.stress.q_over_p(), f.stress.q_vm() / f.stress.p(), f.stress.mu(),
+                 f.stress.skew(), f.has_volume ? "" : "  (times V: no --volume)");
+      fmt::print("principal  s1 {:.6g} ({:.3f} {:.3f} {:.3f})  s2 {:.6g}  s3 {:.6g} ({:.3f} {:.3f} {:.3f})\n",
+                 pr.value[0], pr.dir[0][0], pr.dir[0][1], pr.dir[0][2], pr.value[1], pr.value[2], pr.dir[2][0],
+                 pr.dir[2][1], pr.dir[2][2]);
+      fmt::print("fabric     <nn> xx {:.4f}  yy {:.4f}  zz {:.4f}  xy {:.4f}  xz {:.4f}  yz {:.4f}\n", f.fabric[0][0],
+                 f.fabric[1][1], f.fabric[2][2], f.fabric[0][1], f.fabric[0][2], f.fabric[1][2]);
+      if (f.aniso) {
+        const auto& a = *f.aniso;
+        fmt::print("harmonics  a_c {:.4f}  a_n {:.4f}  a_t {:.4f}  <f> {:.6g}  ({} iterations)\n", a.a_c(), a.a_n(),
+                   a.a_t(), a.mean_f, a.iterations);
+        fmt::print("check      q/p {:.4f} vs (2/5)(a_c + a_n + a_t) {:.4f}, with directions {:.4f}, on the stress "
+                   "axes {:.4f}\n",
+                   f.stress.q_over_p(), a.sum_2_5(), a.sum_2_5_tensor(), a.sum_2_5_on(f.stress));
+      } else {
+        fmt::print("harmonics  none: {}\n", f.aniso_problem);
+      }
+      fmt::print("sliding    {:.4f} of force-bearing contacts (status flag)\n", f.sliding);
+      if (f.connectivity) {
+        const auto& c = *f.connectivity;
+        fmt::print("connect.   z {:.4f}  rattlers {} of {}  non-floating {:.4f}  P_c", c.z, c.rattlers,
+                   c.particles, c.non_floating);
+        for (std::size_t i = 0; i < c.P.size(); ++i) fmt::print(" {}:{:.3f}", i, c.P[i]);
+        fmt::print("\n");
+      } else {
+        fmt::print("connect.   no spheres snapshot next to the contacts: z not computed\n");
+      }
     } else if (fabric->parsed()) {
       const auto f = run_fabric(run, snapshot, bins, volume);
       fmt::print("snapshot   {}\ncontacts   {} ({} force-bearing physical)\n", f.file, f.contacts,
@@ -280,10 +317,17 @@ int main(int argc, char** argv) {
         if (runs.empty()) throw AnalysisError("fit mu-i: give run folders or --table");
         std::optional<std::pair<double, double>> range;
         if (!window.empty()) range = parse_range(window);
-        for (const auto& r : expand_runs(runs)) {
+        const auto all = expand_runs(runs);
+        const int dim = run_dimension(all.front());
+        for (const auto& r : all)
+          if (run_dimension(r) != dim)
+            throw AnalysisError(fmt::format("fit mu-i: '{}' is a {}D run and '{}' a {}D run: one fit mixes no "
+                                            "dimensions", all.front(), dim, r, 5 - dim));
+        if (dim == 3) fmt::print("3D runs: mu = shear_stress_ratio = -(sxy + syx)/2 / syy\n");
+        for (const auto& r : all) {
           const auto series = read_series(r);
           const auto x = default_x_column(series);
-          const auto s = run_steady(r, series, "q_over_p", x, range);
+          const auto s = run_steady(r, series, mu_column(dim), x, range);
           const auto si = measured_inertial_number(series, x, s.stats.window);
           I.push_back(si.mean);
           mu.push_back(s.stats.mean);
@@ -362,6 +406,7 @@ int main(int argc, char** argv) {
       for (const auto& r : all) {
         // A run too short for its bins is skipped with the reason (the
         // transient data of the other runs still make a fit); none usable: error.
+        refuse_3d(r, "fit dilatancy (sin psi from the 2D Mohr circle of the strain rate)");
         try {
           rd.push_back(run_dilatancy(r, read_series(r), opt));
         } catch (const AnalysisError& e) {
@@ -516,6 +561,16 @@ int main(int argc, char** argv) {
       fmt::print("reference {}\nnew       {}\n{}", ref_toml, new_toml, format_comparison(c, tol_sigma, tol_rel));
       if (!c.ok()) return 1;
     } else if (bounds->parsed()) {
+      {  // a 3D fabric table (the report's, with a_n) is refused before its values are read
+        std::ifstream head(table);
+        std::string line;
+        std::getline(head, line);
+        if (("," + line + ",").find(",a_n,") != std::string::npos)
+          throw AnalysisError(fmt::format("fit fabric-bounds is 2D only: '{}' is a 3D fabric table (column a_n); "
+                                          "the bounds of method.md §11 bound the 2D density (z/2pi)(1 + a_c cos "
+                                          "2theta)",
+                                          table));
+      }
       const auto t = Table::read_csv(table);
       const auto b = fabric_bounds(t.column("z"), t.column("a_c"), col_or_empty(t, "z_err"),
                                    col_or_empty(t, "a_c_err"), k_bound);

@@ -53,6 +53,7 @@ struct ReportSummary {
   std::vector<std::string> kinds;  // what the runs vary (inertial, cohesive, angularity, pressure)
   std::vector<std::string> fits;   // models fitted into fits.toml
   std::size_t angularity = 0;      // runs in angularity.csv
+  int dimension = 2;               // the campaign's (its first run's scene.toml)
 };
 
 // The whole report of a campaign into out_dir (created): runs.csv, steady.csv
@@ -61,7 +62,10 @@ struct ReportSummary {
 // and fabric.csv, which are read back as numbers, "n/a" in runs.csv, when a
 // run has none), fits.toml, plots, cost_I.{csv,png,svg} for a campaign over
 // I, and index.html with a table of points (physics and cost) and the
-// campaign's total wall and CPU time.
+// campaign's total wall and CPU time. A 3D campaign (dimension = 3 in the
+// first run's scene.toml) takes mu = shear_stress_ratio and writes the 3D
+// anisotropies into fabric.csv (docs/analysis.md, "3D runs"); runs of the
+// other dimension are listed under problems and skipped.
 ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins = 36);
 
 }  // namespace cda

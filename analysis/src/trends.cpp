@@ -70,6 +70,10 @@ AngularityPoint angularity_point(const std::string& run_dir, const AngularityOpt
   AngularityPoint a;
   a.run = run_dir;
   const auto scene = read_scene_info(run_dir);
+  if (scene.dimension == 3)
+    throw AnalysisError(fmt::format("fit angularity is 2D only: '{}' is a 3D run (dimension = 3 in its "
+                                    "scene.toml; 3D runs are spheres)",
+                                    run_dir));
   a.friction = scene.friction.value_or(0);
   a.sliding_tol = scene.solver_tol.value_or(1e-4);
 
