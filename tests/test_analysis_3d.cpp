@@ -616,12 +616,26 @@ TEST(Commands3, ReportFitAndRefusals) {
     EXPECT_NE(r.out.find(what), std::string::npos) << cmd << "\n" << r.out;
     EXPECT_NE(r.out.find("3D"), std::string::npos) << cmd << "\n" << r.out;
   }
+  // steady without --column: the 3D mu column.
+  const auto sty = cdtest::run_command(fmt::format("{} steady {}", exe.string(), r0));
+  ASSERT_EQ(sty.code, 0) << sty.out;
+  EXPECT_NE(sty.out.find("column     shear_stress_ratio"), std::string::npos) << sty.out;
   // One fit mixes no dimensions.
   const auto two = camp.parent_path() / "two_d";
   fs::remove_all(two);
   synth::RunSpec s2;
   synth::write_run(two, s2);
-  const auto mix = cdtest::run_command(fmt::format("{} fit mu-i {} {}", exe.string(), r0, two.string()));
-  EXPECT_EQ(mix.code, 1) << mix.out;
-  EXPECT_NE(mix.out.find("mixes no dimensions"), std::string::npos) << mix.out;
+  for (const char* fit : {"mu-i", "nu-i", "compaction"}) {
+    const auto mix = cdtest::run_command(fmt::format("{} fit {} {} {}", exe.string(), fit, r0, two.string()));
+    EXPECT_EQ(mix.code, 1) << mix.out;
+    EXPECT_NE(mix.out.find("mixes no dimensions"), std::string::npos) << fit << ": " << mix.out;
+  }
+  // A 3D snapshot in a folder without scene.toml (read as 2D) is refused by the 2D reader.
+  const auto lone = camp.parent_path() / "lone";
+  fs::remove_all(lone);
+  fs::create_directories(lone);
+  fs::copy_file(camp / "I0" / "contacts_00000.vtp", lone / "contacts_00000.vtp");
+  const auto l = cdtest::run_command(fmt::format("{} fabric {}", exe.string(), lone.string()));
+  EXPECT_EQ(l.code, 2) << l.out;
+  EXPECT_NE(l.out.find("is a 3D contact snapshot"), std::string::npos) << l.out;
 }

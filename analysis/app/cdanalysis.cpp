@@ -76,6 +76,18 @@ std::vector<std::string> expand_runs(const std::vector<std::string>& args) {
   return runs;
 }
 
+// The dimension shared by the runs of one fit (run_dimension); runs of
+// different dimensions are refused: one fit mixes no dimensions.
+int common_dimension(const std::vector<std::string>& runs, const std::string& what) {
+  if (runs.empty()) return 2;
+  const int dim = run_dimension(runs.front());
+  for (const auto& r : runs)
+    if (const int d = run_dimension(r); d != dim)
+      throw AnalysisError(fmt::format("{}: '{}' is a {}D run and '{}' a {}D run: one fit mixes no dimensions",
+                                      what, runs.front(), dim, r, d));
+  return dim;
+}
+
 // The command as typed, for the plots' "made by" line.
 std::string command_line(int argc, char** argv) {
   std::string c = "cdanalysis";
@@ -95,9 +107,9 @@ int main(int argc, char** argv) {
 
   // steady
   auto* steady = app.add_subcommand("steady", "steady-state mean and error bar of one series column");
-  std::string run, column = "q_over_p", xcol, window, out;
+  std::string run, column, xcol, window, out;
   steady->add_option("run", run, "run folder (holding series.csv)")->required();
-  steady->add_option("--column", column, "column of series.csv")->capture_default_str();
+  steady->add_option("--column", column, "column of series.csv (default: q_over_p; 3D runs: shear_stress_ratio)");
   steady->add_option("--x", xcol, "abscissa column (default: strain if present, else time)");
   steady->add_option("--window", window, "steady window a:b in the abscissa (default: detected)");
   steady->add_option("--out", out, "folder for the time-series plot (png, svg) and its data");
@@ -229,6 +241,7 @@ int main(int argc, char** argv) {
   try {
     if (steady->parsed()) {
       const auto series = read_series(run);
+      if (column.empty()) column = mu_column(run_dimension(run));
       const std::string x = xcol.empty() ? default_x_column(series) : xcol;
       std::optional<std::pair<double, double>> range;
       if (!window.empty()) range = parse_range(window);
@@ -308,6 +321,7 @@ int main(int argc, char** argv) {
       }
     } else if (mu_i->parsed()) {
       std::vector<double> I, mu, err;
+      std::string mu_label = "μ* = q/p";
       if (!table.empty()) {
         const auto t = Table::read_csv(table);
         I = t.column("I");
@@ -318,12 +332,11 @@ int main(int argc, char** argv) {
         std::optional<std::pair<double, double>> range;
         if (!window.empty()) range = parse_range(window);
         const auto all = expand_runs(runs);
-        const int dim = run_dimension(all.front());
-        for (const auto& r : all)
-          if (run_dimension(r) != dim)
-            throw AnalysisError(fmt::format("fit mu-i: '{}' is a {}D run and '{}' a {}D run: one fit mixes no "
-                                            "dimensions", all.front(), dim, r, 5 - dim));
-        if (dim == 3) fmt::print("3D runs: mu = shear_stress_ratio = -(sxy + syx)/2 / syy\n");
+        const int dim = common_dimension(all, "fit mu-i");
+        if (dim == 3) {
+          fmt::print("3D runs: mu = shear_stress_ratio = -(sxy + syx)/2 / syy\n");
+          mu_label = "μ = −σ_xy/σ_yy";
+        }
         for (const auto& r : all) {
           const auto series = read_series(r);
           const auto x = default_x_column(series);
@@ -341,7 +354,7 @@ int main(int argc, char** argv) {
       write_toml(toml_out, {r}, {mu_of_I()});
       if (!out.empty()) {
         if (err.empty()) err.assign(I.size(), 0.0);
-        if (!plot_mu_I(out, I, mu, err, r))
+        if (!plot_mu_I(out, I, mu, err, r, mu_label))
           fmt::print("cdanalysis: gnuplot did not run: {}/mu_I.gp written, no PNG\n", out);
         else
           fmt::print("wrote {}/mu_I.png and mu_I.svg\n", out);
@@ -508,7 +521,9 @@ int main(int argc, char** argv) {
         }
       } else {
         if (runs.empty()) throw AnalysisError("fit: give run folders or --table");
-        for (const auto& r : expand_runs(runs)) {
+        const auto all = expand_runs(runs);
+        common_dimension(all, is_nu ? "fit nu-i" : "fit compaction");
+        for (const auto& r : all) {
           const auto s = state_point(r);
           if (is_nu)
             fmt::print("{}: I = {:.4g} +- {:.2g}, nu = {:.5f} +- {:.5f}\n", r, s.I.v, s.I.err, s.nu.v, s.nu.err);

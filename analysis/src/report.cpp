@@ -191,7 +191,7 @@ bool plot_series(const std::string& dir, const std::string& stem, const Table& s
 }
 
 bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
-               std::span<const double> mu_err, const FitResult& r) {
+               std::span<const double> mu_err, const FitResult& r, const std::string& ylabel) {
   const Model model = mu_of_I();
   std::filesystem::create_directories(dir);
   Table pts({"I", "mu", "mu_err"});
@@ -206,13 +206,13 @@ bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<cons
   }
   curve.write_csv((fs::path(dir) / "mu_I_fit.csv").string());
   const std::string body = fmt::format(
-      "set datafile separator ','\nset logscale x\nset xlabel 'I'\nset ylabel 'μ* = q/p'\n"
+      "set datafile separator ','\nset logscale x\nset xlabel 'I'\nset ylabel '{}'\n"
       "set key top left\nset grid\n"
       "plot 'mu_I_fit.csv' every ::1 using 1:3:4 with filledcurves fc rgb '#cce5ff' title '1σ band', \\\n"
       "     'mu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' "
       "title 'μ_1 = {:.3f}, μ_2 = {:.3f}, I_0 = {:.3g}', \\\n"
       "     'mu_I_data.csv' every ::1 using 1:2:3 with yerrorbars pt 7 lc rgb 'black' title 'runs'\n",
-      r["mu1"], r["mu2"], r["I0"]);
+      ylabel, r["mu1"], r["mu2"], r["I0"]);
   return plot_both(dir, "mu_I", body);
 }
 
@@ -524,7 +524,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         const auto r = fit_mu_I(I, mu, mu_err);
         fits.push_back(r);
         models.push_back(mu_of_I());
-        sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r) && sum.plots_ok;
+        sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r, dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") && sum.plots_ok;
         sum.fits.push_back("mu_I");
         html_fit += fmt::format("<h3>μ(I){}</h3><img src='mu_I.png' width=600><p>{}: μ1 = {:.4f} ± {:.2g}, "
                                 "μ2 = {:.4f} ± {:.2g}, I0 = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",

@@ -33,9 +33,9 @@ bool plot_series(const std::string& dir, const std::string& stem, const Table& s
 // (second-harmonic) fits; 3 plots named <stem>_P, <stem>_fn, <stem>_ft.
 bool plot_polar(const std::string& dir, const std::string& stem, const RunFabric& f);
 // mu(I) points with error bars, the fit and its 1-sigma band: dir/mu_I.{png,svg}
-// (with mu_I_data.csv, mu_I_fit.csv).
+// (with mu_I_data.csv, mu_I_fit.csv). ylabel: what mu is (2D q/p, 3D -sxy/syy).
 bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
-               std::span<const double> mu_err, const FitResult& r);
+               std::span<const double> mu_err, const FitResult& r, const std::string& ylabel = "μ* = q/p");
 
 // Runs of a campaign folder: its subfolders holding series.csv, sorted; the
 // folder itself if it holds series.csv. Throws AnalysisError naming the

@@ -37,8 +37,9 @@ Val mean_sem(const std::vector<double>& x) {
   return {m, std::sqrt(s2 / static_cast<double>(v.size()))};
 }
 
-// The steady window of a run: on q_over_p when the series has it, else on
-// packing_fraction (an isotropic compaction).
+// The steady window of a run: on its mu column (mu_column: 2D q_over_p, 3D
+// shear_stress_ratio) when the series has it, else on packing_fraction (an
+// isotropic compaction).
 struct SteadyRun {
   Table series;
   std::string x;
@@ -48,7 +49,8 @@ struct SteadyRun {
 SteadyRun steady_run(const std::string& run_dir) {
   SteadyRun s{read_series(run_dir), "", {}, {}};
   s.x = default_x_column(s.series);
-  const std::string col = s.series.has("q_over_p") ? "q_over_p" : "packing_fraction";
+  const std::string mu = mu_column(run_dimension(run_dir));  // 3D: shear_stress_ratio
+  const std::string col = s.series.has(mu) ? mu : "packing_fraction";
   const auto r = run_steady(run_dir, s.series, col, s.x, std::nullopt);
   s.w = r.stats.window;
   s.main = r.stats;
