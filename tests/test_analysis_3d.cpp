@@ -630,6 +630,20 @@ TEST(Commands3, ReportFitAndRefusals) {
     EXPECT_EQ(mix.code, 1) << mix.out;
     EXPECT_NE(mix.out.find("mixes no dimensions"), std::string::npos) << fit << ": " << mix.out;
   }
+  // A report of a 3D campaign with a 2D run in it (no dimension key: 2D):
+  // the 2D run is listed and skipped.
+  const auto mixed = camp.parent_path() / "mixed";
+  fs::remove_all(mixed);
+  fs::create_directories(mixed);
+  fs::copy(camp / "I0", mixed / "a3d", fs::copy_options::recursive);
+  fs::copy(two, mixed / "b2d", fs::copy_options::recursive);
+  const auto mr = cdtest::run_command(
+      fmt::format("{} report {} --out {}", exe.string(), mixed.string(), (mixed / "report").string()));
+  ASSERT_EQ(mr.code, 0) << mr.out;
+  EXPECT_NE(mr.out.find("a 2D run in a 3D campaign"), std::string::npos) << mr.out;
+  const Table mst = Table::read_csv((mixed / "report" / "steady.csv").string(), true);
+  EXPECT_EQ(mst.rows(), 1u);  // the 3D run only
+  EXPECT_TRUE(mst.has("shear_stress_ratio"));
   // A 3D snapshot in a folder without scene.toml (read as 2D) is refused by the 2D reader.
   const auto lone = camp.parent_path() / "lone";
   fs::remove_all(lone);

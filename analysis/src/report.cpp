@@ -336,10 +336,11 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
                                               "skipped", run, scene->dimension, dim);
           sum.problems.push_back(why);
           html_runs += fmt::format("<p>{}</p>\n", html_escape(why));
+        } else {  // a skipped run says nothing of the campaign's kind
+          if (scene->cohesion_number) pt.eta = *scene->cohesion_number;
+          if (scene->inertial_number) pt.I_imposed = *scene->inertial_number;
+          if (scene->pressure) pt.pressure = *scene->pressure;
         }
-        if (scene->cohesion_number) pt.eta = *scene->cohesion_number;
-        if (scene->inertial_number) pt.I_imposed = *scene->inertial_number;
-        if (scene->pressure) pt.pressure = *scene->pressure;
       } catch (const AnalysisError&) {
       }
       pt.nsides = run_nsides(run, scene);
