@@ -20,6 +20,7 @@
 #include "analysis/src/fit.hpp"
 #include "analysis/src/report.hpp"
 #include "analysis/src/run.hpp"
+#include "analysis/src/scene_info.hpp"
 #include "analysis/src/trends.hpp"
 
 namespace fs = std::filesystem;
@@ -75,6 +76,18 @@ std::vector<std::string> expand_runs(const std::vector<std::string>& args) {
   return runs;
 }
 
+// The dimension shared by the runs of one fit (run_dimension); runs of
+// different dimensions are refused: one fit mixes no dimensions.
+int common_dimension(const std::vector<std::string>& runs, const std::string& what) {
+  if (runs.empty()) return 2;
+  const int dim = run_dimension(runs.front());
+  for (const auto& r : runs)
+    if (const int d = run_dimension(r); d != dim)
+      throw AnalysisError(fmt::format("{}: '{}' is a {}D run and '{}' a {}D run: one fit mixes no dimensions",
+                                      what, runs.front(), dim, r, d));
+  return dim;
+}
+
 // The command as typed, for the plots' "made by" line.
 std::string command_line(int argc, char** argv) {
   std::string c = "cdanalysis";
@@ -94,9 +107,9 @@ int main(int argc, char** argv) {
 
   // steady
   auto* steady = app.add_subcommand("steady", "steady-state mean and error bar of one series column");
-  std::string run, column = "q_over_p", xcol, window, out;
+  std::string run, column, xcol, window, out;
   steady->add_option("run", run, "run folder (holding series.csv)")->required();
-  steady->add_option("--column", column, "column of series.csv")->capture_default_str();
+  steady->add_option("--column", column, "column of series.csv (default: q_over_p; 3D runs: shear_stress_ratio)");
   steady->add_option("--x", xcol, "abscissa column (default: strain if present, else time)");
   steady->add_option("--window", window, "steady window a:b in the abscissa (default: detected)");
   steady->add_option("--out", out, "folder for the time-series plot (png, svg) and its data");
@@ -107,7 +120,7 @@ int main(int argc, char** argv) {
   double volume = -1;
   fabric->add_option("run", run, "run folder (holding contacts_NNNNN.vtp)")->required();
   fabric->add_option("--snapshot", snapshot, "snapshot index (negative: from the end)")->capture_default_str();
-  fabric->add_option("--bins", bins, "angular bins over [0, pi)")
+  fabric->add_option("--bins", bins, "angular bins over [0, pi) (2D; 3D runs use the tensors)")
       ->check(CLI::Range(4, 36000))
       ->capture_default_str();
   fabric->add_option("--volume", volume, "volume (area) V for the stress, > 0; default: stress times V")
@@ -228,6 +241,7 @@ int main(int argc, char** argv) {
   try {
     if (steady->parsed()) {
       const auto series = read_series(run);
+      if (column.empty()) column = mu_column(run_dimension(run));
       const std::string x = xcol.empty() ? default_x_column(series) : xcol;
       std::optional<std::pair<double, double>> range;
       if (!window.empty()) range = parse_range(window);
@@ -237,6 +251,42 @@ int main(int argc, char** argv) {
         fs::create_directories(out);
         if (!plot_series(out, "series_" + column, series, x, column, &r.stats.window))
           fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
+      }
+    } else if (fabric->parsed() && run_dimension(run) == 3) {
+      if (!out.empty())
+        throw AnalysisError(fmt::format("fabric --out (polar plots of the angular profiles) is 2D only: '{}' is "
+                                        "a 3D run (dimension = 3 in its scene.toml)", run));
+      const auto f = run_fabric3(run, snapshot, volume);
+      const auto pr = principal(f.stress.s);
+      fmt::print("snapshot   {}\ncontacts   {} ({} force-bearing)\n", f.file, f.contacts, f.physical_contacts);
+      fmt::print("stress     p {:.6g}  q {:.6g}  q/p {:.4f}  (q = (s1 - s3)/3)  q_vm/p {:.4f}  mu {:.4f}  "
+                 "skew {:.3g}{}\n",
+                 f.stress.p(), f.stress.q(), f.stress.q_over_p(), f.stress.q_vm() / f.stress.p(), f.stress.mu(),
+                 f.stress.skew(), f.has_volume ? "" : "  (times V: no --volume)");
+      fmt::print("principal  s1 {:.6g} ({:.3f} {:.3f} {:.3f})  s2 {:.6g}  s3 {:.6g} ({:.3f} {:.3f} {:.3f})\n",
+                 pr.value[0], pr.dir[0][0], pr.dir[0][1], pr.dir[0][2], pr.value[1], pr.value[2], pr.dir[2][0],
+                 pr.dir[2][1], pr.dir[2][2]);
+      fmt::print("fabric     <nn> xx {:.4f}  yy {:.4f}  zz {:.4f}  xy {:.4f}  xz {:.4f}  yz {:.4f}\n", f.fabric[0][0],
+                 f.fabric[1][1], f.fabric[2][2], f.fabric[0][1], f.fabric[0][2], f.fabric[1][2]);
+      if (f.aniso) {
+        const auto& a = *f.aniso;
+        fmt::print("harmonics  a_c {:.4f}  a_n {:.4f}  a_t {:.4f}  <f> {:.6g}  ({} iterations)\n", a.a_c(), a.a_n(),
+                   a.a_t(), a.mean_f, a.iterations);
+        fmt::print("check      q/p {:.4f} vs (2/5)(a_c + a_n + a_t) {:.4f}, with directions {:.4f}, on the stress "
+                   "axes {:.4f}\n",
+                   f.stress.q_over_p(), a.sum_2_5(), a.sum_2_5_tensor(), a.sum_2_5_on(f.stress));
+      } else {
+        fmt::print("harmonics  none: {}\n", f.aniso_problem);
+      }
+      fmt::print("sliding    {:.4f} of force-bearing contacts (status flag)\n", f.sliding);
+      if (f.connectivity) {
+        const auto& c = *f.connectivity;
+        fmt::print("connect.   z {:.4f}  rattlers {} of {}  non-floating {:.4f}  P_c", c.z, c.rattlers,
+                   c.particles, c.non_floating);
+        for (std::size_t i = 0; i < c.P.size(); ++i) fmt::print(" {}:{:.3f}", i, c.P[i]);
+        fmt::print("\n");
+      } else {
+        fmt::print("connect.   no spheres snapshot next to the contacts: z not computed\n");
       }
     } else if (fabric->parsed()) {
       const auto f = run_fabric(run, snapshot, bins, volume);
@@ -271,6 +321,7 @@ int main(int argc, char** argv) {
       }
     } else if (mu_i->parsed()) {
       std::vector<double> I, mu, err;
+      std::string mu_label = "μ* = q/p";
       if (!table.empty()) {
         const auto t = Table::read_csv(table);
         I = t.column("I");
@@ -280,10 +331,16 @@ int main(int argc, char** argv) {
         if (runs.empty()) throw AnalysisError("fit mu-i: give run folders or --table");
         std::optional<std::pair<double, double>> range;
         if (!window.empty()) range = parse_range(window);
-        for (const auto& r : expand_runs(runs)) {
+        const auto all = expand_runs(runs);
+        const int dim = common_dimension(all, "fit mu-i");
+        if (dim == 3) {
+          fmt::print("3D runs: mu = shear_stress_ratio = -(sxy + syx)/2 / syy\n");
+          mu_label = "μ = −σ_xy/σ_yy";
+        }
+        for (const auto& r : all) {
           const auto series = read_series(r);
           const auto x = default_x_column(series);
-          const auto s = run_steady(r, series, "q_over_p", x, range);
+          const auto s = run_steady(r, series, mu_column(dim), x, range);
           const auto si = measured_inertial_number(series, x, s.stats.window);
           I.push_back(si.mean);
           mu.push_back(s.stats.mean);
@@ -297,7 +354,7 @@ int main(int argc, char** argv) {
       write_toml(toml_out, {r}, {mu_of_I()});
       if (!out.empty()) {
         if (err.empty()) err.assign(I.size(), 0.0);
-        if (!plot_mu_I(out, I, mu, err, r))
+        if (!plot_mu_I(out, I, mu, err, r, mu_label))
           fmt::print("cdanalysis: gnuplot did not run: {}/mu_I.gp written, no PNG\n", out);
         else
           fmt::print("wrote {}/mu_I.png and mu_I.svg\n", out);
@@ -362,6 +419,7 @@ int main(int argc, char** argv) {
       for (const auto& r : all) {
         // A run too short for its bins is skipped with the reason (the
         // transient data of the other runs still make a fit); none usable: error.
+        refuse_3d(r, "fit dilatancy (sin psi from the 2D Mohr circle of the strain rate)");
         try {
           rd.push_back(run_dilatancy(r, read_series(r), opt));
         } catch (const AnalysisError& e) {
@@ -463,7 +521,9 @@ int main(int argc, char** argv) {
         }
       } else {
         if (runs.empty()) throw AnalysisError("fit: give run folders or --table");
-        for (const auto& r : expand_runs(runs)) {
+        const auto all = expand_runs(runs);
+        common_dimension(all, is_nu ? "fit nu-i" : "fit compaction");
+        for (const auto& r : all) {
           const auto s = state_point(r);
           if (is_nu)
             fmt::print("{}: I = {:.4g} +- {:.2g}, nu = {:.5f} +- {:.5f}\n", r, s.I.v, s.I.err, s.nu.v, s.nu.err);
@@ -516,6 +576,16 @@ int main(int argc, char** argv) {
       fmt::print("reference {}\nnew       {}\n{}", ref_toml, new_toml, format_comparison(c, tol_sigma, tol_rel));
       if (!c.ok()) return 1;
     } else if (bounds->parsed()) {
+      {  // a 3D fabric table (the report's, with a_n) is refused before its values are read
+        std::ifstream head(table);
+        std::string line;
+        std::getline(head, line);
+        if (("," + line + ",").find(",a_n,") != std::string::npos)
+          throw AnalysisError(fmt::format("fit fabric-bounds is 2D only: '{}' is a 3D fabric table (column a_n); "
+                                          "the bounds of method.md §11 bound the 2D density (z/2pi)(1 + a_c cos "
+                                          "2theta)",
+                                          table));
+      }
       const auto t = Table::read_csv(table);
       const auto b = fabric_bounds(t.column("z"), t.column("a_c"), col_or_empty(t, "z_err"),
                                    col_or_empty(t, "a_c_err"), k_bound);

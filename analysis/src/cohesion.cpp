@@ -21,6 +21,11 @@ SteadyPoint steady_point(const std::string& run_dir) {
   SteadyPoint p;
   p.run = run_dir;
   const auto scene = read_scene_info(run_dir);
+  if (scene.dimension == 3)
+    throw AnalysisError(fmt::format("fit cohesion is 2D only: '{}' is a 3D run (dimension = 3 in its scene.toml; "
+                                    "c/p = (q/p - sin phi)/cos phi is the 2D Mohr-Coulomb construction, and 3D "
+                                    "scenes have no cohesion_number yet)",
+                                    run_dir));
   p.eta = require(scene, scene.cohesion_number, "[contact] cohesion_number");
   if (p.eta < 0) throw AnalysisError(fmt::format("'{}': cohesion_number {} is negative", scene.file, p.eta));
   p.I_imposed = scene.inertial_number.value_or(std::numeric_limits<double>::quiet_NaN());

@@ -4,14 +4,16 @@
 
 namespace cda {
 
-Connectivity connectivity(const ContactSet& cs, const ParticleSet& ps, double f_eps,
-                          int min_contacts) {
+namespace {
+
+template <int D, class Set>
+Connectivity connectivity_of(const Set& cs, const ParticleSet& ps, double f_eps, int min_contacts) {
   std::vector<std::int32_t> ids;
   ids.reserve(ps.size());
   for (const auto& p : ps) ids.push_back(p.id);
   cd::obs::Coordination c;
   try {
-    c = cd::obs::coordination<2>(as_forces(cs), ids, f_eps, min_contacts);
+    c = cd::obs::coordination<D>(as_forces(cs), ids, f_eps, min_contacts);
   } catch (const std::invalid_argument& e) {
     throw AnalysisError(e.what());
   }
@@ -24,6 +26,16 @@ Connectivity connectivity(const ContactSet& cs, const ParticleSet& ps, double f_
   r.P = std::move(c.P);
   r.is_rattler = std::move(c.is_rattler);
   return r;
+}
+
+}  // namespace
+
+Connectivity connectivity(const ContactSet& cs, const ParticleSet& ps, double f_eps, int min_contacts) {
+  return connectivity_of<2>(cs, ps, f_eps, min_contacts);
+}
+
+Connectivity connectivity(const ContactSet3& cs, const ParticleSet& ps, double f_eps, int min_contacts) {
+  return connectivity_of<3>(cs, ps, f_eps, min_contacts);
 }
 
 }  // namespace cda

@@ -26,5 +26,8 @@ struct Connectivity {
 // f_eps < 0: cd::obs::force_threshold (1e-9 x mean |fn| of the set).
 Connectivity connectivity(const ContactSet& cs, const ParticleSet& ps, double f_eps = -1,
                           int min_contacts = 2);
+// 3D (spheres): the same definitions (docs/3d.md: a rattler has fewer than 2).
+Connectivity connectivity(const ContactSet3& cs, const ParticleSet& ps, double f_eps = -1,
+                          int min_contacts = 2);
 
 }  // namespace cda

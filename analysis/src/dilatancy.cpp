@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "report.hpp"
+#include "scene_info.hpp"
 #include "steady.hpp"
 
 namespace fs = std::filesystem;
@@ -55,6 +56,7 @@ double sample_var(const std::vector<double>& v) {
 }  // namespace
 
 RunDilatancy run_dilatancy(const std::string& run_dir, const Table& series, const DilatancyOptions& opt) {
+  refuse_3d(run_dir, "fit dilatancy (sin psi from the 2D Mohr circle of the strain rate)");
   RunDilatancy r;
   r.run = run_dir;
   const auto& qp = series.column("q_over_p");

@@ -191,7 +191,7 @@ bool plot_series(const std::string& dir, const std::string& stem, const Table& s
 }
 
 bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
-               std::span<const double> mu_err, const FitResult& r) {
+               std::span<const double> mu_err, const FitResult& r, const std::string& ylabel) {
   const Model model = mu_of_I();
   std::filesystem::create_directories(dir);
   Table pts({"I", "mu", "mu_err"});
@@ -206,13 +206,13 @@ bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<cons
   }
   curve.write_csv((fs::path(dir) / "mu_I_fit.csv").string());
   const std::string body = fmt::format(
-      "set datafile separator ','\nset logscale x\nset xlabel 'I'\nset ylabel 'μ* = q/p'\n"
+      "set datafile separator ','\nset logscale x\nset xlabel 'I'\nset ylabel '{}'\n"
       "set key top left\nset grid\n"
       "plot 'mu_I_fit.csv' every ::1 using 1:3:4 with filledcurves fc rgb '#cce5ff' title '1σ band', \\\n"
       "     'mu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' "
       "title 'μ_1 = {:.3f}, μ_2 = {:.3f}, I_0 = {:.3g}', \\\n"
       "     'mu_I_data.csv' every ::1 using 1:2:3 with yerrorbars pt 7 lc rgb 'black' title 'runs'\n",
-      r["mu1"], r["mu2"], r["I0"]);
+      ylabel, r["mu1"], r["mu2"], r["I0"]);
   return plot_both(dir, "mu_I", body);
 }
 
@@ -280,7 +280,19 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   fs::create_directories(out_dir);
   ReportSummary sum;
   sum.runs = runs.size();
-  const std::vector<std::string> quantities = {"q_over_p", "inertial_number", "packing_fraction", "z", "p"};
+  // The campaign's dimension: its first run whose scene.toml reads (2 when
+  // none does). A run of the other dimension is listed and skipped.
+  int dim = 2;
+  for (const auto& run : runs) {
+    try {
+      dim = run_dimension(run);
+      break;
+    } catch (const AnalysisError&) {
+    }
+  }
+  sum.dimension = dim;
+  const std::string mu_col = mu_column(dim);
+  const std::vector<std::string> quantities = {mu_col, "inertial_number", "packing_fraction", "z", "p"};
   std::vector<std::string> names = {"run"};
   for (const auto& q : quantities) {
     names.push_back(q);
@@ -289,10 +301,14 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   names.insert(names.end(), {"window_begin", "window_end", "tau_int", "n_eff"});
   names.insert(names.end(), kCostColumns.begin(), kCostColumns.end());
   Table steady(names);
-  std::vector<std::string> fabric_names = {
-      "run", "a_c", "theta_c", "a_ln", "a_lt", "a_fn", "a_ft", "sum_half", "q_over_p",
-      "a_c_tensor", "a_ln_tensor", "a_lt_tensor", "a_fn_tensor", "a_ft_tensor",
-      "sliding", "z", "non_floating"};
+  // 3D: the spherical-harmonic anisotropies (fabric3.hpp), q/p with q =
+  // (s1 - s3)/3 beside (2/5) sum a, and mu = -sxy/syy of the snapshot.
+  std::vector<std::string> fabric_names =
+      dim == 3 ? std::vector<std::string>{"run", "a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p",
+                                          "q_vm_over_p", "mu", "sliding", "z", "non_floating"}
+               : std::vector<std::string>{"run", "a_c", "theta_c", "a_ln", "a_lt", "a_fn", "a_ft", "sum_half",
+                                          "q_over_p", "a_c_tensor", "a_ln_tensor", "a_lt_tensor", "a_fn_tensor",
+                                          "a_ft_tensor", "sliding", "z", "non_floating"};
   fabric_names.insert(fabric_names.end(), kCostColumns.begin(), kCostColumns.end());
   Table fabric(fabric_names);
   std::string runs_csv = "run,folder,status";
@@ -314,9 +330,17 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       std::optional<SceneInfo> scene;
       try {
         scene = read_scene_info(run);
-        if (scene->cohesion_number) pt.eta = *scene->cohesion_number;
-        if (scene->inertial_number) pt.I_imposed = *scene->inertial_number;
-        if (scene->pressure) pt.pressure = *scene->pressure;
+        if (scene->dimension != dim) {
+          status = "skipped";
+          const std::string why = fmt::format("{}: a {}D run in a {}D campaign (the first run's dimension): "
+                                              "skipped", run, scene->dimension, dim);
+          sum.problems.push_back(why);
+          html_runs += fmt::format("<p>{}</p>\n", html_escape(why));
+        } else {  // a skipped run says nothing of the campaign's kind
+          if (scene->cohesion_number) pt.eta = *scene->cohesion_number;
+          if (scene->inertial_number) pt.I_imposed = *scene->inertial_number;
+          if (scene->pressure) pt.pressure = *scene->pressure;
+        }
       } catch (const AnalysisError&) {
       }
       pt.nsides = run_nsides(run, scene);
@@ -335,7 +359,8 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     try {
       const auto series = read_series(run);
       const std::string xc = default_x_column(series);
-      const std::string main = series.has("q_over_p") ? "q_over_p" : "kinetic_energy";
+      if (status == "skipped") throw AnalysisError("");
+      const std::string main = series.has(mu_col) ? mu_col : "kinetic_energy";
       Window w{};
       bool have_window = false;
       try {
@@ -364,7 +389,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         pt.mu = row[1], pt.mu_err = row[2], pt.I = row[3], pt.I_err = row[4];
         pt.phi = row[5], pt.phi_err = row[6], pt.z = row[7], pt.z_err = row[8];
         pt.p = row[9], pt.p_err = row[10];
-        pt.steady = series.has("q_over_p") || series.has("packing_fraction");
+        pt.steady = series.has(mu_col) || series.has("packing_fraction");
         ++sum.steady;
       } catch (const AnalysisError& e) {
         status = "not steady";
@@ -373,7 +398,34 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       }
       sum.plots_ok = plot_series(out_dir, stem + "_series", series, xc, main, have_window ? &w : nullptr) && sum.plots_ok;
       html_runs += fmt::format("<img src='{}_series.png' width=600>\n", stem);
-      if (!list_snapshots(run, "contacts").empty()) {
+      if (dim == 3 && !list_snapshots(run, "contacts").empty()) {
+        try {
+          const auto f = run_fabric3(run, -1, -1);
+          if (!f.aniso) sum.problems.push_back(f.aniso_problem);
+          const double nan = std::nan("");
+          const Anisotropy3 a = f.aniso.value_or(Anisotropy3{});
+          const bool ok = f.aniso.has_value();
+          std::vector<double> frow = {static_cast<double>(k), ok ? a.a_c() : nan, ok ? a.a_n() : nan,
+                                      ok ? a.a_t() : nan, ok ? a.sum_2_5() : nan, ok ? a.sum_2_5_tensor() : nan,
+                                      f.stress.q_over_p(), f.stress.q_vm() / f.stress.p(),
+                                      f.stress.mu(), f.sliding,
+                                      f.connectivity ? f.connectivity->z : std::nan(""),
+                                      f.connectivity ? f.connectivity->non_floating : std::nan("")};
+          frow.insert(frow.end(), cost.begin(), cost.end());
+          fabric.add_row(frow);
+          ++sum.fabric;
+          html_runs += fmt::format(
+              "<p>last snapshot {}: {} force-bearing contacts; a_c = {}, a_n = {}, a_t = {}; "
+              "q/p = {} (q = (σ1 − σ3)/3) against (2/5)(a_c + a_n + a_t) = {}; μ = −σ_xy/σ_yy = "
+              "{}; z = {}</p>\n",
+              html_escape(f.file), f.physical_contacts, or_na(frow[1]), or_na(frow[2]), or_na(frow[3]),
+              or_na(f.stress.q_over_p()), or_na(frow[4]), or_na(f.stress.mu()),
+              f.connectivity ? or_na(f.connectivity->z) : std::string("n/a"));
+        } catch (const AnalysisError& e) {
+          sum.problems.push_back(fmt::format("{}: {}", run, e.what()));
+          html_runs += fmt::format("<p>fabric: {}</p>\n", html_escape(e.what()));
+        }
+      } else if (!list_snapshots(run, "contacts").empty()) {
         try {
           const auto f = run_fabric(run, -1, bins, -1);
           const auto& a = f.fft;
@@ -397,9 +449,11 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         }
       }
     } catch (const AnalysisError& e) {
-      status = "unreadable";
-      sum.problems.push_back(e.what());
-      html_runs += fmt::format("<p>{}</p>\n", html_escape(e.what()));
+      if (status != "skipped") {
+        status = "unreadable";
+        sum.problems.push_back(e.what());
+        html_runs += fmt::format("<p>{}</p>\n", html_escape(e.what()));
+      }
     }
     runs_csv += fmt::format("{},\"{}\",{}", k, run, status);
     for (const double v : cost) runs_csv += "," + or_na(v, "{}");  // shortest exact text
@@ -471,7 +525,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         const auto r = fit_mu_I(I, mu, mu_err);
         fits.push_back(r);
         models.push_back(mu_of_I());
-        sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r) && sum.plots_ok;
+        sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r, dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") && sum.plots_ok;
         sum.fits.push_back("mu_I");
         html_fit += fmt::format("<h3>μ(I){}</h3><img src='mu_I.png' width=600><p>{}: μ1 = {:.4f} ± {:.2g}, "
                                 "μ2 = {:.4f} ± {:.2g}, I0 = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",
@@ -647,9 +701,13 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
 
   // The table of points: physics, then what each cost (summary.toml; n/a without one).
   std::string html_points =
-      "<h2>Points</h2>\n<table border=1 cellspacing=0 cellpadding=3>\n"
+      fmt::format("<h2>Points</h2>\n<p>{}D runs{}.</p>\n<table border=1 cellspacing=0 cellpadding=3>\n", dim,
+                  dim == 3 ? ": μ = −(σ_xy + σ_yx)/2σ_yy (shear_stress_ratio); fabric.csv holds a_c, a_n, a_t "
+                             "of the spherical-harmonic expansion and q/p with q = (σ1 − σ3)/3"
+                           : "") +
       "<tr><th colspan=6>physics (steady window)</th><th colspan=5>cost (summary.toml)</th></tr>\n"
-      "<tr><th>run</th><th>status</th><th>I</th><th>μ* = q/p</th><th>φ</th><th>z</th>"
+      "<tr><th>run</th><th>status</th><th>I</th><th>" + std::string(dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") +
+      "</th><th>φ</th><th>z</th>"
       "<th>wall time (s)</th><th>CPU time (s)</th><th>steps</th><th>sweeps/step</th><th>at cap</th></tr>\n";
   for (const Point& p : points) {
     const std::vector<double> c = cost_values(p.cost);

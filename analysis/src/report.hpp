@@ -33,9 +33,9 @@ bool plot_series(const std::string& dir, const std::string& stem, const Table& s
 // (second-harmonic) fits; 3 plots named <stem>_P, <stem>_fn, <stem>_ft.
 bool plot_polar(const std::string& dir, const std::string& stem, const RunFabric& f);
 // mu(I) points with error bars, the fit and its 1-sigma band: dir/mu_I.{png,svg}
-// (with mu_I_data.csv, mu_I_fit.csv).
+// (with mu_I_data.csv, mu_I_fit.csv). ylabel: what mu is (2D q/p, 3D -sxy/syy).
 bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
-               std::span<const double> mu_err, const FitResult& r);
+               std::span<const double> mu_err, const FitResult& r, const std::string& ylabel = "μ* = q/p");
 
 // Runs of a campaign folder: its subfolders holding series.csv, sorted; the
 // folder itself if it holds series.csv. Throws AnalysisError naming the
@@ -53,6 +53,7 @@ struct ReportSummary {
   std::vector<std::string> kinds;  // what the runs vary (inertial, cohesive, angularity, pressure)
   std::vector<std::string> fits;   // models fitted into fits.toml
   std::size_t angularity = 0;      // runs in angularity.csv
+  int dimension = 2;               // the campaign's (its first run's scene.toml)
 };
 
 // The whole report of a campaign into out_dir (created): runs.csv, steady.csv
@@ -61,7 +62,10 @@ struct ReportSummary {
 // and fabric.csv, which are read back as numbers, "n/a" in runs.csv, when a
 // run has none), fits.toml, plots, cost_I.{csv,png,svg} for a campaign over
 // I, and index.html with a table of points (physics and cost) and the
-// campaign's total wall and CPU time.
+// campaign's total wall and CPU time. A 3D campaign (dimension = 3 in the
+// first run's scene.toml) takes mu = shear_stress_ratio and writes the 3D
+// anisotropies into fabric.csv (docs/analysis.md, "3D runs"); runs of the
+// other dimension are listed under problems and skipped.
 ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins = 36);
 
 }  // namespace cda

@@ -129,6 +129,42 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume,
   return f;
 }
 
+RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double mu, double sliding_tol) {
+  RunFabric3 f;
+  f.file = snapshot_path(run_dir, "contacts", k);
+  const auto raw = read_contacts3(f.file);
+  f.contacts = raw.size();
+  const auto forces = as_forces(raw);
+  const double f_eps = cd::obs::force_threshold<3>(forces);
+  ContactSet3 bearing;
+  for (const auto i : cd::obs::force_bearing_points<3>(forces, f_eps)) bearing.push_back(raw[i]);
+  f.physical_contacts = bearing.size();
+  if (bearing.empty()) throw AnalysisError(fmt::format("'{}' has no force-bearing contact", f.file));
+  try {
+    f.aniso = anisotropy3(bearing);
+  } catch (const AnalysisError& e) {
+    f.aniso_problem = fmt::format("'{}': {}", f.file, e.what());
+  }
+  f.has_volume = volume > 0;
+  f.stress = contact_stress3(raw, f.has_volume ? volume : 1.0);
+  f.fabric = cd::obs::fabric_tensor<3>(forces, f_eps);
+  std::size_t flag = 0, coulomb = 0;
+  for (const auto& c : bearing) {
+    flag += c.status == 2;
+    coulomb += c.c.ft_norm() >= mu * c.c.fn * (1 - sliding_tol);
+  }
+  const double nb = static_cast<double>(bearing.size());
+  f.sliding = static_cast<double>(flag) / nb;
+  if (mu > 0) f.sliding_coulomb = static_cast<double>(coulomb) / nb;
+  const std::string pfile =
+      (fs::path(f.file).parent_path() /
+       ("spheres" + fs::path(f.file).filename().string().substr(std::string("contacts").size())))
+          .string();
+  std::error_code ec;
+  if (fs::exists(pfile, ec)) f.connectivity = connectivity(raw, read_particles(pfile), f_eps);
+  return f;
+}
+
 std::pair<double, double> parse_range(const std::string& s) {
   const auto colon = s.find(':');
   auto bad = [&] { return AnalysisError(fmt::format("window '{}' is not of the form a:b with a < b", s)); };

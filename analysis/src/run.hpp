@@ -9,6 +9,7 @@
 
 #include "anisotropy.hpp"
 #include "coordination.hpp"
+#include "fabric3.hpp"
 #include "steady.hpp"
 #include "stress.hpp"
 #include "table.hpp"
@@ -77,6 +78,32 @@ struct RunFabric {
 // mu > 0: also the Coulomb test of sliding with that friction and tolerance.
 RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume, double mu = 0,
                      double sliding_tol = 1e-4);
+
+// Fabric of one 3D contact snapshot (spheres; fabric3.hpp). The fabric and
+// anisotropies are over the force-bearing contacts (cd::obs::bears_force),
+// the stress over all contacts; z from the spheres snapshot with the same
+// number, when it exists.
+struct RunFabric3 {
+  std::string file;
+  std::size_t contacts = 0, physical_contacts = 0;
+  // The anisotropies; empty when the harmonic forms do not fit the contacts
+  // (too few, or anisotropies of order 1), with the reason in aniso_problem.
+  std::optional<Anisotropy3> aniso;
+  std::string aniso_problem;
+  Stress3 stress;  // with the given volume (1 if none: stress times V)
+  bool has_volume = false;
+  double sliding = 0;                          // status flag 2
+  double sliding_coulomb = std::nan("");       // |f_t| >= mu f_n (1 - tol), when mu > 0
+  Mat3 fabric{};                               // <n n>, cd::obs::fabric_tensor<3>
+  std::optional<Connectivity> connectivity;
+};
+RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double mu = 0,
+                       double sliding_tol = 1e-4);
+
+// The column that is mu in the rheology of a run of this dimension: 2D
+// q_over_p (sin phi of the Mohr circle, method.md §11), 3D
+// shear_stress_ratio (-sigma_xy/sigma_yy; the 3D q_over_p is von Mises').
+inline const char* mu_column(int dimension) { return dimension == 3 ? "shear_stress_ratio" : "q_over_p"; }
 
 // "a:b" -> (a, b); throws AnalysisError on bad syntax or a >= b.
 std::pair<double, double> parse_range(const std::string& s);

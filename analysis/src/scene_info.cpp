@@ -41,6 +41,17 @@ SceneInfo read_scene_info(const std::string& run_dir) {
   } catch (const std::exception& e) {
     throw InputError(fmt::format("'{}' does not parse as TOML: {}", s.file, e.what()));
   }
+  if (root.is_table() && root.contains("dimension")) {
+    const auto& d = root.at("dimension");
+    const bool whole = d.is_integer() || (d.is_floating() && std::isfinite(d.as_floating()) &&
+                                               d.as_floating() == std::floor(d.as_floating()) &&
+                                               std::abs(d.as_floating()) < 1e9);
+    const long long v = d.is_integer() ? d.as_integer() : whole ? static_cast<long long>(d.as_floating()) : 0;
+    if (!whole || (v != 2 && v != 3))
+      throw InputError(fmt::format("'{}': dimension is {} (2 or 3 expected)", s.file,
+                                   toml::format(d)));
+    s.dimension = static_cast<int>(v);
+  }
   s.cohesion_number = number(root, "contact", "cohesion_number", s.file);
   s.inertial_number = number(root, "shear", "inertial_number", s.file);
   s.pressure = number(root, "shear", "pressure", s.file);
@@ -78,6 +89,18 @@ SceneInfo read_scene_info(const std::string& run_dir) {
 }
 
 double angularity_of(int nsides) { return nsides == 0 ? 0.0 : 2 * std::numbers::pi / nsides; }
+
+int run_dimension(const std::string& run_dir) {
+  std::error_code ec;
+  if (!fs::exists(fs::path(run_dir) / "scene.toml", ec)) return 2;
+  return read_scene_info(run_dir).dimension;
+}
+
+void refuse_3d(const std::string& run_dir, const std::string& what) {
+  if (run_dimension(run_dir) == 3)
+    throw AnalysisError(fmt::format("{} is 2D only: '{}' is a 3D run (dimension = 3 in its scene.toml)",
+                                    what, run_dir));
+}
 
 double require(const SceneInfo& s, const std::optional<double>& v, const std::string& key) {
   if (!v) throw InputError(fmt::format("'{}' has no {}", s.file, key));

@@ -11,6 +11,9 @@ namespace cda {
 
 struct SceneInfo {
   std::string file;
+  // The top-level `dimension` (2 or 3; absent: 2, cdsim's default). Every
+  // command reads it before it interprets series columns or snapshots.
+  int dimension = 2;
   std::optional<double> cohesion_number;   // [contact] cohesion_number (eta; 0: cohesionless)
   std::optional<double> inertial_number;   // [shear] inertial_number (imposed I)
   std::optional<double> pressure;          // [shear] pressure
@@ -30,6 +33,16 @@ double angularity_of(int nsides);
 // file when it does not parse or a key has a non-numeric value. Absent keys
 // are left empty: the caller says which ones it needs (require()).
 SceneInfo read_scene_info(const std::string& run_dir);
+
+// The dimension of a run: its scene.toml's `dimension` (2 when the key is
+// absent), or 2 when the folder has no scene.toml (synthetic 2D series).
+// Throws InputError when the scene does not parse or the key is not 2 or 3.
+int run_dimension(const std::string& run_dir);
+
+// AnalysisError "<what> is 2D only: '<run>' is a 3D run (dimension = 3 in its
+// scene.toml)" when the run is 3D: the commands whose definitions have no
+// 3D form yet call it before reading anything.
+void refuse_3d(const std::string& run_dir, const std::string& what);
 
 // The value of an optional field, or an AnalysisError naming the file and
 // the key ("[contact] cohesion_number").

@@ -38,6 +38,13 @@ std::vector<cd::obs::Contact<2>> as_forces(const ContactSet& cs) {
   return out;
 }
 
+std::vector<cd::obs::Contact<3>> as_forces(const ContactSet3& cs) {
+  std::vector<cd::obs::Contact<3>> out;
+  out.reserve(cs.size());
+  for (const auto& c : cs) out.push_back(c.c);
+  return out;
+}
+
 ContactSet of_type(const ContactSet& cs, int type) {
   ContactSet out;
   for (const auto& c : cs)
@@ -150,6 +157,15 @@ ContactSet read_contacts(const std::string& path) {
   auto* fn = need(cd, "fn", 1, path);
   auto* ft = need(cd, "ft", 1, path);
   auto* normal = need(cd, "normal", 2, path);
+  const auto refuse_3d = [&](const std::string& why) {
+    return InputError(fmt::format("'{}' is a 3D contact snapshot ({}): a 3D run needs dimension = 3 in its "
+                                  "scene.toml",
+                                  path, why));
+  };
+  if (ft->GetNumberOfComponents() > 1) throw refuse_3d("ft has 3 components");
+  if (normal->GetNumberOfComponents() >= 3)
+    for (vtkIdType i = 0; i < n; ++i)
+      if (normal->GetComponent(i, 2) != 0) throw refuse_3d(fmt::format("normal {} has a z component", i));
   auto* status = need(cd, "status", 1, path);
   auto* type = need(cd, "type", 1, path);
   auto* b1 = need(cd, "b1", 1, path);
@@ -186,6 +202,55 @@ ContactSet read_contacts(const std::string& path) {
   return cs;
 }
 
+ContactSet3 read_contacts3(const std::string& path) {
+  auto pd = read_polydata(path);
+  ContactSet3 cs;
+  const vtkIdType n = pd->GetNumberOfCells();
+  if (n == 0) return cs;
+  auto* cd = pd->GetCellData();
+  auto* fn = need(cd, "fn", 1, path);
+  auto* ft = need(cd, "ft", 1, path);
+  if (ft->GetNumberOfComponents() != 3 || cd->GetArray("type"))
+    throw InputError(fmt::format("'{}' is a 2D contact snapshot (ft has {} component{}): its scene.toml "
+                                 "should not say dimension = 3",
+                                 path, ft->GetNumberOfComponents(), ft->GetNumberOfComponents() == 1 ? "" : "s"));
+  auto* normal = need(cd, "normal", 3, path);
+  auto* status = need(cd, "status", 1, path);
+  auto* b1 = need(cd, "b1", 1, path);
+  auto* b2 = need(cd, "b2", 1, path);
+  vtkDataArray* branch = cd->GetArray("branch");
+  cs.reserve(static_cast<std::size_t>(n));
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType i = 0; i < n; ++i) {
+    Contact3 c;
+    const double* nv = normal->GetTuple(i);
+    const double nn = std::sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
+    if (std::abs(nn - 1) > 1e-6)
+      throw InputError(fmt::format("'{}': contact cell {} has a normal of length {} (unit expected)", path, i, nn));
+    for (int a = 0; a < 3; ++a) c.c.n[a] = nv[a];
+    c.c.fn = fn->GetTuple1(i);
+    const double* t = ft->GetTuple(i);
+    for (int a = 0; a < 3; ++a) c.c.ft[a] = t[a];
+    c.status = static_cast<int>(status->GetTuple1(i));
+    c.c.b1 = static_cast<std::int32_t>(b1->GetTuple1(i));
+    c.c.b2 = static_cast<std::int32_t>(b2->GetTuple1(i));
+    if (branch && branch->GetNumberOfComponents() >= 3) {
+      const double* l = branch->GetTuple(i);
+      for (int a = 0; a < 3; ++a) c.c.l[a] = l[a];
+    } else {
+      pd->GetCellPoints(i, ids);
+      if (ids->GetNumberOfIds() != 2)
+        throw InputError(fmt::format("'{}': contact cell {} is not a line of 2 points", path, i));
+      double p1[3], p2[3];
+      pd->GetPoint(ids->GetId(0), p1);
+      pd->GetPoint(ids->GetId(1), p2);
+      for (int a = 0; a < 3; ++a) c.c.l[a] = p2[a] - p1[a];
+    }
+    cs.push_back(c);
+  }
+  return cs;
+}
+
 ParticleSet read_particles(const std::string& path) {
   auto pd = read_polydata(path);
   ParticleSet ps;
@@ -205,13 +270,15 @@ ParticleSet read_particles(const std::string& path) {
     pd->GetPoint(i, x);
     p.x = x[0];
     p.y = x[1];
+    p.z = x[2];
     p.id = static_cast<int>(id->GetTuple1(i));
     p.radius = radius->GetTuple1(i);
     if (vel) {
       p.vx = vel->GetComponent(i, 0);
       p.vy = vel->GetComponent(i, 1);
+      if (vel->GetNumberOfComponents() >= 3) p.vz = vel->GetComponent(i, 2);
     }
-    if (omega) p.omega = omega->GetTuple1(i);
+    if (omega && omega->GetNumberOfComponents() == 1) p.omega = omega->GetTuple1(i);  // 2D: a scalar
     if (angle) p.angle = angle->GetTuple1(i);
     if (mass) p.mass = mass->GetTuple1(i);
     p.nsides = nsides ? static_cast<int>(nsides->GetTuple1(i)) : -1;
@@ -277,6 +344,61 @@ void write_contacts(const std::string& path, const ContactSet& cs, const Particl
   if (w->Write() != 1) throw InputError(fmt::format("cannot write '{}'", path));
 }
 
+void write_contacts3(const std::string& path, const ContactSet3& cs, const ParticleSet& centres) {
+  std::map<int, const Particle*> by_id;
+  for (const auto& p : centres) by_id[p.id] = &p;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> lines;
+  auto darr = [](const char* name, int comps) {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name);
+    a->SetNumberOfComponents(comps);
+    return vtkSmartPointer<vtkDoubleArray>(a.GetPointer());
+  };
+  auto iarr = [](const char* name) {
+    vtkNew<vtkIntArray> a;
+    a->SetName(name);
+    return vtkSmartPointer<vtkIntArray>(a.GetPointer());
+  };
+  auto fn = darr("fn", 1), ft = darr("ft", 3), force = darr("force", 3), normal = darr("normal", 3),
+       gap = darr("gap", 1);
+  auto status = iarr("status"), b1 = iarr("b1"), b2 = iarr("b2");
+  for (const auto& k : cs) {
+    const auto& c = k.c;
+    double x2[3] = {0, 0, 0};
+    if (auto it = by_id.find(c.b2); it != by_id.end()) {
+      x2[0] = it->second->x;
+      x2[1] = it->second->y;
+      x2[2] = it->second->z;
+    }
+    const vtkIdType i1 = pts->InsertNextPoint(x2[0] - c.l[0], x2[1] - c.l[1], x2[2] - c.l[2]);
+    const vtkIdType i2 = pts->InsertNextPoint(x2);
+    const vtkIdType line[2] = {i1, i2};
+    lines->InsertNextCell(2, line);
+    const auto f = c.force();
+    fn->InsertNextValue(c.fn);
+    ft->InsertNextTuple3(c.ft[0], c.ft[1], c.ft[2]);
+    force->InsertNextTuple3(f[0], f[1], f[2]);
+    normal->InsertNextTuple3(c.n[0], c.n[1], c.n[2]);
+    gap->InsertNextValue(0);
+    status->InsertNextValue(k.status);
+    b1->InsertNextValue(c.b1);
+    b2->InsertNextValue(c.b2);
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->SetLines(lines);
+  for (auto& a : {fn, ft, force, normal, gap}) pd->GetCellData()->AddArray(a);
+  for (auto& a : {status, b1, b2}) pd->GetCellData()->AddArray(a);
+  vtkNew<vtkXMLPolyDataWriter> w;
+  w->SetFileName(path.c_str());
+  w->SetInputData(pd);
+  w->SetDataModeToAppended();
+  w->EncodeAppendedDataOff();
+  if (w->Write() != 1) throw InputError(fmt::format("cannot write '{}'", path));
+}
+
 void write_particles(const std::string& path, const ParticleSet& ps) {
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();  // float32 would cost 1e-7 relative on branch vectors
@@ -291,11 +413,11 @@ void write_particles(const std::string& path, const ParticleSet& ps) {
   angle->SetName("angle");
   mass->SetName("mass");
   for (const auto& p : ps) {
-    pts->InsertNextPoint(p.x, p.y, 0);
+    pts->InsertNextPoint(p.x, p.y, p.z);
     id->InsertNextValue(p.id);
     nsides->InsertNextValue(p.nsides < 0 ? 0 : p.nsides);
     radius->InsertNextValue(p.radius);
-    vel->InsertNextTuple3(p.vx, p.vy, 0);
+    vel->InsertNextTuple3(p.vx, p.vy, p.vz);
     omega->InsertNextValue(p.omega);
     angle->InsertNextValue(p.angle);
     mass->InsertNextValue(p.mass);

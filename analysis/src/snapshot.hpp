@@ -32,9 +32,9 @@ using ContactSet = std::vector<Contact>;
 
 struct Particle {
   int id = 0;
-  double x = 0, y = 0;
+  double x = 0, y = 0, z = 0;  // z: 3D (spheres) snapshots; 0 in 2D
   double radius = 0;
-  double vx = 0, vy = 0, omega = 0, angle = 0, mass = 0;
+  double vx = 0, vy = 0, vz = 0, omega = 0, angle = 0, mass = 0;  // omega: 2D only (0 in 3D)
   int nsides = -1;  // 0 disk, n polygon; -1: the snapshot has no nsides array
 };
 
@@ -53,10 +53,27 @@ ContactSet merge_side_side(const ContactSet& cs);
 // force-bearing and coordination definitions shared with cdsim.
 std::vector<cd::obs::Contact<2>> as_forces(const ContactSet& cs);
 
+// A contact of a 3D snapshot (cd/src/3d/output3.cpp, docs/3d.md): the
+// shared observables' contact (bodies, unit normal n from body 1 to body 2,
+// fn, the tangential force vector ft on body 2, the branch vector l) and the
+// status flag (0 open, 1 stick, 2 slide). Spheres only: one point per body
+// pair. A wall contact's branch runs from the contact point on the wall to
+// the sphere's centre.
+struct Contact3 {
+  cd::obs::Contact<3> c;
+  int status = 0;
+};
+using ContactSet3 = std::vector<Contact3>;
+std::vector<cd::obs::Contact<3>> as_forces(const ContactSet3& cs);
+
 // Readers. Throw AnalysisError naming the file when it is missing, unreadable,
 // or lacks a required array. The branch vector comes from the cell array
 // `branch` when present (periodic runs), else from the line's two points.
+// read_contacts refuses a 3D snapshot (a 3-component ft, or a normal
+// with a z component) by name, and read_contacts3 a 2D one: neither reads
+// the other's data as its own.
 ContactSet read_contacts(const std::string& vtp_path);
+ContactSet3 read_contacts3(const std::string& vtp_path);
 ParticleSet read_particles(const std::string& vtp_path);
 
 // Writers of the same format, for synthetic fixtures (tests, examples).
@@ -66,6 +83,12 @@ ParticleSet read_particles(const std::string& vtp_path);
 void write_contacts(const std::string& vtp_path, const ContactSet& cs,
                     const ParticleSet& centres, bool with_branch = true);
 void write_particles(const std::string& vtp_path, const ParticleSet& ps);
+// cdsim's 3D format: lines from x2 - l to x2 (x2 = body 2's centre in
+// `centres`, the origin if absent), no `branch` array, as output3.cpp.
+void write_contacts3(const std::string& vtp_path, const ContactSet3& cs, const ParticleSet& centres);
+
+// The prefix of the particle snapshots: "particles" in 2D, "spheres" in 3D.
+inline const char* particles_prefix(int dimension) { return dimension == 3 ? "spheres" : "particles"; }
 
 // Snapshot files of a run folder, sorted by their number:
 // prefix "contacts" lists contacts_NNNNN.vtp. Throws if the folder is missing.

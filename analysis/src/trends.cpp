@@ -37,8 +37,9 @@ Val mean_sem(const std::vector<double>& x) {
   return {m, std::sqrt(s2 / static_cast<double>(v.size()))};
 }
 
-// The steady window of a run: on q_over_p when the series has it, else on
-// packing_fraction (an isotropic compaction).
+// The steady window of a run: on its mu column (mu_column: 2D q_over_p, 3D
+// shear_stress_ratio) when the series has it, else on packing_fraction (an
+// isotropic compaction).
 struct SteadyRun {
   Table series;
   std::string x;
@@ -48,7 +49,8 @@ struct SteadyRun {
 SteadyRun steady_run(const std::string& run_dir) {
   SteadyRun s{read_series(run_dir), "", {}, {}};
   s.x = default_x_column(s.series);
-  const std::string col = s.series.has("q_over_p") ? "q_over_p" : "packing_fraction";
+  const std::string mu = mu_column(run_dimension(run_dir));  // 3D: shear_stress_ratio
+  const std::string col = s.series.has(mu) ? mu : "packing_fraction";
   const auto r = run_steady(run_dir, s.series, col, s.x, std::nullopt);
   s.w = r.stats.window;
   s.main = r.stats;
@@ -70,6 +72,10 @@ AngularityPoint angularity_point(const std::string& run_dir, const AngularityOpt
   AngularityPoint a;
   a.run = run_dir;
   const auto scene = read_scene_info(run_dir);
+  if (scene.dimension == 3)
+    throw AnalysisError(fmt::format("fit angularity is 2D only: '{}' is a 3D run (dimension = 3 in its "
+                                    "scene.toml; 3D runs are spheres)",
+                                    run_dir));
   a.friction = scene.friction.value_or(0);
   a.sliding_tol = scene.solver_tol.value_or(1e-4);
 

@@ -1,0 +1,655 @@
+// cdanalysis on 3D runs (issue 13 item 5; docs/analysis.md, "3D runs"):
+// - the contact stress of a 3D snapshot against an exact sum (a cubic
+//   lattice through its periodic images, read back from a VTK file), and
+//   against the stress columns cdsim writes for the same step of a real
+//   tri-periodic run;
+// - the spherical-harmonic anisotropies (analysis/src/fabric3.hpp) against
+//   contacts sampled from the harmonic forms with known A_c, A_n, A_t: each
+//   tensor entry within 5 standard errors (the error measured from 16
+//   independent batches of the sample), the scalars within 0.01;
+// - the stress-fabric relation q/p ~ (2/5)(a_c + a_n + a_t), q = (s1 - s3)/3,
+//   on contacts built from the definitions: exact to second order within
+//   sampling error, and the first-order form within 15 % (the issue's
+//   criterion) at steady-shear-like anisotropies and within 2 % at small ones;
+// - dimension detection and the refusals.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <random>
+#include <regex>
+#include <sstream>
+
+#include "analysis/src/compare.hpp"
+#include "analysis/src/fabric3.hpp"
+#include "analysis/src/run.hpp"
+#include "analysis/src/scene_info.hpp"
+#include "analysis/src/snapshot.hpp"
+#include "analysis_synth.hpp"
+#include "cli_util.hpp"
+#include "run3.hpp"
+#include "setup3.hpp"
+#include "world3.hpp"
+
+namespace fs = std::filesystem;
+using namespace cda;
+
+namespace {
+
+using M3 = Eigen::Matrix3d;
+using V3 = Eigen::Vector3d;
+
+M3 E(const Mat3& t) {
+  M3 m;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m(i, j) = t[i][j];
+  return m;
+}
+Mat3 T(const M3& m) {
+  Mat3 t{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) t[i][j] = m(i, j);
+  return t;
+}
+M3 dev(const M3& m) { return 0.5 * (m + m.transpose()) - (m.trace() / 3) * M3::Identity(); }
+
+// a (3 e e - 1): axisymmetric about e, scalar anisotropy a.
+M3 axisym(double a, V3 e) {
+  e.normalize();
+  return a * (3 * e * e.transpose() - M3::Identity());
+}
+// Simple-shear-like (plane strain): principal values (a, 0, -a) x 3/2 with
+// the major axis at angle t in the xy plane, the intermediate along z; its
+// scalar anisotropy (A1 - A3)/3 is a.
+M3 planar(double a, double t) {
+  const V3 e1(std::cos(t), std::sin(t), 0), e3(-std::sin(t), std::cos(t), 0);
+  return 1.5 * a * (e1 * e1.transpose() - e3 * e3.transpose());
+}
+
+struct Forms {
+  M3 Ac = M3::Zero(), An = M3::Zero(), At = M3::Zero();
+  double f = 1.0, d = 1.0;  // <f>, branch length
+};
+
+// N contacts drawn from the harmonic forms (fabric3.hpp): n by rejection from
+// P(n) ~ 1 + A_c : n n; f_n = <f>(1 + A_n : n n) xi, xi uniform on [0.5, 1.5]
+// (mean 1: the form is the conditional mean); f_t = <f>(2/3)(A_t n - (n.A_t n) n)
+// plus a zero-mean random tangential part; l = d n (the relation's
+// assumption of one branch length).
+ContactSet3 sample(const Forms& F, std::size_t N, std::uint64_t seed) {
+  std::mt19937_64 g(seed);
+  std::normal_distribution<double> G(0, 1);
+  std::uniform_real_distribution<double> U(0, 1);
+  const double cap = 1 + Eigen::SelfAdjointEigenSolver<M3>(F.Ac).eigenvalues().maxCoeff();
+  ContactSet3 cs;
+  cs.reserve(N);
+  while (cs.size() < N) {
+    V3 n(G(g), G(g), G(g));
+    n.normalize();
+    if (U(g) * cap > 1 + n.dot(F.Ac * n)) continue;
+    const double fn = F.f * (1 + n.dot(F.An * n)) * (0.5 + U(g));
+    V3 ft = F.f * (2.0 / 3) * (F.At * n - n.dot(F.At * n) * n);
+    V3 r(G(g), G(g), G(g));
+    r -= r.dot(n) * n;
+    ft += 0.05 * F.f * r;
+    Contact3 c;
+    c.status = 1;
+    c.c.b1 = static_cast<int>(cs.size());
+    c.c.b2 = static_cast<int>(cs.size()) + 1;
+    for (int a = 0; a < 3; ++a) {
+      c.c.n[a] = n[a];
+      c.c.ft[a] = ft[a];
+      c.c.l[a] = F.d * n[a];
+    }
+    c.c.fn = fn;
+    cs.push_back(c);
+  }
+  return cs;
+}
+
+// Estimates of A_c, A_n, A_t, their standard errors from B batches, and the scalars.
+struct Recovered {
+  Anisotropy3 all;
+  M3 se_c, se_n, se_t;
+};
+Recovered recover(const ContactSet3& cs, int B = 16) {
+  Recovered r;
+  r.all = anisotropy3(cs);
+  std::vector<Anisotropy3> parts;
+  const std::size_t m = cs.size() / B;
+  for (int b = 0; b < B; ++b)
+    parts.push_back(anisotropy3(ContactSet3(cs.begin() + b * m, cs.begin() + (b + 1) * m)));
+  auto se = [&](auto get) {
+    M3 mean = M3::Zero(), sq = M3::Zero();
+    for (const auto& p : parts) mean += get(p) / B;
+    for (const auto& p : parts) sq += (get(p) - mean).cwiseAbs2() / (B - 1);
+    return M3((sq / B).cwiseSqrt());  // the error of the mean of B batches ~ that of the whole
+  };
+  r.se_c = se([](const Anisotropy3& a) { return E(a.Ac); });
+  r.se_n = se([](const Anisotropy3& a) { return E(a.An); });
+  r.se_t = se([](const Anisotropy3& a) { return E(a.At); });
+  return r;
+}
+
+void expect_tensor(const M3& est, const M3& truth, const M3& se, const char* what) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      // An entry with no scatter at all would make the test unable to fail.
+      EXPECT_GT(se(i, j), 0.0) << what;
+      EXPECT_LT(se(i, j), 0.01) << what << ": the sample is too small for the test";
+      EXPECT_NEAR(est(i, j), truth(i, j), 5 * se(i, j)) << what << " (" << i << "," << j << ")";
+    }
+}
+
+void check_recovery(const Forms& F, std::uint64_t seed) {
+  const auto cs = sample(F, 200000, seed);
+  const auto r = recover(cs);
+  expect_tensor(E(r.all.Ac), F.Ac, r.se_c, "A_c");
+  expect_tensor(E(r.all.An), F.An, r.se_n, "A_n");
+  expect_tensor(E(r.all.At), F.At, r.se_t, "A_t");
+  EXPECT_NEAR(r.all.a_c(), spread3(T(F.Ac)), 0.01);
+  EXPECT_NEAR(r.all.a_n(), spread3(T(F.An)), 0.01);
+  EXPECT_NEAR(r.all.a_t(), spread3(T(F.At)), 0.01);
+  EXPECT_NEAR(r.all.mean_f, F.f, 0.01 * F.f);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- harmonics
+
+// The classical axisymmetric forms: a (3 e e - 1) gives P = (1 + a(3 cos^2 -
+// 1))/4pi about e, and the fabric F = 1/3 + (2/15) A_c, so a_c = (5/2)(F1 - F3).
+TEST(Fabric3, ScalarsOfTheAxisymmetricForms) {
+  EXPECT_NEAR(spread3(T(axisym(0.3, V3(0, 0, 1)))), 0.3, 1e-14);
+  EXPECT_NEAR(spread3(T(planar(0.2, 0.7))), 0.2, 1e-14);
+  const auto p = principal(T(axisym(0.3, V3(1, 1, 0))));
+  EXPECT_NEAR(p.value[0], 0.6, 1e-14);
+  EXPECT_NEAR(std::abs(p.dir[0][0]), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(p.value[2], -0.3, 1e-14);
+}
+
+TEST(Fabric3, IsotropicNormalsGiveZero) {
+  Forms F;
+  check_recovery(F, 1);
+}
+
+TEST(Fabric3, RecoversAxisymmetricAnisotropies) {
+  Forms F;
+  const V3 e(0.3, -0.5, 1.0);  // an axis that is none of the coordinate axes
+  F.Ac = axisym(0.25, e);
+  F.An = axisym(0.35, e);
+  F.At = axisym(0.12, e);
+  F.f = 3.0;
+  check_recovery(F, 2);
+}
+
+// Simple shear: compression at 135 degrees in the xy plane; forces rotated
+// from the fabric by 10 degrees (non-coaxial), tangential along 135 too.
+TEST(Fabric3, RecoversPlanarNonCoaxialAnisotropies) {
+  Forms F;
+  F.Ac = planar(0.2, 3 * std::numbers::pi / 4);
+  F.An = planar(0.3, 3 * std::numbers::pi / 4 + 0.17);
+  F.At = planar(0.1, 3 * std::numbers::pi / 4);
+  check_recovery(F, 3);
+}
+
+// The first-order definitions (the estimator's starting point) are biased
+// by the product terms at these anisotropies; the fixed point removes it.
+// At a_c = 0.4, a_n = 0.5 the first-order a_n is 0.474, off by more than
+// twice the tolerance of the recovery tests.
+TEST(Fabric3, SecondOrderTermsMatter) {
+  Forms F;
+  const V3 e(0, 0, 1);
+  F.Ac = axisym(0.4, e);
+  F.An = axisym(0.5, e);
+  const auto cs = sample(F, 200000, 4);
+  Eigen::Matrix3d Fab = M3::Zero(), chi = M3::Zero();
+  for (const auto& c : cs) {
+    const V3 n(c.c.n[0], c.c.n[1], c.c.n[2]);
+    Fab += n * n.transpose() / cs.size();
+    chi += c.c.fn * n * n.transpose() / cs.size();
+  }
+  const double first_order_an = spread3(T(7.5 * dev(chi) / chi.trace() - 7.5 * dev(Fab)));
+  // Expected: 0.474 (header's relations), 0.026 from the truth.
+  EXPECT_GT(std::abs(first_order_an - 0.5), 0.02) << first_order_an;
+  EXPECT_NEAR(anisotropy3(cs).a_n(), 0.5, 0.01);
+}
+
+// ---------------------------------------------------------------- relation
+
+namespace {
+
+// sigma/(N d <f>/V) of the forms, to second order (fabric3.hpp):
+// 1/3 + (2/15)(A_c + A_n + A_t) + (4/105) dev(A_c A_n + A_n A_c)
+// + (2/105) dev(A_c A_t + A_t A_c) + (2/45)(A_c : A_n).
+M3 predicted_stress(const Forms& F) {
+  return (1.0 / 3 + (2.0 / 45) * F.Ac.cwiseProduct(F.An).sum()) * M3::Identity() +
+         (2.0 / 15) * (F.Ac + F.An + F.At) + (4.0 / 105) * dev(F.Ac * F.An + F.An * F.Ac) +
+         (2.0 / 105) * dev(F.Ac * F.At + F.At * F.Ac);
+}
+
+struct RelationCheck {
+  double qp, qp_se, qp_exact, sum_2_5, sum_true;
+};
+RelationCheck relation(const Forms& F, std::uint64_t seed) {
+  const std::size_t N = 160000;
+  const auto cs = sample(F, N, seed);
+  const double V = 7.0;
+  RelationCheck r{};
+  const Stress3 s = contact_stress3(cs, V);
+  r.qp = s.q_over_p();
+  std::vector<double> b;
+  for (int k = 0; k < 16; ++k) b.push_back(contact_stress3(ContactSet3(cs.begin() + k * N / 16, cs.begin() + (k + 1) * N / 16), V).q_over_p());
+  double m = 0, v = 0;
+  for (double x : b) m += x / 16;
+  for (double x : b) v += (x - m) * (x - m) / 15;
+  r.qp_se = std::sqrt(v / 16);
+  const Stress3 exact{T(predicted_stress(F))};
+  r.qp_exact = exact.q_over_p();
+  r.sum_2_5 = anisotropy3(cs).sum_2_5();
+  r.sum_true = 0.4 * (spread3(T(F.Ac)) + spread3(T(F.An)) + spread3(T(F.At)));
+  // p: tr sigma/3 = (N d/V)<f>(1 + (2/15) A_c : A_n)/3 exactly (f_t _|_ n).
+  EXPECT_NEAR(s.p(), N * F.d * F.f / V * (1 + (2.0 / 15) * F.Ac.cwiseProduct(F.An).sum()) / 3,
+              0.01 * s.p());
+  return r;
+}
+
+}  // namespace
+
+// Coaxial forms at the size of a steady dense shear flow of spheres
+// (a_c ~ 0.2, a_n ~ 0.3, a_t ~ 0.1), axisymmetric (triaxial) and planar.
+TEST(Fabric3, StressFabricRelationTriaxial) {
+  Forms F;
+  const V3 e(0, 0, 1);
+  F.Ac = axisym(0.2, e);
+  F.An = axisym(0.3, e);
+  F.At = axisym(0.1, e);
+  F.f = 2.0;
+  F.d = 0.01;
+  const auto r = relation(F, 5);
+  EXPECT_NEAR(r.qp, r.qp_exact, 5 * r.qp_se + 1e-4);  // the sum f (x) l of the definitions
+  EXPECT_NEAR(r.sum_2_5, r.sum_true, 0.01);            // the estimated anisotropies
+  EXPECT_NEAR(r.sum_2_5, r.qp, 0.15 * r.qp);           // the relation, first order
+}
+
+TEST(Fabric3, StressFabricRelationPlanar) {
+  Forms F;
+  const double t = 3 * std::numbers::pi / 4;
+  F.Ac = planar(0.2, t);
+  F.An = planar(0.3, t);
+  F.At = planar(0.1, t);
+  const auto r = relation(F, 6);
+  EXPECT_NEAR(r.qp, r.qp_exact, 5 * r.qp_se + 1e-4);
+  EXPECT_NEAR(r.sum_2_5, r.qp, 0.15 * r.qp);
+}
+
+// Small anisotropies: the relation holds to first order (relative error O(a)).
+TEST(Fabric3, StressFabricRelationFirstOrder) {
+  Forms F;
+  const V3 e(1, 2, 0.5);
+  F.Ac = axisym(0.02, e);
+  F.An = axisym(0.03, e);
+  F.At = axisym(0.01, e);
+  const double qp_exact = Stress3{T(predicted_stress(F))}.q_over_p();
+  EXPECT_NEAR(qp_exact, 0.4 * 0.06, 0.02 * 0.4 * 0.06);
+}
+
+// ---------------------------------------------------------------- stress
+
+// A simple-cubic lattice, one sphere of diameter d per cubic cell of side d:
+// its three contacts go through the x, y, z images (branch +d e_a). Normal
+// forces Fx, Fy, Fz and a tangential force g along y on the x contact give
+// sigma = diag(Fx, Fy, Fz) d / d^3 plus sigma_yx = g d / d^3; written to a
+// VTK file in cdsim's 3D format and read back.
+TEST(Stress3, LatticeThroughImagesExact) {
+  const double d = 0.01, Fx = 3, Fy = 5, Fz = 11, g = 0.7, V = d * d * d;
+  ContactSet3 cs(3);
+  for (int a = 0; a < 3; ++a) {
+    cs[a].c.b1 = cs[a].c.b2 = 0;
+    cs[a].c.n[a] = 1;
+    cs[a].c.l[a] = d;
+    cs[a].c.fn = a == 0 ? Fx : a == 1 ? Fy : Fz;
+    cs[a].status = 1;
+  }
+  cs[0].c.ft[1] = g;
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "lattice");
+  Particle s;
+  s.id = 0;
+  s.x = s.y = s.z = 0.5 * d;
+  s.radius = 0.5 * d;
+  write_contacts3((dir / "contacts_00000.vtp").string(), cs, {s});
+  const auto back = read_contacts3((dir / "contacts_00000.vtp").string());
+  ASSERT_EQ(back.size(), 3u);
+  const Stress3 st = contact_stress3(back, V);
+  const double k = d / V;
+  const double expect[3][3] = {{Fx * k, 0, 0}, {g * k, Fy * k, 0}, {0, 0, Fz * k}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(st.s[i][j], expect[i][j], 1e-9 * Fz * k) << i << j;
+  EXPECT_NEAR(st.p(), (Fx + Fy + Fz) * k / 3, 1e-9 * Fz * k);
+  // Principal values of the symmetric part: Fz k and those of [[Fx, g/2], [g/2, Fy]] k.
+  const double m = 0.5 * (Fx + Fy), r = std::hypot(0.5 * (Fx - Fy), 0.5 * g);
+  EXPECT_NEAR(st.q(), (Fz - (m - r)) * k / 3, 1e-9 * Fz * k);
+  EXPECT_NEAR(st.mu(), -0.5 * g / Fy, 1e-12);
+  EXPECT_NEAR(st.skew(), 0.5 * g * k, 1e-9 * Fz * k);
+}
+
+// A real tri-periodic run: 64 spheres as a granular gas (random velocities)
+// colliding for 300 steps; one series row per step, a contact snapshot
+// every 10 steps. Each snapshot with force-bearing contacts is compared
+// with the series row of its time (from contacts.pvd): with V = L_x L_y L_z
+// its stress is the series' stress of that step (the same contacts and
+// branches at the step's midpoint), to the CSV's digits, and so are p, the
+// von Mises q and z.
+TEST(Stress3, SnapshotMatchesTheSeriesOfARealRun) {
+  cd::Scene sc;
+  sc.dimension = 3;
+  sc.gravity = {0, 0, 0};
+  sc.shear_mode = "periodic";
+  sc.n = 64;
+  sc.d_mean = 0.01;
+  sc.size_ratio = 1.5;
+  sc.density = 2600;
+  sc.dt = 1e-4;
+  sc.duration = 3e-2;
+  sc.mu = 0.3;
+  sc.alert = 0.05;
+  sc.series_interval = 1e-4;
+  sc.snapshot_interval = 1e-3;
+  cd::World3 w = cd::build_world3(sc);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> N(0.0, 0.5);
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) w.bodies.vel[i].v = cd::Vec3(N(rng), N(rng), N(rng));
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "gas");
+  cd::RunOptions opt;
+  opt.out = dir.string();
+  opt.quiet = true;
+  opt.fresh = true;
+  cd::run3(w, sc, opt);
+  std::ofstream(dir / "scene.toml") << "dimension = 3\n";  // the key the analysis reads
+  const auto series = read_series(dir.string());
+  const auto L = w.params().cell;
+  const double V = L.x() * L.y() * L.z();
+  // Snapshot times from the collection file.
+  std::ifstream pvd(dir / "contacts.pvd");
+  const std::string text((std::istreambuf_iterator<char>(pvd)), {});
+  const std::regex re(R"re(timestep="([^"]+)"[^>]*file="contacts_(\d+)\.vtp")re");
+  std::map<int, double> times;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it)
+    times[std::stoi((*it)[2].str())] = std::stod((*it)[1].str());
+  ASSERT_GT(times.size(), 10u);
+  const auto& time = series.column("time");
+  const char* names[3][3] = {{"sxx", "sxy", "sxz"}, {"syx", "syy", "syz"}, {"szx", "szy", "szz"}};
+  std::size_t compared = 0, snaps = 0;
+  for (const auto& [k, t] : times) {
+    const auto cs = read_contacts3(snapshot_path(dir.string(), "contacts", k));
+    if (cd::obs::force_bearing_points<3>(as_forces(cs)).empty()) continue;
+    const auto f = run_fabric3(dir.string(), k, V);
+    std::size_t row = time.size();
+    for (std::size_t r = 0; r < time.size(); ++r)
+      if (std::abs(time[r] - t) < 0.5 * sc.dt) row = r;
+    ASSERT_LT(row, time.size()) << "no series row at the snapshot's time " << t;
+    double scale = 0;
+    for (int i = 0; i < 3; ++i) scale = std::max(scale, std::abs(f.stress.s[i][i]));
+    ASSERT_GT(scale, 0.0);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        EXPECT_NEAR(f.stress.s[i][j], series.column(names[i][j])[row], 1e-6 * scale) << names[i][j] << " at " << t;
+    EXPECT_NEAR(f.stress.p(), series.column("p")[row], 1e-6 * scale);
+    EXPECT_NEAR(f.stress.q_vm(), series.column("q")[row], 1e-6 * scale);
+    ASSERT_TRUE(f.connectivity);
+    EXPECT_NEAR(f.connectivity->z, series.column("z")[row], 1e-6);
+    compared += f.physical_contacts;
+    ++snaps;
+  }
+  std::printf("%zu snapshots with %zu force-bearing contacts in all compared with their series rows\n", snaps,
+              compared);
+  EXPECT_GE(compared, 20u) << "too few contacts for a test";
+}
+
+// ---------------------------------------------------------------- runs and commands
+
+namespace {
+
+const fs::path exe = fs::path(CDLAB_BINARY_DIR) / "analysis" / "cdanalysis";
+
+// A synthetic 3D shear run in the format of cdsim's 3D series (the columns
+// the analysis reads): shear_stress_ratio = mu + AR(1) noise, q_over_p (von
+// Mises, set 0.2 above mu so that reading it for mu would show), I, phi, z,
+// p; scene.toml with dimension = 3; one contact snapshot drawn from the
+// harmonic forms (l = d n between spheres of diameter d) and its spheres
+// snapshot.
+struct Run3Spec {
+  double mu = 0.4, I = 0.01, noise = 0.01;
+  int rows = 300;
+  std::uint64_t seed = 1;
+  Forms forms;
+  std::size_t contacts = 0;  // 0: no snapshot
+  std::string extra_scene;
+};
+
+void write_run3(const fs::path& dir, const Run3Spec& s) {
+  fs::create_directories(dir);
+  synth::Normal G(s.seed);
+  double e = G();
+  std::ofstream csv(dir / "series.csv");
+  csv << "step,time,strain,shear_rate,shear_stress_ratio,q_over_p,inertial_number,packing_fraction,z,p\n";
+  for (int i = 0; i < s.rows; ++i) {
+    const double gamma = 0.01 * i;
+    csv << fmt::format("{},{:.6g},{:.6g},1,{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},100\n", i, gamma, gamma,
+                       s.mu + s.noise * e, s.mu + 0.2 + s.noise * e, s.I, 0.6 - 0.3 * s.I + 0.002 * e,
+                       4.5 + 0.05 * e);
+    e = 0.5 * e + std::sqrt(0.75) * G();
+  }
+  std::ofstream(dir / "scene.toml") << fmt::format(
+      "# synthetic 3D run (tests/test_analysis_3d.cpp)\ndimension = 3\n{}\n[shear]\ninertial_number = {}\n",
+      s.extra_scene, s.I);
+  if (s.contacts) {
+    auto cs = sample(s.forms, s.contacts, s.seed + 100);
+    // Bodies: pairs (2k, 2k+1), each a sphere of the snapshot.
+    ParticleSet ps;
+    for (std::size_t k = 0; k < cs.size(); ++k) {
+      cs[k].c.b1 = static_cast<int>(2 * k);
+      cs[k].c.b2 = static_cast<int>(2 * k + 1);
+      for (int b = 0; b < 2; ++b) {
+        Particle p;
+        p.id = static_cast<int>(2 * k + b);
+        p.radius = 0.5 * s.forms.d;
+        p.x = static_cast<double>(k) * 3 * s.forms.d + b * cs[k].c.l[0];
+        p.y = b * cs[k].c.l[1];
+        p.z = b * cs[k].c.l[2];
+        ps.push_back(p);
+      }
+    }
+    write_contacts3((dir / "contacts_00000.vtp").string(), cs, ps);
+    write_particles((dir / "spheres_00000.vtp").string(), ps);
+  }
+}
+
+// The value of `column` in row `row` of a CSV written by the report.
+double csv_value(const fs::path& file, const std::string& column, std::size_t row = 0) {
+  const Table t = Table::read_csv(file.string(), true);  // the report's own table: nan = no summary.toml
+  return t.column(column).at(row);
+}
+
+}  // namespace
+
+TEST(Scene3, DimensionFromSceneToml) {
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "scene");
+  EXPECT_EQ(run_dimension(dir.string()), 2);  // no scene.toml: a synthetic 2D series
+  std::ofstream(dir / "scene.toml") << "[contact]\nmu = 0.3\n";
+  EXPECT_EQ(run_dimension(dir.string()), 2);  // cdsim's default
+  std::ofstream(dir / "scene.toml") << "dimension = 3\n";
+  EXPECT_EQ(run_dimension(dir.string()), 3);
+  for (const char* bad : {"dimension = 4\n", "dimension = \"3\"\n", "dimension = 2.5\n", "dimension = inf\n"}) {
+    std::ofstream(dir / "scene.toml") << bad;
+    try {
+      run_dimension(dir.string());
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("dimension is"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("scene.toml"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Neither reader takes the other dimension's snapshot for its own.
+TEST(Snapshot3, ReadersRefuseTheOtherDimension) {
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "readers");
+  Forms F;
+  write_contacts3((dir / "c3.vtp").string(), sample(F, 10, 1), {});
+  try {
+    read_contacts((dir / "c3.vtp").string());
+    ADD_FAILURE() << "a 3D snapshot read as 2D";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a 3D contact snapshot"), std::string::npos) << e.what();
+  }
+  ContactSet c2(1);
+  c2[0].fn = 1;
+  c2[0].lx = 1;
+  write_contacts((dir / "c2.vtp").string(), c2, {});
+  try {
+    read_contacts3((dir / "c2.vtp").string());
+    ADD_FAILURE() << "a 2D snapshot read as 3D";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a 2D contact snapshot"), std::string::npos) << e.what();
+  }
+  // A normal that is not unit (a damaged or foreign file).
+  auto bad = sample(F, 3, 2);
+  bad[1].c.n[0] *= 1.5;
+  write_contacts3((dir / "bad.vtp").string(), bad, {});
+  try {
+    read_contacts3((dir / "bad.vtp").string());
+    ADD_FAILURE() << "non-unit normal accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("contact cell 1 has a normal of length"), std::string::npos) << e.what();
+  }
+}
+
+// A 3D campaign through the command line: report (tables with mu =
+// shear_stress_ratio, the 3D anisotropies of each snapshot, the mu(I) fit),
+// fit mu-i, fabric; and the 2D-only commands refused by name.
+TEST(Commands3, ReportFitAndRefusals) {
+  ASSERT_TRUE(fs::exists(exe)) << "cdanalysis not built: " << exe;
+  const auto camp = cdtest::scratch_dir("test_analysis_3d", "campaign");
+  const double mu1 = 0.38, mu2 = 0.9, I0 = 0.3;
+  const std::vector<double> Is = {0.003, 0.01, 0.03, 0.1, 0.2, 0.4};
+  Forms F;
+  const double t = 3 * std::numbers::pi / 4;
+  F.Ac = planar(0.15, t);
+  F.An = planar(0.25, t);
+  F.At = planar(0.08, t);
+  F.d = 0.01;
+  for (std::size_t k = 0; k < Is.size(); ++k) {
+    Run3Spec s;
+    s.I = Is[k];
+    s.mu = synth::mu_of_I(mu1, mu2, I0, s.I);
+    s.seed = 10 + k;
+    s.forms = F;
+    s.contacts = k == 0 ? 40000 : 0;
+    write_run3(camp / fmt::format("I{}", k), s);
+  }
+  const auto out = camp.parent_path() / "campaign_report";
+  fs::remove_all(out);
+  const auto rep = cdtest::run_command(fmt::format("{} report {} --out {}", exe.string(), camp.string(), out.string()));
+  ASSERT_EQ(rep.code, 0) << rep.out;
+  // steady.csv: mu is the shear_stress_ratio (true value within 4 sigma; the
+  // q_over_p column of the series, 0.2 higher, is not read for mu).
+  const Table st = Table::read_csv((out / "steady.csv").string(), true);
+  ASSERT_TRUE(st.has("shear_stress_ratio")) << "3D steady.csv without mu";
+  for (std::size_t k = 0; k < Is.size(); ++k) {
+    // The mean is that of the series' shear_stress_ratio over the window
+    // the report gives (summed here from the file), and the true mu within
+    // 5 of its error bars (the detected window of a stationary series is
+    // sometimes short: this is a check of the column, not of the detector).
+    const Table series = Table::read_csv((camp / fmt::format("I{}", k) / "series.csv").string());
+    double sum = 0;
+    int n = 0;
+    for (std::size_t r = 0; r < series.rows(); ++r)
+      if (series.column("strain")[r] >= st.column("window_begin")[k] &&
+          series.column("strain")[r] <= st.column("window_end")[k])
+        sum += series.column("shear_stress_ratio")[r], ++n;
+    ASSERT_GT(n, 10) << k;
+    EXPECT_NEAR(st.column("shear_stress_ratio")[k], sum / n, 1e-9) << k;
+    const double truth = synth::mu_of_I(mu1, mu2, I0, Is[k]);
+    EXPECT_NEAR(st.column("shear_stress_ratio")[k], truth, 5 * st.column("shear_stress_ratio_err")[k]) << k;
+    EXPECT_LT(st.column("shear_stress_ratio_err")[k], 0.01);
+  }
+  // fabric.csv: the anisotropies of the snapshot (40000 contacts: errors ~0.004).
+  EXPECT_NEAR(csv_value(out / "fabric.csv", "a_c"), 0.15, 0.015);
+  EXPECT_NEAR(csv_value(out / "fabric.csv", "a_n"), 0.25, 0.015);
+  EXPECT_NEAR(csv_value(out / "fabric.csv", "a_t"), 0.08, 0.015);
+  EXPECT_NEAR(csv_value(out / "fabric.csv", "q_over_p"), csv_value(out / "fabric.csv", "sum_2_5"),
+              0.15 * csv_value(out / "fabric.csv", "q_over_p"));
+  std::ifstream html(out / "index.html");
+  const std::string page((std::istreambuf_iterator<char>(html)), {});
+  EXPECT_NE(page.find("3D runs"), std::string::npos);
+  EXPECT_NE(page.find("μ(I)"), std::string::npos) << "no mu(I) fit on the page";
+  // fit mu-i on the 3D runs: the true parameters within 3 sigma.
+  const auto toml = camp.parent_path() / "mu_i3.toml";
+  const auto fit = cdtest::run_command(fmt::format("{} fit mu-i {} --toml {}", exe.string(), camp.string(), toml.string()));
+  ASSERT_EQ(fit.code, 0) << fit.out;
+  EXPECT_NE(fit.out.find("shear_stress_ratio"), std::string::npos) << fit.out;
+  const auto fitted = read_fit_toml(toml.string());
+  ASSERT_EQ(fitted.order.size(), 1u);
+  const auto& params = fitted.models.at(fitted.order[0]).params;
+  const std::map<std::string, double> truth = {{"mu1", mu1}, {"mu2", mu2}, {"I0", I0}};
+  for (const auto& [name, v] : truth)
+    EXPECT_NEAR(params.at(name).value, v, 3 * params.at(name).error) << name;
+  // fabric on one run: the 3D report of a snapshot.
+  const auto fab = cdtest::run_command(fmt::format("{} fabric {}", exe.string(), (camp / "I0").string()));
+  ASSERT_EQ(fab.code, 0) << fab.out;
+  EXPECT_NE(fab.out.find("(2/5)(a_c + a_n + a_t)"), std::string::npos) << fab.out;
+  // Refused by name, exit 1: the commands whose definitions are 2D.
+  const std::string r0 = (camp / "I0").string();
+  for (const auto& [cmd, what] : std::vector<std::pair<std::string, std::string>>{
+           {"fit cohesion " + r0, "fit cohesion is 2D only"},
+           {"fit dilatancy " + r0, "fit dilatancy"},
+           {"fit angularity " + r0, "fit angularity is 2D only"},
+           {"fabric " + r0 + " --out " + (camp.parent_path() / "polar").string(), "fabric --out"},
+           {"fit fabric-bounds --table " + (out / "fabric.csv").string(), "fit fabric-bounds is 2D only"}}) {
+    const auto r = cdtest::run_command(exe.string() + " " + cmd);
+    EXPECT_EQ(r.code, 1) << cmd << "\n" << r.out;
+    EXPECT_NE(r.out.find(what), std::string::npos) << cmd << "\n" << r.out;
+    EXPECT_NE(r.out.find("3D"), std::string::npos) << cmd << "\n" << r.out;
+  }
+  // steady without --column: the 3D mu column.
+  const auto sty = cdtest::run_command(fmt::format("{} steady {}", exe.string(), r0));
+  ASSERT_EQ(sty.code, 0) << sty.out;
+  EXPECT_NE(sty.out.find("column     shear_stress_ratio"), std::string::npos) << sty.out;
+  // One fit mixes no dimensions.
+  const auto two = camp.parent_path() / "two_d";
+  fs::remove_all(two);
+  synth::RunSpec s2;
+  synth::write_run(two, s2);
+  for (const char* fit : {"mu-i", "nu-i", "compaction"}) {
+    const auto mix = cdtest::run_command(fmt::format("{} fit {} {} {}", exe.string(), fit, r0, two.string()));
+    EXPECT_EQ(mix.code, 1) << mix.out;
+    EXPECT_NE(mix.out.find("mixes no dimensions"), std::string::npos) << fit << ": " << mix.out;
+  }
+  // A report of a 3D campaign with a 2D run in it (no dimension key: 2D):
+  // the 2D run is listed and skipped.
+  const auto mixed = camp.parent_path() / "mixed";
+  fs::remove_all(mixed);
+  fs::create_directories(mixed);
+  fs::copy(camp / "I0", mixed / "a3d", fs::copy_options::recursive);
+  fs::copy(two, mixed / "b2d", fs::copy_options::recursive);
+  const auto mr = cdtest::run_command(
+      fmt::format("{} report {} --out {}", exe.string(), mixed.string(), (mixed / "report").string()));
+  ASSERT_EQ(mr.code, 0) << mr.out;
+  EXPECT_NE(mr.out.find("a 2D run in a 3D campaign"), std::string::npos) << mr.out;
+  const Table mst = Table::read_csv((mixed / "report" / "steady.csv").string(), true);
+  EXPECT_EQ(mst.rows(), 1u);  // the 3D run only
+  EXPECT_TRUE(mst.has("shear_stress_ratio"));
+  // A 3D snapshot in a folder without scene.toml (read as 2D) is refused by the 2D reader.
+  const auto lone = camp.parent_path() / "lone";
+  fs::remove_all(lone);
+  fs::create_directories(lone);
+  fs::copy_file(camp / "I0" / "contacts_00000.vtp", lone / "contacts_00000.vtp");
+  const auto l = cdtest::run_command(fmt::format("{} fabric {}", exe.string(), lone.string()));
+  EXPECT_EQ(l.code, 2) << l.out;
+  EXPECT_NE(l.out.find("is a 3D contact snapshot"), std::string::npos) << l.out;
+}
