@@ -120,6 +120,8 @@ void check_scene3(const Scene& s) {
   const auto fail = fail3;
   if (s.dimension != 3) fail(fmt::format("dimension = {}: not a 3D scene", s.dimension));
   if (s.gravity.size() != 3) fail("gravity.g: a 3D scene needs [gx, gy, gz]");
+  if (s.overlap_projection != 0)
+    fail("contact.overlap_projection: the overlap projection is 2D only; leave it at 0");
   if (s.shear_mode == "periodic") {
     check_derived(s);
     return check_cell3(with_auto_cell3(s));
