@@ -214,9 +214,12 @@ std::string prepared(const std::string& name, int n, int steps) {
 // (the mean of v_x - gamma-dot (y - L_y/2) in 5 layers is 0), and
 // sigma_yy + K_yy = p on average. Strain 1 to forget the start, then
 // strain 2 in 8 blocks: the tolerances are 3 standard errors of the block
-// means plus 5 % (the cell is only ~5 d high: its layers' mean flows
-// fluctuate, correlated over more than a block; measured with 100 spheres
-// and strain 1: slope 1.10 +- 0.03, layers within 0.05 gamma-dot L_y).
+// means plus 5 % (the cell is only ~5 d high: its mean flow fluctuates,
+// correlated over about a strain of 0.5, more than a block: the slope over
+// successive strain windows of 0.5 ranged 0.91-1.11 gamma-dot, mean 1.01
+// over strain 4; here 1.05 +- 0.03, layers within 0.03 gamma-dot L_y). The
+// run is deterministic (bit-identical on any thread count), so the check
+// cannot flicker; the margin is what a fluctuating window needs.
 TEST(Shear3Cell, ShearAtImposedInertialNumber) {
   const std::string start = prepared("shear", 150, 300);
   const double I = 0.1;
