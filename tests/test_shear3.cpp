@@ -16,6 +16,7 @@
 #include "checkpoint.hpp"
 #include "checkpoint3.hpp"
 #include "cli_util.hpp"
+#include "run.hpp"
 #include "run3.hpp"
 #include "setup.hpp"
 #include "setup3.hpp"
@@ -408,4 +409,36 @@ TEST(Shear3Cell, KeysWithoutWhatTheyNeedAreRefusedByName) {
   { Scene t = s; t.pressure = 0; t.isotropic = false; t.dt_tp = 0; t.dt = 1e-5; refused(t, "shear.compaction_rate needs shear.pressure"); }
   { Scene t = s; t.pressure = std::nan(""); refused(t, "t_p"); }
   { Scene t = s; t.overlap_projection = 0.5; refused(t, "contact.overlap_projection"); }
+}
+
+// output.checkpoint_strain in 3D: the plan (2D's plan_of, shared) puts a
+// checkpoint every 0.25 of strain on series rows, and a cdsim-style run
+// (run3) to strain 0.5 leaves a checkpoint whose cell is the run's last
+// (lengths, rate, offset, strain 0.5) and whose spheres are the world's.
+TEST(Shear3Cell, CheckpointByStrain) {
+  const std::string start = prepared("ckstrain", 60, 100);
+  Scene s = shear_scene(start, 0.1);
+  s.strain = 0.5;
+  s.checkpoint_strain = 0.25;
+  const double dt = time_step(s), gd = shear_rate(s);
+  s.series_interval = 5 * dt;
+  const RunPlan plan = plan_of(s, dt);
+  EXPECT_EQ(plan.nsteps, 100);  // 0.5 / (gd dt) = 0.5 / (0.1 x 0.05)
+  EXPECT_EQ(plan.every_ckpt_strain, 50);
+  EXPECT_NEAR(plan.every_ckpt_strain * dt * gd, 0.25, 1e-9);
+  World3 w = build_world3(s);
+  const auto dir = cdtest::scratch_dir("test_shear3", "ckstrain-run");
+  RunOptions opt;
+  opt.out = dir.string();
+  opt.quiet = true;
+  opt.fresh = true;
+  run3(w, s, opt);
+  EXPECT_NEAR(w.params().strain, 0.5, 1e-9);
+  World3 c = build_world3(s);
+  load_checkpoint3((dir / "checkpoint.bin").string(), c);
+  EXPECT_EQ(c.params().strain, w.params().strain);
+  EXPECT_EQ(c.params().cell, w.params().cell);
+  EXPECT_EQ(c.params().cell_rate, w.params().cell_rate);
+  EXPECT_EQ(c.params().le_offset, w.params().le_offset);
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) ASSERT_EQ(c.bodies.pos[i], w.bodies.pos[i]) << i;
 }
