@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "cell_dof.hpp"
 #include "world.hpp"
 
 namespace cd {
@@ -78,11 +79,8 @@ void LeesEdwardsCell::set_dofs(World& w) const {
   // across the boundary by well under the alert distance in a step, so those
   // contacts are detected before they close, and the grains they hit move
   // (and spin) no faster, whatever the cell's size.
-  const double inf = std::numeric_limits<double>::infinity();
   const double rate = c.max_strain_rate;
-  const auto floor = [&](double L) {
-    return rate > 0.0 ? -std::min(rate * L, 0.25 * w.alert_ / w.prm_.dt) : -inf;
-  };
+  const auto floor = [&](double L) { return cell_dof::floor(rate, L, w.alert_, w.prm_.dt); };
   dofs.push_back(w.make_dof(cell.hdot, (c.pressure - K(1, 1)) * cm.width, cm.width, floor(cm.height)));
   if (c.isotropic)
     dofs.push_back(w.make_dof(cell.wdot, (c.pressure - K(0, 0)) * cm.height, cm.height, floor(cm.width)));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <variant>
 
+#include "cell_dof.hpp"
 #include "law.hpp"
 #include "colour_rows.hpp"
 #include "coupling.hpp"
@@ -42,15 +43,7 @@ void law_residuals(const ContactProblem& p, const SolverParams& prm, SolveStats&
 }
 
 double update_dof(BoundaryDof& d, ContactRow* rows) {
-  // The sweep runs with the dof frozen, so this update is a Jacobi step
-  // between the dof and its rows: a change dv of the dof makes each active
-  // row answer with about -(an^2/W_nn + at^2/W_tt) dv, and the plain update
-  // v = v0 + inv_mass sum(...) overshoots by inv_mass times the sum of those
-  // responses. It diverges once the dof is lighter than the grains it
-  // touches (measured: a top wall of 0.1 the mass of 100 disks hit the
-  // iteration cap and blew up within 400 steps). The step is damped by that
-  // response (the Newton step of the dof's equation with the rows' local
-  // response): same fixed point, and a contraction.
+  // The damped step of core/cell_dof.hpp (why damped: there).
   double s = 0.0, k = 0.0;
   const std::size_t m = d.rows.size();
   for (std::size_t i = 0; i < m; ++i) {
@@ -58,8 +51,8 @@ double update_dof(BoundaryDof& d, ContactRow* rows) {
     s += d.an[i] * r.pn + d.at[i] * r.pt;
     if (r.pn + r.adh > 0.0) k += d.an[i] * d.an[i] / r.wnn + d.at[i] * d.at[i] / r.wtt;
   }
-  const double res = d.v0 + d.inv_mass * s - d.v;  // residual of the dof's equation
-  const double dv = res / (1.0 + d.inv_mass * k);
+  double res;
+  const double dv = cell_dof::damped_step(d.v0, d.v, d.inv_mass, s, k, res);
   for (std::size_t i = 0; i < m; ++i) {
     ContactRow& r = rows[d.rows[i]];
     r.bn += d.an[i] * dv;

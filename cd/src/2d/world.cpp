@@ -9,6 +9,8 @@
 #include <type_traits>
 #include <variant>
 
+#include "cell_dof.hpp"
+
 namespace cd {
 
 void World::configure() {
@@ -322,7 +324,7 @@ BoundaryDof World::make_dof(double v_start, double load, double length, double v
   const double dt = prm_.dt, M = prm_.cell.mass;
   BoundaryDof d;
   d.inv_mass = 1.0 / M;
-  d.v0 = std::max(v_start - dt * load / M, v_floor);
+  d.v0 = cell_dof::free_velocity(v_start, load, M, dt, v_floor);
   d.v = d.v0;
   d.scale = dt * prm_.cell.pressure * length;  // the imposed impulse, unit of its convergence test
   return d;

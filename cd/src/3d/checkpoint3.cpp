@@ -1,5 +1,6 @@
 #include "checkpoint3.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
@@ -40,7 +41,8 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
   o.array("3d.warm.p", w.warm_start().p);
   const WorldParams3& p = w.params();
   o.array("3d.cell", std::vector<double>{p.cell.x(), p.cell.y(), p.cell.z(), p.le_offset, double(p.periodic[0]),
-                                         double(p.periodic[1]), double(p.periodic[2])});
+                                         double(p.periodic[1]), double(p.periodic[2]), p.cell_rate.x(),
+                                         p.cell_rate.y(), p.cell_rate.z(), p.strain});
   ckpt::finish(o, totals, path);
 }
 
@@ -60,7 +62,10 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
   if (warm.keys.size() != warm.p.size()) in.fail("is corrupt (warm-start sizes differ)");
   std::vector<double> cell;
   in.array("3d.cell", cell);
-  if (cell.size() != 7) in.fail("is corrupt (the cell's state is not 7 numbers)");
+  // 7 numbers: written before the cell had rates and a strain (both 0).
+  if (cell.size() != 7 && cell.size() != 11) in.fail("is corrupt (the cell's state is not 7 or 11 numbers)");
+  for (const double x : cell)
+    if (!std::isfinite(x)) in.fail("is corrupt (a non-finite number in the cell's state)");
   WorldParams3 p = w.params();
   for (int a = 0; a < 3; ++a)
     if ((cell[4 + a] != 0.0) != p.periodic[a])
@@ -71,6 +76,8 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
 
   p.cell = Vec3(cell[0], cell[1], cell[2]);
   p.le_offset = cell[3];
+  p.cell_rate = cell.size() == 11 ? Vec3(cell[7], cell[8], cell[9]) : Vec3::Zero();
+  p.strain = cell.size() == 11 ? cell[10] : 0.0;
   try {
     World3 probe(p);  // checks the cell without touching w
   } catch (const std::invalid_argument& e) {

@@ -5,8 +5,10 @@
 // The file's frame is core/checkpoint_io.hpp's with dimension 3; between the
 // timers and the totals it holds one array per Bodies3 member ("3d.vel",
 // "3d.pos", ...), then "3d.warm.keys", "3d.warm.p" and "3d.cell": the
-// periodic cell's state, {L_x, L_y, L_z, le_offset, periodic x, y, z (0/1)}
-// (all 0 without a cell). A 2D checkpoint is refused by its dimension tag,
+// periodic cell's state, {L_x, L_y, L_z, le_offset, periodic x, y, z (0/1),
+// dL_x/dt, dL_y/dt, dL_z/dt, strain} (all 0 without a cell; a file of the
+// first 7 only, written before the cell's lengths could move, is read with
+// rates and strain 0). A 2D checkpoint is refused by its dimension tag,
 // naming both dimensions.
 #pragma once
 #include <cstdint>
@@ -22,7 +24,7 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
                       const RunTotals& totals = {});
 
 // Reads a checkpoint into w: its parameters are kept but for the cell's
-// state (lengths and Lees-Edwards offset), which the checkpoint's replace;
+// state (lengths, Lees-Edwards offset, rates, strain), which the checkpoint's replace;
 // a checkpoint whose periodic axes differ from w's is refused. Returns the
 // stored scene key; with `totals`, also the run's totals. w is changed only if the
 // whole file is valid; otherwise throws CheckpointError naming the file.

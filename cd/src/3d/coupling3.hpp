@@ -1,7 +1,8 @@
 // The 3D sphere rows for the sweep (core/sweep.hpp): rows coupled through
 // the velocities of their bodies (BodyCoupling3, the sibling of 2D's
 // BodyCoupling), the laws chosen once per scene, and what the sweep asks of
-// a row (its law residual, its impulse norm, a boundary dof type).
+// a row (its law residual, its impulse norm; the boundary dof is
+// world3.hpp's CellDof3).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -39,12 +40,6 @@ struct SphereLaw3 {
     }
   }
 };
-
-// No boundary dofs in the 3D step yet; the sweep's interface asks for a type.
-struct NoDof3 {
-  double v = 0, v0 = 0;
-};
-inline double update_dof(NoDof3&, SphereRow*) { return 0.0; }
 
 inline double impulse_norm(const SphereRow& r) { return r.r.norm(); }
 

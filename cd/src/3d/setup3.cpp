@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "checkpoint3.hpp"
 #include "pile3d.hpp"
 
 namespace cd {
@@ -22,24 +23,26 @@ double cell_pitch3(const Scene& s) { return 1.02 * diameter_bounds(s).second; }
 // The tri-periodic cell (shear.mode = "periodic"): the keys that apply,
 // and the lattice fitting the cell.
 void check_cell3(const Scene& s) {
-  // What needs the cell lengths as boundary dofs at imposed stress (issue 13
-  // item 3), or a cell carried by a 3D checkpoint: refused by name.
-  const std::pair<const char*, bool> later[] = {
-      {"shear.pressure", s.pressure != 0},
-      {"shear.inertial_number", s.inertial_number != 0},
-      {"shear.isotropic", s.isotropic},
-      {"shear.compaction_rate", s.compaction_rate != 0},
-      {"shear.strain", s.strain != 0},
-      {"shear.dt_tp", s.dt_tp != 0},
-      {"shear.start", !s.start.empty()},
-      {"contact.cohesion_number", s.cohesion_number != 0},
-      {"output.checkpoint_strain", s.checkpoint_strain != 0},
-  };
-  for (const auto& [key, set] : later)
-    if (set)
-      fail3(fmt::format("{}: a 3D periodic cell has fixed lengths and no imposed stress yet (issue 13 "
-                        "item 3); leave it at its default",
-                        key));
+  // The protocol's keys (2D's, docs/3d.md "Tri-periodic protocol"): what
+  // each needs, by name.
+  if (s.cohesion_number != 0)
+    fail3("contact.cohesion_number: cohesion at imposed pressure is 2D only; use contact.adhesion");
+  if (s.pressure <= 0) {
+    const std::pair<const char*, bool> need_p[] = {
+        {"shear.inertial_number", s.inertial_number != 0}, {"shear.isotropic", s.isotropic},
+        {"shear.compaction_rate", s.compaction_rate != 0}, {"shear.dt_tp", s.dt_tp != 0},
+        {"shear.strain", s.strain != 0},                   {"output.checkpoint_strain", s.checkpoint_strain != 0}};
+    for (const auto& [key, set] : need_p)
+      if (set)
+        fail3(fmt::format("{} needs shear.pressure > 0 (the cell's lengths at imposed stress; t_p = d "
+                          "sqrt(rho/p), shear rate I sqrt(p/rho)/d)", key));
+  }
+  if (s.isotropic && s.inertial_number > 0)
+    fail3("shear.isotropic (compaction: all three lengths at sigma = p) needs shear.inertial_number = 0");
+  if (s.strain > 0 && s.inertial_number <= 0) fail3("shear.strain > 0 needs shear.inertial_number > 0");
+  if (s.checkpoint_strain > 0 && s.inertial_number <= 0)
+    fail3("output.checkpoint_strain > 0 needs shear.inertial_number > 0 (a shear rate); use "
+          "output.checkpoint_interval or output.checkpoint_wall");
   if (s.gravity[0] != 0 || s.gravity[1] != 0 || s.gravity[2] != 0)
     fail3("gravity.g: a tri-periodic cell has no floor; use [0, 0, 0]");
   if (s.box_width != 0 || s.box_depth != 0 || s.box_height != 0)
@@ -51,6 +54,15 @@ void check_cell3(const Scene& s) {
   if (s.nsides.size() != 1 || s.nsides[0] != 0) fail3("particles.nsides: 3D particles are spheres; use [0]");
   if (!s.region.empty()) fail3("particles.region: the spheres fill the periodic cell; use []");
   check_derived(s);
+  if (!s.start.empty()) {
+    // The spheres and the cell come from the sample (build_cell3).
+    if (s.n > 0 || !s.diameters.empty())
+      fail3("shear.start gives the spheres: set particles.n = 0 and no particles.diameters");
+    if (s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0)
+      fail3(fmt::format("shear.width, shear.height, shear.depth = {}, {}, {}: shear.start gives the cell; "
+                        "leave them at 0", s.cell_width, s.cell_height, s.cell_depth));
+    return;
+  }
   if (s.n <= 0) fail3("particles.n = 0: a 3D periodic cell needs generated spheres (particles.n or particles.diameters)");
   const bool given = s.cell_width > 0 || s.cell_height > 0 || s.cell_depth > 0;
   if (given && !(s.cell_width > 0 && s.cell_height > 0 && s.cell_depth > 0))
@@ -84,11 +96,22 @@ void check_cell3(const Scene& s) {
 
 // 0 x 0 x 0: the smallest cube that holds the spheres on the loose lattice.
 Scene with_auto_cell3(const Scene& s) {
-  if (s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0 || s.n <= 0) return s;
+  if (s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0 || s.n <= 0 || !s.start.empty()) return s;
   Scene c = s;
   const double k = lattice_side3(s.n);
   c.cell_width = c.cell_height = c.cell_depth = cell_pitch3(s) * k * (1 + 1e-9);  // floor(side / pitch) = k
   return c;
+}
+
+// The cell's mass (the dofs' at imposed stress): shear.cell_mass times the
+// spheres' total mass, as 2D's.
+void set_cell_mass3(const Scene& s, World3& w) {
+  double mass = 0;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i)
+    if (w.bodies.is_dynamic(i)) mass += w.bodies.mass[i];
+  WorldParams3 q = w.params();
+  q.cell_mass = s.cell_mass * mass;
+  w.set_params(q);
 }
 
 }  // namespace
@@ -97,6 +120,8 @@ void check_scene3(const Scene& s) {
   const auto fail = fail3;
   if (s.dimension != 3) fail(fmt::format("dimension = {}: not a 3D scene", s.dimension));
   if (s.gravity.size() != 3) fail("gravity.g: a 3D scene needs [gx, gy, gz]");
+  if (s.overlap_projection != 0)
+    fail("contact.overlap_projection: the overlap projection is 2D only; leave it at 0");
   if (s.shear_mode == "periodic") {
     check_derived(s);
     return check_cell3(with_auto_cell3(s));
@@ -145,7 +170,7 @@ WorldParams3 world_params3(const Scene& s0) {
   check_scene3(s0);
   const Scene s = s0.shear_mode == "periodic" ? with_auto_cell3(s0) : s0;
   WorldParams3 p;
-  p.dt = s.dt;
+  p.dt = time_step(s);
   p.gravity = Vec3(s.gravity[0], s.gravity[1], s.gravity[2]);
   p.mu = s.mu;
   p.mu_wall = s.mu_w();
@@ -169,13 +194,96 @@ WorldParams3 world_params3(const Scene& s0) {
   if (s.shear_mode == "periodic") {
     p.cell = Vec3(s.cell_width, s.cell_height, s.cell_depth);
     p.periodic = {true, true, true};
+    // At imposed pressure: L_y a dof (sigma_yy = p); isotropic, all three.
+    // cell_mass is set by build_cell3, which knows the spheres' mass.
+    p.pressure = s.pressure;
+    if (s.pressure > 0) p.cell_dof = {s.isotropic, true, s.isotropic};
+    p.shear_rate = shear_rate(s);  // I sqrt(p/rho)/d
+    const double tp = pressure_time(s);
+    p.max_strain_rate = s.compaction_rate > 0 && tp > 0 ? s.compaction_rate / tp : 0.0;
   }
   return p;
 }
 
+namespace {
+
+// shear.start: the spheres and the cell of a 3D periodic run's checkpoint (a
+// preparation's or a shear run's), as 2D's. Time and strain start from 0; a
+// compacted sample (strain 0) starts from rest, its offset and rates 0; a
+// sheared one keeps its Lees-Edwards offset and cell rates (the images stay
+// where the spheres see them) and has its mean flow a + g y (least squares)
+// replaced. Either way the shear starts from the linear profile
+// gamma-dot (y - L_y/2) e_x, without a start-up transient.
+void load_start3(const Scene& s, World3& w) {
+  try {
+    load_checkpoint3(s.start, w);
+  } catch (const CheckpointError& e) {
+    throw SceneError(fmt::format("shear.start: {}", e.what()));
+  }
+  Bodies3& B = w.bodies;
+  double dsum = 0;
+  int nd = 0;
+  for (std::size_t i = 0; i < B.size(); ++i) {
+    if (B.shape[i] != Shape3::Sphere || !B.is_dynamic(i))
+      throw SceneError(fmt::format("shear.start: '{}' holds a plane or a driven sphere (body {}); a periodic "
+                                   "run starts from a periodic run's spheres", s.start, i));
+    // The masses come with the sample: they must be the scene's.
+    const double rho = B.mass[i] / obs::sphere_volume(B.radius[i]);
+    if (std::abs(rho - s.density) > 1e-9 * s.density)
+      throw SceneError(fmt::format("shear.start: the sample's spheres have density {:.6g} kg/m^3 (body {}), "
+                                   "particles.density is {:.6g}; set particles.density to the preparation's",
+                                   rho, i, s.density));
+    dsum += 2 * B.radius[i];
+    ++nd;
+  }
+  // d sets the shear rate and t_p: it must be the sample's.
+  const double d_ref = w.params().d_ref;
+  if (nd == 0 || std::abs(dsum / nd - d_ref) > 0.1 * d_ref)
+    throw SceneError(fmt::format("shear.start: the sample's mean diameter is {:.4g} m, particles.d_mean is "
+                                 "{:.4g} m; set particles.d_mean to the preparation's",
+                                 nd ? dsum / nd : 0.0, d_ref));
+  WorldParams3 q = w.params();
+  const bool sheared = q.strain != 0.0;
+  if (!sheared) {
+    q.le_offset = 0.0;
+    q.cell_rate = Vec3::Zero();
+  }
+  q.strain = 0.0;
+  w.set_params(q);
+  w.steps = 0;
+  w.time = 0.0;
+  w.times = StageTimes{};
+  double a = 0, g = 0;  // the sample's mean flow v_x = a + g y
+  if (sheared) {
+    double sy = 0, sv = 0, syy = 0, syv = 0, m = 0;
+    for (std::size_t i = 0; i < B.size(); ++i) {
+      const double y = B.pos[i].y(), v = B.vel[i].v.x();
+      sy += y, sv += v, syy += y * y, syv += y * v, m += 1;
+    }
+    const double den = m * syy - sy * sy;
+    g = den > 0 ? (m * syv - sy * sv) / den : 0.0;
+    a = m > 0 ? (sv - g * sy) / m : 0.0;
+  }
+  const double y0 = q.cell_origin.y() + 0.5 * q.cell.y();
+  for (std::size_t i = 0; i < B.size(); ++i) {
+    const double y = B.pos[i].y();
+    if (sheared) B.vel[i].v.x() -= a + g * y;
+    B.vel[i].v.x() += q.shear_rate * (y - y0);
+  }
+}
+
+}  // namespace
+
 World3 build_cell3(const Scene& s0) {
-  const WorldParams3 p = world_params3(s0);
+  WorldParams3 p = world_params3(s0);
   const Scene s = with_auto_cell3(s0);
+  if (!s.start.empty()) {
+    p.cell = Vec3::Ones();  // a placeholder: the sample's cell replaces it
+    World3 w(p);
+    load_start3(s, w);
+    set_cell_mass3(s, w);
+    return w;
+  }
   World3 w(p);
   // Loose placement on a jittered cubic lattice of pitch 1.02 d_max (2D's
   // rule): sphere k at site (k mod nx, (k / nx) mod ny, k / (nx ny)), its
@@ -194,6 +302,7 @@ World3 build_cell3(const Scene& s0) {
     w.bodies.add_sphere(Vec3((i + 0.5) * pitch + jx, (j + 0.5) * pitch + jy, (l + 0.5) * pitch + jz),
                         0.5 * d[k], s.density);
   }
+  set_cell_mass3(s, w);
   return w;
 }
 

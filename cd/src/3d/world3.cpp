@@ -7,6 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "cell_dof.hpp"
 #include "colour_rows.hpp"
 #include "coupling3.hpp"
 
@@ -17,10 +18,9 @@ namespace {
 
 template <class L>
 SolveStats solve_with(std::vector<SphereRow>& rows, const std::vector<RowExtra3>& extra, const Colouring& col,
-                      std::vector<BodyVel3>& vel, const SolverParams& prm) {
+                      std::vector<BodyVel3>& vel, const SolverParams& prm, std::vector<CellDof3>* dofs) {
   sweep::BodyCoupling3 c{vel.data(), extra.empty() ? nullptr : extra.data(), rows.data()};
-  std::vector<NoDof3>* nodofs = nullptr;
-  return sweep::solve<L>(rows, col, c, prm, nodofs, {});
+  return sweep::solve<L>(rows, col, c, prm, dofs, {});
 }
 
 // exp(h w) q: the rotation by the angle h |w| about w (world frame), then
@@ -34,6 +34,31 @@ Quat rotate(const Quat& q, const Vec3& w, double h) {
 }
 
 }  // namespace
+
+double update_dof(CellDof3& d, SphereRow* rows) {
+  // core/cell_dof.hpp's damped step, with the 3D rows' impulses and
+  // responses (W = diag(W_nn, W_tt, W_tt)).
+  double s = 0.0, k = 0.0;
+  const std::size_t m = d.rows.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    const SphereRow& r = rows[d.rows[i]];
+    const Vec3& a = d.a[i];
+    s += a.dot(r.r);
+    if (r.r[0] + r.adh > 0.0) k += a[0] * a[0] / r.wnn + (a[1] * a[1] + a[2] * a[2]) / r.wtt;
+  }
+  double res;
+  const double dv = cell_dof::damped_step(d.v0, d.v, d.inv_mass, s, k, res);
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::int32_t j = d.rows[i];
+    rows[j].bn += d.a[i][0] * dv;
+    if (d.extra) {
+      d.extra[j].bt1 += d.a[i][1] * dv;
+      d.extra[j].bt2 += d.a[i][2] * dv;
+    }
+  }
+  d.v += dv;
+  return std::abs(res) / (d.inv_mass * d.scale);
+}
 
 // The sweep instance of a scene: each flag fixed here, once.
 template <bool F, bool C, bool O>
@@ -57,10 +82,17 @@ void World3::configure() {
   for (int a = 0; a < 3; ++a)
     if (prm_.periodic[a] && !(prm_.cell[a] > 0.0))
       throw std::invalid_argument("WorldParams3: a periodic axis needs cell > 0");
-  const bool le = prm_.le_offset != 0.0 || prm_.le_velocity != 0.0;
+  const bool le = prm_.le_offset != 0.0 || prm_.le_velocity != 0.0 || prm_.shear_rate != 0.0;
   if (le && !(prm_.periodic[0] && prm_.periodic[1]))
     throw std::invalid_argument("WorldParams3: Lees-Edwards needs periodic x and y");
-  moving_images_ = le && prm_.le_velocity != 0.0;
+  const bool tri = prm_.periodic[0] && prm_.periodic[1] && prm_.periodic[2];
+  dofs_on_ = prm_.pressure > 0.0 && prm_.cell_mass > 0.0 &&
+             (prm_.cell_dof[0] || prm_.cell_dof[1] || prm_.cell_dof[2]);
+  if (dofs_on_ && !tri)
+    throw std::invalid_argument("WorldParams3: cell lengths at imposed stress need a tri-periodic cell");
+  // Images move relative to the bodies: Lees-Edwards, or lengths that move.
+  moving_images_ = (le && (prm_.le_velocity != 0.0 || prm_.shear_rate != 0.0)) || dofs_on_;
+  cm_ = prm_.cell;
   // Contacts within the alert distance enter the solver with the gap term
   // u_n + g_m/dt >= 0, which closes gaps without overlap (as in 2D). With
   // restitution the law acts at effective contacts only (gap <= 0): a gap
@@ -77,10 +109,10 @@ void World3::configure() {
                        : pick_law<false>(adhesion_on_, false, false);
 }
 
-PeriodicCell3 World3::cell_at(double offset) const {
+PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const {
   PeriodicCell3 c;
   c.origin = prm_.cell_origin;
-  c.size = prm_.cell;
+  c.size = size;
   c.periodic = prm_.periodic;
   c.le_offset = offset;
   return c;
@@ -107,6 +139,10 @@ void World3::predict() {
   xm_.resize(n);
   qm_.resize(n);
   const bool par = static_cast<int>(n) >= prm_.solver.min_parallel / 2;
+  // The midpoint cell: lengths at imposed stress move at their rates; an
+  // imposed shear rate sets the images' velocity from the midpoint height.
+  if (dofs_on_) cm_ = prm_.cell + h * prm_.cell_rate;
+  if (prm_.shear_rate != 0.0) prm_.le_velocity = prm_.shear_rate * cm_.y();
   // Spheres placed outside a periodic cell are brought in first (the end
   // of each step keeps them in), so that image counts stay small.
   if (periodic_on_) wrap_into_cell(prm_.le_offset);
@@ -120,7 +156,7 @@ void World3::predict() {
 
 void World3::detect_stage() {
   if (periodic_on_)
-    detect3(bodies, xm_, alert_, cell_at(prm_.le_offset + 0.5 * prm_.dt * prm_.le_velocity), grid_, rows_,
+    detect3(bodies, xm_, alert_, cell_at(prm_.le_offset + 0.5 * prm_.dt * prm_.le_velocity, cm_), grid_, rows_,
             info_, prm_.solver.min_parallel);
   else
     detect3(bodies, xm_, alert_, grid_, rows_, info_, prm_.solver.min_parallel);
@@ -160,12 +196,16 @@ void World3::build() {
     // an overlap separates at beta |g|/dt (beta = 0: pure CD).
     r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
     r.adh = adhesion_on_ && gap <= prm_.debond ? a : 0.0;
-    // A contact with a moving image of body 2 (Lees-Edwards, iy != 0): the
-    // image moves at iy le_velocity e_x more than body 2, and that velocity
-    // is part of the relative velocity the law sees.
+    // A contact with a moving image of body 2: across y (Lees-Edwards) the
+    // image moves at iy le_velocity e_x more than body 2; with cell lengths
+    // at imposed stress, across each face a by i_a dL_a/dt e_a (the rates at
+    // the step's start). That velocity is part of the relative velocity the
+    // law sees.
     Vec3 vimg = Vec3::Zero();
-    if (moving_images_ && info_[k].iy != 0) {
-      vimg = Vec3(info_[k].iy * prm_.le_velocity, 0.0, 0.0);
+    const ContactInfo3& f = info_[k];
+    if (moving_images_ && (f.iy != 0 || (dofs_on_ && (f.ix != 0 || f.iz != 0)))) {
+      const Vec3& L = prm_.cell_rate;
+      vimg = Vec3(f.iy * prm_.le_velocity + f.ix * L.x(), f.iy * L.y(), f.iz * L.z());
       r.bn += r.n.dot(vimg);
       if (x) {
         x->bt1 = r.t1.dot(vimg);
@@ -213,6 +253,9 @@ void World3::colour() {
 
 void World3::solve() {
   auto& V = bodies.vel;
+  // The kinetic stress the imposed one balances, from the velocities at
+  // the step's start (before gravity and the warm start).
+  if (dofs_on_) set_dofs(kinetic_stress());
   if (gravity_on_) {
     const Vec3 dv = prm_.dt * prm_.gravity;
     for (std::size_t i = 0; i < bodies.size(); ++i)
@@ -228,7 +271,8 @@ void World3::solve() {
     A.v -= A.inv_m * P;
     A.w -= A.inv_I * r.c1.cross(P);
   }
-  last_.solve = solve_fn_(rows_, extra_, colouring_, V, prm_.solver);
+  last_.solve = solve_fn_(rows_, extra_, colouring_, V, prm_.solver, dofs_on_ ? &dofs_ : nullptr);
+  for (const CellDof3& d : dofs_) prm_.cell_rate[d.axis] = d.v;
 
   // Keep the impulses (world frame) for the next step's warm start.
   const std::size_t nr = rows_.size();
@@ -243,6 +287,47 @@ void World3::solve() {
   }
 }
 
+// One dof per controlled length (as 2D's LeesEdwardsCell::set_dofs): its
+// velocity at the start of the step is already in the rows' offsets (build),
+// v0 holds the imposed stress's impulse, and the offsets get the difference.
+// The imposed stress balances the whole normal stress: a length sees only
+// the contacts across its face, so the kinetic stress K_aa (the momentum
+// grains carry through the face) is taken off the load (2D's rule).
+void World3::set_dofs(const Eigen::Matrix3d& K) {
+  const double dt = prm_.dt, M = prm_.cell_mass;
+  const double V = cm_.x() * cm_.y() * cm_.z();
+  dofs_.clear();
+  for (int a = 0; a < 3; ++a) {
+    if (!prm_.cell_dof[a]) continue;
+    CellDof3 d;
+    d.axis = a;
+    d.inv_mass = 1.0 / M;
+    const double area = V / cm_[a], v_start = prm_.cell_rate[a];
+    d.v0 = cell_dof::free_velocity(v_start, (prm_.pressure - K(a, a)) * area, M, dt,
+                                   cell_dof::floor(prm_.max_strain_rate, cm_[a], alert_, dt));
+    d.v = d.v0;
+    d.scale = dt * prm_.pressure * area;
+    d.extra = extras_on_ ? extra_.data() : nullptr;
+    const double dv = d.v0 - v_start;
+    for (std::size_t k = 0; k < rows_.size(); ++k) {
+      const ContactInfo3& f = info_[k];
+      const int i = a == 0 ? f.ix : a == 1 ? f.iy : f.iz;
+      if (i == 0) continue;
+      SphereRow& r = rows_[k];
+      // The image of body 2 moves at i dL_a/dt e_a: u += i (n_a, t1_a, t2_a) v.
+      const Vec3 c(i * r.n[a], d.extra ? i * r.t1[a] : 0.0, d.extra ? i * r.t2[a] : 0.0);
+      d.rows.push_back(static_cast<std::int32_t>(k));
+      d.a.push_back(c);
+      r.bn += c[0] * dv;
+      if (d.extra) {
+        d.extra[k].bt1 += c[1] * dv;
+        d.extra[k].bt2 += c[2] * dv;
+      }
+    }
+    dofs_.push_back(std::move(d));
+  }
+}
+
 void World3::integrate() {
   const double h = 0.5 * prm_.dt;
   const std::size_t n = bodies.size();
@@ -253,6 +338,8 @@ void World3::integrate() {
     bodies.orient[i] = rotate(qm_[i], v.w, h);
   }
   if (!periodic_on_) return;
+  if (dofs_on_) prm_.cell = cm_ + h * prm_.cell_rate;
+  prm_.strain += prm_.dt * shear_rate();
   double off = prm_.le_offset + prm_.dt * prm_.le_velocity;
   if (prm_.periodic[0]) off -= prm_.cell.x() * std::floor(off / prm_.cell.x());
   wrap_into_cell(off);
@@ -263,7 +350,36 @@ void World3::integrate() {
 // sphere moved by ky images across y takes the images' shift and velocity.
 void World3::wrap_into_cell(double off) {
   const std::size_t n = bodies.size();
-  const PeriodicCell3 c = cell_at(off);
+  const PeriodicCell3 c = cell_at(off, prm_.cell);
+  if (dofs_on_) {
+    // Lengths that move: a sphere brought back across face a takes the
+    // images' velocity there, k_a dL_a/dt e_a, too. The origin is fixed, so
+    // a changing cell sweeps spheres through the far faces only, and those
+    // parts would add up to a drift of the whole sample (2D measured 0.7
+    // sqrt(p/rho) after an isotropic compaction); a uniform velocity is a
+    // symmetry of the periodic cell, so it is removed (2D's rule; the
+    // gamma-dot L_y part is the usual Lees-Edwards one, kept). In body
+    // order, one thread: the sum must not depend on the thread count.
+    const Vec3& R = prm_.cell_rate;
+    Vec3 P = Vec3::Zero();
+    double mass = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (bodies.shape[i] != Shape3::Sphere) continue;
+      std::array<int, 3> k;
+      bodies.pos[i] = c.wrap(bodies.pos[i], k);
+      const Vec3 dv(k[0] * R.x(), k[1] * R.y(), k[2] * R.z());
+      bodies.vel[i].v += dv;
+      bodies.vel[i].v.x() += k[1] * prm_.le_velocity;
+      P += bodies.mass[i] * dv;
+      mass += bodies.mass[i];
+    }
+    if (mass > 0.0 && P != Vec3::Zero()) {
+      const Vec3 u = P / mass;
+      for (std::size_t i = 0; i < n; ++i)
+        if (bodies.is_dynamic(i)) bodies.vel[i].v -= u;
+    }
+    return;
+  }
 #pragma omp parallel for schedule(static) if (static_cast<int>(n) >= prm_.solver.min_parallel / 2)
   for (std::size_t i = 0; i < n; ++i) {
     if (bodies.shape[i] != Shape3::Sphere) continue;
@@ -328,7 +444,10 @@ double World3::cell_volume() const {
   return tri ? prm_.cell.x() * prm_.cell.y() * prm_.cell.z() : 0.0;
 }
 
-double World3::shear_rate() const { return prm_.periodic[1] ? prm_.le_velocity / prm_.cell.y() : 0.0; }
+double World3::shear_rate() const {
+  if (!prm_.periodic[1]) return 0.0;
+  return prm_.shear_rate != 0.0 ? prm_.shear_rate : prm_.le_velocity / prm_.cell.y();
+}
 
 Eigen::Matrix3d World3::contact_stress(double volume) const {
   const double V = volume > 0.0 ? volume : cell_volume();

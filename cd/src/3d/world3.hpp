@@ -74,7 +74,43 @@ struct WorldParams3 {
   Vec3 cell_origin = Vec3::Zero(), cell = Vec3::Zero();
   std::array<bool, 3> periodic{false, false, false};
   double le_offset = 0.0, le_velocity = 0.0;
+
+  // Imposed shear rate gamma-dot (> 0): the images across y move at
+  // le_velocity = gamma-dot L_y, L_y at each step's midpoint (a height that
+  // follows a pressure changes it); 0: le_velocity as given.
+  double shear_rate = 0.0;
+  // Cell lengths at imposed stress (tri-periodic cell; method.md section 9,
+  // docs/3d.md; 2D's LeesEdwardsCell in 3D): with pressure > 0 and
+  // cell_mass > 0, each length L_a with cell_dof[a] is a degree of freedom
+  // of mass cell_mass, solved with the contacts, driven by the imposed
+  // stress: M dL_a/dt changes by (sum of the contact impulses across the
+  // face normal to a) - dt (pressure - K_aa) A_a, A_a = V / L_a the face,
+  // K the kinetic stress (pressure: force per area, N/m^2). Isotropic
+  // compaction: all three; shear: L_y. max_strain_rate > 0: the lengths
+  // shrink at most at that strain rate (the brake, core/cell_dof.hpp).
+  double pressure = 0.0, cell_mass = 0.0, max_strain_rate = 0.0;
+  std::array<bool, 3> cell_dof{false, false, false};
+  // The cell's state beside its lengths and le_offset (checkpointed):
+  // dL/dt, and the shear strain sum dt gamma-dot.
+  Vec3 cell_rate = Vec3::Zero();
+  double strain = 0.0;
 };
+
+// A cell length as a boundary dof of the 3D sweep (the 3D sibling of 2D's
+// BoundaryDof): its velocity v enters the relative velocity of the rows
+// that touch an image across its face as a.(u_n, u_t1, u_t2) += a v, and
+// their impulses act back. Updated between sweeps by core/cell_dof.hpp's
+// damped step; the change goes into the rows' offsets (bn, and the
+// tangential ones in `extra`, null in frictionless scenes).
+struct CellDof3 {
+  double v0 = 0.0, v = 0.0, inv_mass = 0.0;
+  double scale = 1.0;  // impulse scale of the convergence test (the imposed impulse)
+  int axis = 0;
+  std::vector<std::int32_t> rows;
+  std::vector<Vec3> a;  // coefficients in the row's frame (n, t1, t2)
+  RowExtra3* extra = nullptr;
+};
+double update_dof(CellDof3& d, SphereRow* rows);
 
 class World3 {
  public:
@@ -110,8 +146,12 @@ class World3 {
   std::vector<obs::Contact<3>> contact_forces() const;
   // L_x L_y L_z of a tri-periodic cell; 0 unless x, y and z are all periodic.
   double cell_volume() const;
-  // Shear rate of the Lees-Edwards cell: le_velocity / L_y (0 without).
+  // Shear rate of the Lees-Edwards cell: WorldParams3::shear_rate if set,
+  // else le_velocity / L_y (0 without).
   double shear_rate() const;
+  // The cell lengths solved at imposed stress (pressure, cell_mass and some
+  // cell_dof set).
+  bool cell_dofs() const { return dofs_on_; }
   // Contact stress sigma_ij = (1/V) sum_c f_i l_j, compression positive;
   // V = cell_volume() unless volume > 0 (no volume at all: stress times V).
   Eigen::Matrix3d contact_stress(double volume = 0.0) const;
@@ -133,7 +173,7 @@ class World3 {
 
   // A scene's sweep instance (chosen in configure).
   using SolveFn = SolveStats (*)(std::vector<SphereRow>&, const std::vector<RowExtra3>&, const Colouring&,
-                                 std::vector<BodyVel3>&, const SolverParams&);
+                                 std::vector<BodyVel3>&, const SolverParams&, std::vector<CellDof3>*);
 
  private:
   void configure();
@@ -145,12 +185,13 @@ class World3 {
   void integrate();
   void observe();
 
-  PeriodicCell3 cell_at(double offset) const;
+  PeriodicCell3 cell_at(double offset, const Vec3& size) const;
   void wrap_into_cell(double offset);
+  void set_dofs(const Eigen::Matrix3d& K);
 
   WorldParams3 prm_;
   bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, periodic_on_ = false,
-       moving_images_ = false, extras_on_ = false;
+       moving_images_ = false, extras_on_ = false, dofs_on_ = false;
   double alert_ = 0.0;
   SolveFn solve_fn_ = nullptr;
   StepStats last_;
@@ -162,6 +203,8 @@ class World3 {
   Colouring colouring_;
   CellGrid3 grid_;
   WarmStart warm_;
+  Vec3 cm_ = Vec3::Zero();  // the cell's lengths at the step's midpoint
+  std::vector<CellDof3> dofs_;
 };
 
 }  // namespace cd

@@ -1,0 +1,50 @@
+// A periodic cell's length as a degree of freedom at imposed stress
+// (method.md section 9), the arithmetic 2D (2d/boundary.cpp) and 3D
+// (3d/world3.cpp) share: the free velocity of a length under its load, the
+// compaction brake, and the damped Gauss-Seidel update of the dof between
+// sweeps. Each dimension keeps its own row coupling (which rows cross the
+// boundary, with which coefficients); the numbers those give go through
+// these functions, so the two cells answer a pressure the same way.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace cd::cell_dof {
+
+// Lower bound of the free velocity of a length L with the compaction brake
+// (shear.compaction_rate): -min(rate L, alert / (4 dt)): the cell shrinks at
+// most at the strain rate `rate`, and by a quarter of the alert distance a
+// step, so that the images approach the grains across the boundary by well
+// under the alert distance in a step and those contacts are detected before
+// they close. rate = 0: no bound (-inf).
+inline double floor(double rate, double L, double alert, double dt) {
+  return rate > 0.0 ? -std::min(rate * L, 0.25 * alert / dt) : -std::numeric_limits<double>::infinity();
+}
+
+// Free velocity of a length of mass M whose velocity at the start of the
+// step is v_start, under the load `load` (imposed stress minus the kinetic
+// stress, times the face it acts on; > 0 pushes the length shorter), over a
+// step dt, bounded below by v_floor.
+inline double free_velocity(double v_start, double load, double M, double dt, double v_floor) {
+  return std::max(v_start - dt * load / M, v_floor);
+}
+
+// One update of a dof between sweeps. s = sum of its coefficients times
+// the rows' impulses (the impulse the contacts put on the length), k = the
+// active rows' local response sum a^2 / W (per component). The sweep runs
+// with the dof frozen, so this is a Jacobi step between the dof and its
+// rows: a change dv of the dof makes each active row answer with about -k
+// dv, and the plain update v = v0 + s/M overshoots by k/M. It diverges once
+// the dof is lighter than the grains it touches (measured in 2D: a top wall
+// of 0.1 the mass of 100 disks hit the iteration cap and blew up within 400
+// steps). The step is damped by that response (the Newton step of the dof's
+// equation with the rows' local response): same fixed point, and a
+// contraction. Returns dv (to add to v and to the rows' offsets, times their
+// coefficients); res = the residual of the dof's equation before the step.
+inline double damped_step(double v0, double v, double inv_mass, double s, double k, double& res) {
+  res = v0 + inv_mass * s - v;
+  return res / (1.0 + inv_mass * k);
+}
+
+}  // namespace cd::cell_dof
