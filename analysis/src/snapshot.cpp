@@ -146,6 +146,27 @@ vtkDataArray* need(vtkDataSetAttributes* attr, const char* name, int comps,
   return a;
 }
 
+// The test writers' pieces (write_contacts, write_contacts3, write_particles).
+vtkSmartPointer<vtkDoubleArray> darr(const char* name, int comps) {
+  vtkNew<vtkDoubleArray> a;
+  a->SetName(name);
+  a->SetNumberOfComponents(comps);
+  return vtkSmartPointer<vtkDoubleArray>(a.GetPointer());
+}
+vtkSmartPointer<vtkIntArray> iarr(const char* name) {
+  vtkNew<vtkIntArray> a;
+  a->SetName(name);
+  return vtkSmartPointer<vtkIntArray>(a.GetPointer());
+}
+void write_polydata(const std::string& path, vtkPolyData* pd) {
+  vtkNew<vtkXMLPolyDataWriter> w;
+  w->SetFileName(path.c_str());
+  w->SetInputData(pd);
+  w->SetDataModeToAppended();
+  w->EncodeAppendedDataOff();
+  if (w->Write() != 1) throw InputError(fmt::format("cannot write '{}'", path));
+}
+
 }  // namespace
 
 ContactSet read_contacts(const std::string& path) {
@@ -294,17 +315,6 @@ void write_contacts(const std::string& path, const ContactSet& cs, const Particl
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();  // float32 would cost 1e-7 relative on branch vectors
   vtkNew<vtkCellArray> lines;
-  auto darr = [](const char* name, int comps) {
-    vtkNew<vtkDoubleArray> a;
-    a->SetName(name);
-    a->SetNumberOfComponents(comps);
-    return vtkSmartPointer<vtkDoubleArray>(a.GetPointer());
-  };
-  auto iarr = [](const char* name) {
-    vtkNew<vtkIntArray> a;
-    a->SetName(name);
-    return vtkSmartPointer<vtkIntArray>(a.GetPointer());
-  };
   auto fn = darr("fn", 1), ft = darr("ft", 1), force = darr("force", 3), normal = darr("normal", 3),
        gap = darr("gap", 1), branch = darr("branch", 3);
   auto status = iarr("status"), type = iarr("type"), b1 = iarr("b1"), b2 = iarr("b2");
@@ -336,12 +346,7 @@ void write_contacts(const std::string& path, const ContactSet& cs, const Particl
   for (auto& a : {fn, ft, force, normal, gap}) pd->GetCellData()->AddArray(a);
   if (with_branch) pd->GetCellData()->AddArray(branch);
   for (auto& a : {status, type, b1, b2}) pd->GetCellData()->AddArray(a);
-  vtkNew<vtkXMLPolyDataWriter> w;
-  w->SetFileName(path.c_str());
-  w->SetInputData(pd);
-  w->SetDataModeToAppended();
-  w->EncodeAppendedDataOff();
-  if (w->Write() != 1) throw InputError(fmt::format("cannot write '{}'", path));
+  write_polydata(path, pd);
 }
 
 void write_contacts3(const std::string& path, const ContactSet3& cs, const ParticleSet& centres) {
@@ -350,17 +355,6 @@ void write_contacts3(const std::string& path, const ContactSet3& cs, const Parti
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();
   vtkNew<vtkCellArray> lines;
-  auto darr = [](const char* name, int comps) {
-    vtkNew<vtkDoubleArray> a;
-    a->SetName(name);
-    a->SetNumberOfComponents(comps);
-    return vtkSmartPointer<vtkDoubleArray>(a.GetPointer());
-  };
-  auto iarr = [](const char* name) {
-    vtkNew<vtkIntArray> a;
-    a->SetName(name);
-    return vtkSmartPointer<vtkIntArray>(a.GetPointer());
-  };
   auto fn = darr("fn", 1), ft = darr("ft", 3), force = darr("force", 3), normal = darr("normal", 3),
        gap = darr("gap", 1);
   auto status = iarr("status"), b1 = iarr("b1"), b2 = iarr("b2");
@@ -391,12 +385,7 @@ void write_contacts3(const std::string& path, const ContactSet3& cs, const Parti
   pd->SetLines(lines);
   for (auto& a : {fn, ft, force, normal, gap}) pd->GetCellData()->AddArray(a);
   for (auto& a : {status, b1, b2}) pd->GetCellData()->AddArray(a);
-  vtkNew<vtkXMLPolyDataWriter> w;
-  w->SetFileName(path.c_str());
-  w->SetInputData(pd);
-  w->SetDataModeToAppended();
-  w->EncodeAppendedDataOff();
-  if (w->Write() != 1) throw InputError(fmt::format("cannot write '{}'", path));
+  write_polydata(path, pd);
 }
 
 void write_particles(const std::string& path, const ParticleSet& ps) {
@@ -430,12 +419,7 @@ void write_particles(const std::string& path, const ParticleSet& ps) {
                           static_cast<vtkDataArray*>(omega), static_cast<vtkDataArray*>(angle),
                           static_cast<vtkDataArray*>(mass)})
     pd->GetPointData()->AddArray(a);
-  vtkNew<vtkXMLPolyDataWriter> w;
-  w->SetFileName(path.c_str());
-  w->SetInputData(pd);
-  w->SetDataModeToAppended();
-  w->EncodeAppendedDataOff();
-  if (w->Write() != 1) throw InputError(fmt::format("cannot write '{}'", path));
+  write_polydata(path, pd);
 }
 
 std::vector<std::string> list_snapshots(const std::string& run_dir, const std::string& prefix) {
