@@ -42,6 +42,19 @@ void print_stats(const RunSteady& r) {
              r.x_column);
 }
 
+// z and rattlers of a fabric (2D and 3D), or why they are missing.
+void print_connectivity(const std::optional<cda::Connectivity>& conn, const char* bodies) {
+  if (!conn) {
+    fmt::print("connect.   no {} snapshot next to the contacts: z not computed\n", bodies);
+    return;
+  }
+  const auto& c = *conn;
+  fmt::print("connect.   z {:.4f}  rattlers {} of {}  non-floating {:.4f}  P_c", c.z, c.rattlers, c.particles,
+             c.non_floating);
+  for (std::size_t i = 0; i < c.P.size(); ++i) fmt::print(" {}:{:.3f}", i, c.P[i]);
+  fmt::print("\n");
+}
+
 void print_harmonics(const char* label, const Anisotropy& a) {
   fmt::print("{:<8} a_c {:.4f} ({:.1f} deg)  a_ln {:.4f}  a_lt {:.4f}  a_fn {:.4f} ({:.1f} deg)  "
              "a_ft {:.4f} ({:.1f} deg)  sum/2 {:.4f}\n",
@@ -279,15 +292,7 @@ int main(int argc, char** argv) {
         fmt::print("harmonics  none: {}\n", f.aniso_problem);
       }
       fmt::print("sliding    {:.4f} of force-bearing contacts (status flag)\n", f.sliding);
-      if (f.connectivity) {
-        const auto& c = *f.connectivity;
-        fmt::print("connect.   z {:.4f}  rattlers {} of {}  non-floating {:.4f}  P_c", c.z, c.rattlers,
-                   c.particles, c.non_floating);
-        for (std::size_t i = 0; i < c.P.size(); ++i) fmt::print(" {}:{:.3f}", i, c.P[i]);
-        fmt::print("\n");
-      } else {
-        fmt::print("connect.   no spheres snapshot next to the contacts: z not computed\n");
-      }
+      print_connectivity(f.connectivity, "spheres");
     } else if (fabric->parsed()) {
       const auto f = run_fabric(run, snapshot, bins, volume);
       fmt::print("snapshot   {}\ncontacts   {} ({} force-bearing physical)\n", f.file, f.contacts,
@@ -306,15 +311,7 @@ int main(int argc, char** argv) {
       if (f.ss) print_harmonics("ss", *f.ss);
       if (f.sv_stress) fmt::print("sv stress  p {:.6g} q {:.6g}\n", f.sv_stress->p(), f.sv_stress->q());
       if (f.ss_stress) fmt::print("ss stress  p {:.6g} q {:.6g}\n", f.ss_stress->p(), f.ss_stress->q());
-      if (f.connectivity) {
-        const auto& c = *f.connectivity;
-        fmt::print("connect.   z {:.4f}  rattlers {} of {}  non-floating {:.4f}  P_c", c.z, c.rattlers,
-                   c.particles, c.non_floating);
-        for (std::size_t i = 0; i < c.P.size(); ++i) fmt::print(" {}:{:.3f}", i, c.P[i]);
-        fmt::print("\n");
-      } else {
-        fmt::print("connect.   no particles snapshot next to the contacts: z not computed\n");
-      }
+      print_connectivity(f.connectivity, "particles");
       if (!out.empty()) {
         fs::create_directories(out);
         if (!plot_polar(out, "polar", f)) fmt::print(stderr, "warning: gnuplot failed; scripts in {}\n", out);

@@ -83,6 +83,17 @@ Estimate measured_inertial_number(const Table& series, const std::string& x_colu
   return {i, 0.5 * i * ss.error() / ss.mean};
 }
 
+// The bodies snapshot with the same number as a contacts snapshot
+// (stem "particles" in 2D, "spheres" in 3D), if it exists.
+static std::optional<std::string> companion_snapshot(const std::string& contacts_file, const std::string& stem) {
+  const fs::path f(contacts_file);
+  const std::string p =
+      (f.parent_path() / (stem + f.filename().string().substr(std::string("contacts").size()))).string();
+  std::error_code ec;
+  if (!fs::exists(p, ec)) return std::nullopt;
+  return p;
+}
+
 RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume, double mu,
                      double sliding_tol) {
   RunFabric f;
@@ -120,12 +131,7 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume,
     (type == 1 ? f.sv_stress : f.ss_stress) = contact_stress(of_type(raw, type), V);
   }
   // The particles snapshot with the same number, for rattlers and z.
-  const std::string pfile =
-      (fs::path(f.file).parent_path() /
-       ("particles" + fs::path(f.file).filename().string().substr(std::string("contacts").size())))
-          .string();
-  std::error_code ec;
-  if (fs::exists(pfile, ec)) f.connectivity = connectivity(raw, read_particles(pfile), f_eps);
+  if (const auto pfile = companion_snapshot(f.file, "particles")) f.connectivity = connectivity(raw, read_particles(*pfile), f_eps);
   return f;
 }
 
@@ -156,12 +162,7 @@ RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double 
   const double nb = static_cast<double>(bearing.size());
   f.sliding = static_cast<double>(flag) / nb;
   if (mu > 0) f.sliding_coulomb = static_cast<double>(coulomb) / nb;
-  const std::string pfile =
-      (fs::path(f.file).parent_path() /
-       ("spheres" + fs::path(f.file).filename().string().substr(std::string("contacts").size())))
-          .string();
-  std::error_code ec;
-  if (fs::exists(pfile, ec)) f.connectivity = connectivity(raw, read_particles(pfile), f_eps);
+  if (const auto pfile = companion_snapshot(f.file, "spheres")) f.connectivity = connectivity(raw, read_particles(*pfile), f_eps);
   return f;
 }
 
