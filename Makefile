@@ -5,7 +5,14 @@ SHELL := /bin/bash
 BUILD ?= build
 JOBS  ?= $(shell nproc)
 SCENE ?= configs/default.toml
-CAMPAIGNS ?= outputs/campaigns
+# DIM=3 runs the shear campaigns and analyses with spheres (configs/shear3-*.toml,
+# p in N/m^2, rho in kg/m^3) into their own folders (docs/3d.md).
+DIM ?= 2
+ifeq ($(filter 2 3,$(DIM)),)
+$(error DIM=$(DIM): the dimension is 2 or 3)
+endif
+dim3 = $(filter 3,$(DIM))
+CAMPAIGNS ?= outputs/campaigns$(if $(dim3),3d)
 OUT   ?= outputs/default
 
 # Debian 12 packages the build needs (what each is for: README.md, "Two commands").
@@ -159,7 +166,13 @@ prep-overlap: build
 # invalidate finished runs: use another CAMPAIGNS folder (or remove it).
 N        ?= 200
 STRAIN   ?= 2
-P        ?= 100
+# The imposed pressure and the grains' density: 2D per length and per area
+# (N/m, kg/m^2), 3D per area and per volume (N/m^2, kg/m^3); the 3D values
+# are 2D's read as a 1 mm thick layer, so t_p = d sqrt(rho/p) is the same.
+P        ?= $(if $(dim3),1e5,100)
+RHO      := $(if $(dim3),2600,2.6)
+PREP_SCENE  := configs/shear$(if $(dim3),3)-prep.toml
+SHEAR_SCENE := configs/shear$(if $(dim3),3)-inertial.toml
 INERTIAL_I ?= 0.001 0.003 0.01 0.03 0.1 0.3
 COHESIVE_ETA ?= 0 1 10 100
 COHESIVE_I ?= 0.01 0.1
@@ -187,9 +200,9 @@ SIZE_DIST  ?= uniform_area
 dt_tp = $(shell awk 'BEGIN { x = 0.005 / $(1); printf "%.4g", x < 0.05 ? x : 0.05 }')
 # 100 series rows per unit strain: 0.01 / shear rate = 0.01 t_p / I.
 # (A second argument, when given, is the pressure instead of P.)
-series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt(2.6 / $(or $(2),$(P))) / $(1) }')
+series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt($(RHO) / $(or $(2),$(P))) / $(1) }')
 # A contact snapshot every 0.2 strain (fabric, cdanalysis fabric / report).
-snapshot_dt = $(shell awk 'BEGIN { printf "%.6g", 0.2e-3 * sqrt(2.6 / $(or $(2),$(P))) / $(1) }')
+snapshot_dt = $(shell awk 'BEGIN { printf "%.6g", 0.2e-3 * sqrt($(RHO) / $(or $(2),$(P))) / $(1) }')
 # Checkpoints every CKPT_STRAIN of shear strain and at most every CKPT_WALL
 # seconds of wall clock (at the next series row), so that a kill loses little
 # (docs/shear.md). Preparations have no strain: the wall clock alone.
@@ -218,9 +231,11 @@ campaign-prep-of:
 # Products, never intermediates: make must not delete a sample when done.
 .PRECIOUS: $(CAMPAIGNS)/prep/ns_%/.done
 
-# Compacted samples: disks (ns_0) or n-gons, N grains, isotropic at P.
+# Compacted samples: disks (ns_0) or n-gons, N grains, isotropic at P
+# (3D: spheres, compacted at 0.05 / t_p for 50 t_p; PREP_SET adds settings).
+PREP_SET ?= $(if $(dim3),$(PREP3_FAST))
 $(CAMPAIGNS)/prep/ns_%/.done: | build
-	$(CDSIM) configs/shear-prep.toml --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_strain=0 \
+	$(CDSIM) $(PREP_SCENE) --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_strain=0 \
 	  --set output.snapshot_interval=0 \
 	  --set particles.n=$(N) --set particles.nsides=[$*] --set shear.pressure=$(P) \
 	  --set particles.size_ratio=$(SIZE_RATIO) --set particles.size_dist=$(SIZE_DIST) \
@@ -240,7 +255,7 @@ shear_solver = $(if $(SHEAR_TOL),--set solver.tol=$(SHEAR_TOL),$(shell awk 'BEGI
   "--set solver.tol=1e-3" : "--set solver.tol=1e-4 --set solver.residual_tol=3e-3" }'))
 # One shear run of every campaign (fresh, ladder, pressure series): $(1) I,
 # $(2) the run folder it starts from, $(3) p, $(4) strain.
-shear_cmd = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) $(call shear_solver,$(1)) \
+shear_cmd = $(CDSIM) $(SHEAR_SCENE) --out $(@D) $(CAMPAIGN_SET) $(call shear_solver,$(1)) \
 	  --set shear.start='"$(2)/checkpoint.bin"' --set shear.pressure=$(3) \
 	  --set shear.inertial_number=$(1) --set shear.strain=$(4) --set shear.dt_tp=$(call dt_tp,$(1)) \
 	  --set output.series_interval=$(call series_dt,$(1),$(3)) --set output.snapshot_interval=$(call snapshot_dt,$(1),$(3))
@@ -303,6 +318,7 @@ $(CAMPAIGNS)/cohesive/eta_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
 	touch $@
 
 $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done
+	$(if $(dim3),@echo "campaign-angularity is 2D only (3D grains are spheres)"; exit 2)
 	$(call shear_run,$(ANGULAR_I),$*)
 	touch $@
 
@@ -404,13 +420,13 @@ $(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(eva
 # Campaign analyses: the report of outputs/campaigns/<name> (made by the
 # campaign-* targets) into outputs/analysis/<name>/, plus the campaign's fits.
 CDA := $(BUILD)/analysis/cdanalysis
-ANALYSIS := outputs/analysis
+ANALYSIS := outputs/analysis$(if $(dim3),3d)
 
 analyze-inertial: build
 	$(CDA) report $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial
 	$(CDA) fit mu-i $(CAMPAIGNS)/inertial --toml $(ANALYSIS)/inertial/mu_i.toml
 	$(CDA) fit nu-i $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/nu_i --toml $(ANALYSIS)/inertial/nu_i.toml
-	$(CDA) fit dilatancy $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/dilatancy --toml $(ANALYSIS)/inertial/dilatancy.toml
+	$(if $(dim3),,$(CDA) fit dilatancy $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/dilatancy --toml $(ANALYSIS)/inertial/dilatancy.toml)
 
 # The eta = 0 reference runs (eta_0_I_*) must be in the cohesive campaign.
 analyze-cohesive: build
@@ -424,27 +440,39 @@ analyze-pressure analyze-pressure-ladder: analyze-%: build
 analyze-inertial-ladder: build
 	$(CDA) report $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder
 	$(CDA) fit mu-i $(CAMPAIGNS)/inertial-ladder --toml $(ANALYSIS)/inertial-ladder/mu_i.toml
+	$(CDA) fit nu-i $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder/nu_i --toml $(ANALYSIS)/inertial-ladder/nu_i.toml
 
 analyze-angularity: build
 	$(CDA) report $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity
 	$(CDA) fit angularity $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity/fit --toml $(ANALYSIS)/angularity/mu_alpha.toml
 
-# Regression of fitted curves: re-runs the small reference campaign of
-# tests/data/regress/ from scratch (same sizes and seed, ~1 min on 2 cores),
-# fits mu(I) and compares with the stored fit: a parameter fails when it
+# Regression of fitted curves: re-runs the small reference campaigns of
+# tests/data/regress/ (2D: 100 disks) and tests/data/regress3d/ (3D: 200
+# spheres) from scratch (same sizes and seed, ~1 min and ~5 min on 2 cores),
+# fits mu(I) and compares with the stored fits: a parameter fails when it
 # moved by more than 3 combined standard uncertainties (cdanalysis
 # compare-fits). The simulator is deterministic, so an unchanged code gives
 # the same numbers; a change of the physics or numerics shows up here.
 REGRESS_DIR ?= outputs/regress
 REGRESS_I := 0.01 0.02 0.05 0.1 0.2 0.3 0.4
-.PHONY: regress regress-campaign
-regress: regress-campaign
+REGRESS3_DIR ?= outputs/regress3d
+REGRESS3_I := 0.02 0.05 0.1 0.2 0.3
+# The 3D sample is compacted at 0.05 / t_p for 50 t_p (docs/3d.md).
+PREP3_FAST := --set shear.compaction_rate=0.05 --set time.duration=0.008
+.PHONY: regress regress-campaign regress3-campaign
+regress: regress-campaign regress3-campaign
 	$(CDA) fit mu-i $(REGRESS_DIR)/inertial --window 1:3 --toml $(REGRESS_DIR)/mu_i.toml
 	$(CDA) compare-fits tests/data/regress/mu_i.toml $(REGRESS_DIR)/mu_i.toml --tol-sigma 3
+	$(CDA) fit mu-i $(REGRESS3_DIR)/inertial --window 1:3 --toml $(REGRESS3_DIR)/mu_i.toml
+	$(CDA) compare-fits tests/data/regress3d/mu_i.toml $(REGRESS3_DIR)/mu_i.toml --tol-sigma 3
 regress-campaign: build
 	rm -rf $(REGRESS_DIR)
-	$(MAKE) --no-print-directory -j $(JOBS) campaign-inertial CAMPAIGNS=$(REGRESS_DIR) N=100 STRAIN=3 P=100 SHEAR_TOL=1e-4 \
+	$(MAKE) --no-print-directory -j $(JOBS) campaign-inertial DIM=2 CAMPAIGNS=$(REGRESS_DIR) N=100 STRAIN=3 P=100 SHEAR_TOL=1e-4 \
 	  INERTIAL_I="$(REGRESS_I)"
+regress3-campaign: build
+	rm -rf $(REGRESS3_DIR)
+	$(MAKE) --no-print-directory -j $(JOBS) campaign-inertial DIM=3 CAMPAIGNS=$(REGRESS3_DIR) N=200 STRAIN=3 P=1e5 SHEAR_TOL=1e-4 \
+	  INERTIAL_I="$(REGRESS3_I)"
 
 clean:
 	rm -rf $(BUILD)
