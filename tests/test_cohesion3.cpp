@@ -267,11 +267,12 @@ TEST(Cohesion3Shear, CohesiveShearAtImposedPressure) {
   for (int k = 0; k < kThreadSteps; ++k) w2.step();
   omp_set_num_threads(1);
   double syy[nblk] = {}, rn_min = 0;
-  long tensile = 0, rows = 0, sweeps = 0;
+  long tensile = 0, rows = 0, sweeps = 0, caps = 0;
   bool finite = true;
   for (int k = 0; k < skip + avg; ++k) {
     w.step();
     sweeps += w.last().solve.iterations;
+    caps += w.last().solve.cap_hit;
     if (k + 1 == kThreadSteps) {
       for (std::size_t i = 0; i < w.bodies.size(); ++i) {
         ASSERT_EQ(w2.bodies.pos[i], w.bodies.pos[i]) << i;
@@ -294,9 +295,10 @@ TEST(Cohesion3Shear, CohesiveShearAtImposedPressure) {
   double m = 0, m2 = 0;
   for (const double x : syy) m += x / nblk, m2 += x * x / nblk;
   const double se = std::sqrt(std::max(0.0, m2 - m * m) / (nblk - 1));
-  std::printf("eta %g: f_a = %.4g N; (sigma_yy + K_yy)/p = %.4f +- %.4f; tensile rows %.1f %%, min r_n/dt = %.6f f_a; "
-              "%.0f sweeps/step\n",
-              eta, fa, m, se, 100.0 * tensile / rows, rn_min / fa, double(sweeps) / (skip + avg));
+  std::printf("eta %g: f_a = %.4g N; (sigma_yy + K_yy)/p = %.4f +- %.4f; tensile rows %.1f %%, min r_n/dt = -f_a "
+              "(1 + %.2g); %.0f sweeps/step, %ld of %d steps at the cap\n",
+              eta, fa, m, se, 100.0 * tensile / rows, -rn_min / fa - 1, double(sweeps) / (skip + avg), caps,
+              skip + avg);
   EXPECT_TRUE(finite);
   EXPECT_NEAR(m, 1.0, 3 * se + 0.05);
   EXPECT_GT(tensile, 0);
