@@ -734,6 +734,17 @@ TEST(Commands3, CohesionFitOnThreeDRuns) {
   EXPECT_NEAR(params.at("k0").value, f["k0"], 1e-6 * std::abs(f["k0"]));
   const Table data = Table::read_csv((d.parent_path() / "cohesion3_out" / "cohesion_data.csv").string());
   EXPECT_TRUE(data.has("mu0"));
+  // The report of the campaign: its cohesive section makes the same fit.
+  const auto rep_dir = d.parent_path() / "cohesion3_report";
+  fs::remove_all(rep_dir);
+  const auto rep = cdtest::run_command(fmt::format("{} report {} --out {}", exe.string(), d.string(), rep_dir.string()));
+  ASSERT_EQ(rep.code, 0) << rep.out;
+  const auto rfit = read_fit_toml((rep_dir / "fits.toml").string());
+  ASSERT_TRUE(rfit.models.count("cohesion")) << rep.out;
+  EXPECT_NEAR(rfit.models.at("cohesion").params.at("k0").value, f["k0"], 1e-6 * std::abs(f["k0"]));
+  std::ifstream html(rep_dir / "index.html");
+  const std::string page((std::istreambuf_iterator<char>(html)), {});
+  EXPECT_NE(page.find("μ0(I)"), std::string::npos) << "the page names the 3D construction";
   // A 2D run among the 3D ones: one fit mixes no dimensions.
   synth::RunSpec s2;
   synth::write_run(d / "z_2d", s2);
