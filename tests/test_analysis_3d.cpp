@@ -11,6 +11,7 @@
 //   on contacts built from the definitions: exact to second order within
 //   sampling error, and the first-order form within 15 % (the issue's
 //   criterion) at steady-shear-like anisotropies and within 2 % at small ones;
+// - fit cohesion on 3D runs: c/p = mu - mu0(I) against a known model;
 // - dimension detection and the refusals.
 #include <gtest/gtest.h>
 
@@ -24,6 +25,7 @@
 #include <regex>
 #include <sstream>
 
+#include "analysis/src/cohesion.hpp"
 #include "analysis/src/compare.hpp"
 #include "analysis/src/fabric3.hpp"
 #include "analysis/src/run.hpp"
@@ -429,6 +431,7 @@ struct Run3Spec {
   Forms forms;
   std::size_t contacts = 0;  // 0: no snapshot
   std::string extra_scene;
+  double q_offset = 0.2;     // q_over_p - shear_stress_ratio
 };
 
 void write_run3(const fs::path& dir, const Run3Spec& s) {
@@ -440,7 +443,7 @@ void write_run3(const fs::path& dir, const Run3Spec& s) {
   for (int i = 0; i < s.rows; ++i) {
     const double gamma = 0.01 * i;
     csv << fmt::format("{},{:.6g},{:.6g},1,{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},100\n", i, gamma, gamma,
-                       s.mu + s.noise * e, s.mu + 0.2 + s.noise * e, s.I, 0.6 - 0.3 * s.I + 0.002 * e,
+                       s.mu + s.noise * e, s.mu + s.q_offset + s.noise * e, s.I, 0.6 - 0.3 * s.I + 0.002 * e,
                        4.5 + 0.05 * e);
     e = 0.5 * e + std::sqrt(0.75) * G();
   }
@@ -606,7 +609,6 @@ TEST(Commands3, ReportFitAndRefusals) {
   // Refused by name, exit 1: the commands whose definitions are 2D.
   const std::string r0 = (camp / "I0").string();
   for (const auto& [cmd, what] : std::vector<std::pair<std::string, std::string>>{
-           {"fit cohesion " + r0, "fit cohesion is 2D only"},
            {"fit dilatancy " + r0, "fit dilatancy"},
            {"fit angularity " + r0, "fit angularity is 2D only"},
            {"fabric " + r0 + " --out " + (camp.parent_path() / "polar").string(), "fabric --out"},
@@ -652,4 +654,109 @@ TEST(Commands3, ReportFitAndRefusals) {
   const auto l = cdtest::run_command(fmt::format("{} fabric {}", exe.string(), lone.string()));
   EXPECT_EQ(l.code, 2) << l.out;
   EXPECT_NE(l.out.find("is a 3D contact snapshot"), std::string::npos) << l.out;
+}
+
+// fit cohesion on 3D runs (docs/analysis.md "3D runs"): eta = 0 runs on
+// mu(I) (mu the shear_stress_ratio) and cohesive runs with mu = mu0(I) +
+// c/p, c/p from the model with known k0, beta, alpha (I_c = I/(1 + alpha
+// eta)^(1/2)). Their q_over_p (von Mises, 3D) is that of the reference
+// curve, so reading it would give c/p = 0. Each run's c/p within 4 of its
+// error bars of the model value, the model's parameters within 3 sigma
+// (2D's criterion, test_analysis_runs.cpp); the command agrees and names
+// the 3D construction; a 2D run among them is refused.
+TEST(Commands3, CohesionFitOnThreeDRuns) {
+  ASSERT_TRUE(fs::exists(exe)) << "cdanalysis not built: " << exe;
+  const auto d = cdtest::scratch_dir("test_analysis_3d", "cohesion");
+  const double mu1 = 0.36, mu2 = 0.8, I0 = 0.1;
+  const double k0 = 0.12, beta = 0.8, alpha = 0.5;
+  std::uint64_t seed = 1000;
+  const auto scene = [](double eta) { return fmt::format("[contact]\ncohesion_number = {:.17g}\n", eta); };
+  for (double I : {1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3}) {
+    Run3Spec s;
+    s.I = I;
+    s.mu = synth::mu_of_I(mu1, mu2, I0, I);
+    s.seed = seed++;
+    s.extra_scene = scene(0);
+    write_run3(d / fmt::format("eta_0_I_{:g}", I), s);
+  }
+  std::map<std::string, double> truth_c;
+  for (double eta : {1.0, 3.0, 10.0})
+    for (double I : {2e-3, 2e-2, 0.1, 0.25}) {
+      Run3Spec s;
+      s.I = I;
+      const double c = synth::cohesion_model(k0, beta, alpha, eta, I);
+      s.mu = synth::mu_of_I(mu1, mu2, I0, I) + c;
+      s.q_offset = 0.2 - c;  // q_over_p on the reference's curve
+      s.seed = seed++;
+      s.extra_scene = scene(eta);
+      const auto dir = d / fmt::format("eta_{:g}_I_{:g}", eta, I);
+      write_run3(dir, s);
+      truth_c[dir.string()] = c;
+    }
+  // The library path.
+  std::vector<SteadyPoint> ref, coh;
+  for (const auto& e : fs::directory_iterator(d)) {
+    const auto p = steady_point(e.path().string());
+    EXPECT_EQ(p.dim, 3);
+    (p.eta == 0 ? ref : coh).push_back(p);
+  }
+  ASSERT_EQ(ref.size(), 6u);
+  ASSERT_EQ(coh.size(), 12u);
+  const SinPhiReference sr(ref, SinPhiReference::Mode::Auto);
+  EXPECT_TRUE(sr.uses_fit());
+  EXPECT_EQ(sr.dim(), 3);
+  std::vector<double> eta, I, c, ce;
+  for (const auto& p : coh) {
+    const auto cp = cohesion_point(p, sr);
+    EXPECT_NEAR(cp.c_over_p, truth_c.at(p.run), 4 * cp.c_over_p_err) << p.run;
+    EXPECT_GT(cp.c_over_p_err, 0.0);
+    EXPECT_LT(cp.c_over_p_err, 0.02);
+    eta.push_back(p.eta);
+    I.push_back(p.I);
+    c.push_back(cp.c_over_p);
+    ce.push_back(cp.c_over_p_err);
+  }
+  const auto f = fit_cohesion(eta, I, c, ce);
+  ASSERT_TRUE(f.converged);
+  EXPECT_NEAR(f["k0"], k0, 3 * f.err("k0"));
+  EXPECT_NEAR(f["beta"], beta, 3 * f.err("beta"));
+  EXPECT_NEAR(f["alpha"], alpha, 3 * f.err("alpha"));
+  std::printf("3D cohesion fit: k0 = %.4f +- %.4f (%.2f), beta = %.3f +- %.3f (%.2f), alpha = %.3f +- %.3f (%.2f)\n",
+              f["k0"], f.err("k0"), k0, f["beta"], f.err("beta"), beta, f["alpha"], f.err("alpha"), alpha);
+  // The command: the same construction, the parameters in its TOML.
+  const auto toml = d.parent_path() / "cohesion3.toml";
+  const auto r = cdtest::run_command(fmt::format("{} fit cohesion {} --toml {} --out {}", exe.string(), d.string(),
+                                                 toml.string(), (d.parent_path() / "cohesion3_out").string()));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("c/p = mu - mu0(I)"), std::string::npos) << r.out;
+  const auto fitted = read_fit_toml(toml.string());
+  const auto& params = fitted.models.at("cohesion").params;
+  EXPECT_NEAR(params.at("k0").value, f["k0"], 1e-6 * std::abs(f["k0"]));
+  const Table data = Table::read_csv((d.parent_path() / "cohesion3_out" / "cohesion_data.csv").string());
+  EXPECT_TRUE(data.has("mu0"));
+  // The report of the campaign: its cohesive section makes the same fit.
+  const auto rep_dir = d.parent_path() / "cohesion3_report";
+  fs::remove_all(rep_dir);
+  const auto rep = cdtest::run_command(fmt::format("{} report {} --out {}", exe.string(), d.string(), rep_dir.string()));
+  ASSERT_EQ(rep.code, 0) << rep.out;
+  const auto rfit = read_fit_toml((rep_dir / "fits.toml").string());
+  ASSERT_TRUE(rfit.models.count("cohesion")) << rep.out;
+  EXPECT_NEAR(rfit.models.at("cohesion").params.at("k0").value, f["k0"], 1e-6 * std::abs(f["k0"]));
+  std::ifstream html(rep_dir / "index.html");
+  const std::string page((std::istreambuf_iterator<char>(html)), {});
+  EXPECT_NE(page.find("μ0(I)"), std::string::npos) << "the page names the 3D construction";
+  // A 2D run among the 3D ones: one fit mixes no dimensions.
+  synth::RunSpec s2;
+  synth::write_run(d / "z_2d", s2);
+  const auto mix = cdtest::run_command(fmt::format("{} fit cohesion {}", exe.string(), d.string()));
+  EXPECT_EQ(mix.code, 1) << mix.out;
+  EXPECT_NE(mix.out.find("mixes no dimensions"), std::string::npos) << mix.out;
+  // The library refuses it too: a 2D point against the 3D reference.
+  const auto p2 = steady_point((d / "z_2d").string());
+  try {
+    cohesion_point(p2, sr);
+    ADD_FAILURE() << "a 2D point against a 3D reference: accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_NE(std::string(e.what()).find("mixes no dimensions"), std::string::npos) << e.what();
+  }
 }

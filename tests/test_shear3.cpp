@@ -404,7 +404,9 @@ TEST(Shear3Cell, KeysWithoutWhatTheyNeedAreRefusedByName) {
   { Scene t = s; t.inertial_number = 0.1; refused(t, "shear.isotropic"); }
   { Scene t = s; t.isotropic = false; t.strain = 1; refused(t, "shear.strain > 0 needs shear.inertial_number"); }
   { Scene t = s; t.checkpoint_strain = 0.5; refused(t, "output.checkpoint_strain"); }
-  { Scene t = s; t.cohesion_number = 0.5; refused(t, "contact.cohesion_number"); }
+  // The cohesion number works at imposed pressure (tests/test_cohesion3.cpp); not with a given f_a.
+  { Scene t = s; t.cohesion_number = 0.5; EXPECT_NO_THROW(check_scene3(t)); }
+  { Scene t = s; t.cohesion_number = 0.5; t.adhesion = 1e-3; refused(t, "contact.cohesion_number"); }
   { Scene t = s; t.pressure = 0; t.dt_tp = 0; t.dt = 1e-5; refused(t, "shear.isotropic needs shear.pressure"); }
   { Scene t = s; t.pressure = 0; t.isotropic = false; t.dt_tp = 0; t.dt = 1e-5; refused(t, "shear.compaction_rate needs shear.pressure"); }
   { Scene t = s; t.pressure = std::nan(""); refused(t, "t_p"); }

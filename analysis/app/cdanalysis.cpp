@@ -157,7 +157,8 @@ int main(int argc, char** argv) {
       "cohesion",
       "c/p = k0 eta/(1 - beta ln(1 - I/(1 + alpha eta)^(1/2))) over steady runs: eta from scene.toml "
       "([contact] cohesion_number), I the measured inertial_number, c/p = (q/p - sin phi)/cos phi with "
-      "sin phi(I) from the eta = 0 runs among those given");
+      "sin phi(I) from the eta = 0 runs among those given; 3D runs: c/p = mu - mu0(I), mu the "
+      "shear_stress_ratio, mu0(I) that of the eta = 0 runs");
   std::string reference = "auto";
   coh->add_option("runs", runs, "run or campaign folders, eta = 0 reference runs included");
   coh->add_option("--table", table, "CSV with columns eta, I, c_over_p and optionally c_over_p_err, instead of runs");
@@ -367,7 +368,9 @@ int main(int argc, char** argv) {
       } else {
         if (runs.empty()) throw AnalysisError("fit cohesion: give run folders or --table");
         std::vector<SteadyPoint> ref_pts, coh_pts;
-        for (const auto& r : expand_runs(runs)) {
+        const auto all = expand_runs(runs);
+        const int dim = common_dimension(all, "fit cohesion");
+        for (const auto& r : all) {
           const auto p = steady_point(r);
           (p.eta == 0 ? ref_pts : coh_pts).push_back(p);
         }
@@ -376,18 +379,24 @@ int main(int argc, char** argv) {
                           : reference == "interp" ? SinPhiReference::Mode::Interp
                                                   : SinPhiReference::Mode::Auto;
         const SinPhiReference ref(ref_pts, mode);
-        fmt::print("reference: {} eta = 0 runs, sin phi(I) by {}\n", ref_pts.size(),
+        const char* ref_name = cohesion_ref_name(dim);
+        if (dim == 3)
+          fmt::print("3D runs: mu = {} (-(sigma_xy + sigma_yx)/(2 sigma_yy)), {}, eta = f_a/(p d^2)\n",
+                     cohesion_mu_column(dim), cohesion_formula(dim));
+        fmt::print("reference: {} eta = 0 runs, {}(I) by {}\n", ref_pts.size(), ref_name,
                    ref.uses_fit() ? "the mu(I) fit" : "interpolation in ln I");
         for (const auto& p : ref.points())
-          fmt::print("  {}: I = {:.4g} +- {:.2g}, sin phi = {:.4f} +- {:.4f}\n", p.run, p.I, p.I_err, p.mu, p.mu_err);
+          fmt::print("  {}: I = {:.4g} +- {:.2g}, {} = {:.4f} +- {:.4f}\n", p.run, p.I, p.I_err, ref_name, p.mu,
+                     p.mu_err);
         if (ref.uses_fit()) print_fit(ref.fit(), mu_of_I());
         std::vector<CohesionPoint> pts;
         std::vector<double> eta, I, c, ce;
         for (const auto& p : coh_pts) {
           const auto cp = cohesion_point(p, ref);
-          fmt::print("{}: eta = {:g}, I = {:.4g} +- {:.2g} (imposed {:.4g}), q/p = {:.4f} +- {:.4f}, "
-                     "sin phi = {:.4f} +- {:.4f}{}, c/p = {:.4f} +- {:.4f}\n",
-                     p.run, p.eta, p.I, p.I_err, p.I_imposed, p.mu, p.mu_err, cp.ref.sin_phi, cp.ref.err,
+          fmt::print("{}: eta = {:g}, I = {:.4g} +- {:.2g} (imposed {:.4g}), {} = {:.4f} +- {:.4f}, "
+                     "{} = {:.4f} +- {:.4f}{}, c/p = {:.4f} +- {:.4f}\n",
+                     p.run, p.eta, p.I, p.I_err, p.I_imposed, dim == 3 ? "mu" : "q/p", p.mu, p.mu_err, ref_name,
+                     cp.ref.sin_phi, cp.ref.err,
                      cp.ref.extrapolated ? " (extrapolated)" : "", cp.c_over_p, cp.c_over_p_err);
           pts.push_back(cp);
           eta.push_back(p.eta);

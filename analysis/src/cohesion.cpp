@@ -17,21 +17,23 @@ namespace fs = std::filesystem;
 
 namespace cda {
 
+const char* cohesion_mu_column(int dim) { return dim == 3 ? "shear_stress_ratio" : "q_over_p"; }
+const char* cohesion_ref_name(int dim) { return dim == 3 ? "mu0" : "sin phi"; }
+const char* cohesion_formula(int dim) {
+  return dim == 3 ? "c/p = mu - mu0(I)" : "c/p = (q/p - sin phi)/cos phi";
+}
+
 SteadyPoint steady_point(const std::string& run_dir) {
   SteadyPoint p;
   p.run = run_dir;
   const auto scene = read_scene_info(run_dir);
-  if (scene.dimension == 3)
-    throw AnalysisError(fmt::format("fit cohesion is 2D only: '{}' is a 3D run (dimension = 3 in its scene.toml; "
-                                    "c/p = (q/p - sin phi)/cos phi is the 2D Mohr-Coulomb construction, and 3D "
-                                    "scenes have no cohesion_number yet)",
-                                    run_dir));
+  p.dim = scene.dimension;
   p.eta = require(scene, scene.cohesion_number, "[contact] cohesion_number");
   if (p.eta < 0) throw AnalysisError(fmt::format("'{}': cohesion_number {} is negative", scene.file, p.eta));
   p.I_imposed = scene.inertial_number.value_or(std::numeric_limits<double>::quiet_NaN());
   const auto series = read_series(run_dir);
   const auto x = default_x_column(series);
-  const auto s = run_steady(run_dir, series, "q_over_p", x, std::nullopt);
+  const auto s = run_steady(run_dir, series, cohesion_mu_column(p.dim), x, std::nullopt);
   const auto si = measured_inertial_number(series, x, s.stats.window);
   p.mu = s.stats.mean;
   p.mu_err = s.stats.error();
@@ -45,8 +47,13 @@ SinPhiReference::SinPhiReference(std::vector<SteadyPoint> pts, Mode mode) {
     throw AnalysisError("fit cohesion: no eta = 0 run among the given runs; sin phi(I) of the cohesionless "
                         "material is the reference for c/p = (q/p - sin phi)/cos phi: add the eta = 0 runs "
                         "([contact] cohesion_number = 0) to the run list");
-  for (const auto& p : pts)
+  dim_ = pts.front().dim;
+  for (const auto& p : pts) {
+    if (p.dim != dim_)
+      throw AnalysisError(fmt::format("fit cohesion: '{}' is a {}D run and '{}' a {}D run: one fit mixes no "
+                                      "dimensions", pts.front().run, dim_, p.run, p.dim));
     if (!(p.I > 0)) throw AnalysisError(fmt::format("'{}': measured inertial number {} is not positive", p.run, p.I));
+  }
   std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.I < b.I; });
   if (mode != Mode::Interp && pts.size() >= 4) {
     std::vector<double> I, mu, e;
@@ -105,8 +112,17 @@ SinPhiReference::Value SinPhiReference::at(double I, double I_err) const {
 CohesionPoint cohesion_point(const SteadyPoint& p, const SinPhiReference& ref) {
   CohesionPoint c;
   c.run = p;
+  if (p.dim != ref.dim())
+    throw AnalysisError(fmt::format("fit cohesion: '{}' is a {}D run and the eta = 0 runs are {}D: one fit mixes no "
+                                    "dimensions", p.run, p.dim, ref.dim()));
   c.ref = ref.at(p.I, p.I_err);
   const double s = c.ref.sin_phi, m = p.mu;
+  if (p.dim == 3) {
+    // The Coulomb law on the shear plane: mu = mu0(I) + c/p.
+    c.c_over_p = m - s;
+    c.c_over_p_err = std::hypot(p.mu_err, c.ref.err);
+    return c;
+  }
   if (!(std::abs(s) < 1))
     throw AnalysisError(fmt::format("'{}': reference sin phi = {} at I = {} is outside (-1, 1)", p.run, s, p.I));
   const double cphi = std::sqrt(1 - s * s);
@@ -118,8 +134,9 @@ CohesionPoint cohesion_point(const SteadyPoint& p, const SinPhiReference& ref) {
 
 bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts, const FitResult& r) {
   fs::create_directories(dir);
-  Table data({"eta", "I", "I_err", "q_over_p", "q_over_p_err", "sin_phi", "sin_phi_err", "c_over_p",
-              "c_over_p_err", "extrapolated"});
+  const bool d3 = !pts.empty() && pts.front().run.dim == 3;
+  Table data({"eta", "I", "I_err", d3 ? "mu" : "q_over_p", d3 ? "mu_err" : "q_over_p_err", d3 ? "mu0" : "sin_phi",
+              d3 ? "mu0_err" : "sin_phi_err", "c_over_p", "c_over_p_err", "extrapolated"});
   std::set<double> etas;
   double lo = 1, hi = 0;
   for (const auto& c : pts) {

@@ -3,6 +3,15 @@
 // cohesionless material at the same inertial number, taken from the
 // eta = 0 runs given alongside (the reference).
 //
+// 3D runs (dimension = 3; docs/analysis.md "3D runs"): the Coulomb law on
+// the shear plane, tau = mu0(I) sigma_yy + c, with mu = -(sigma_xy +
+// sigma_yx)/(2 sigma_yy) the series' shear_stress_ratio (the mu of the 3D
+// steady analysis and mu(I) fit) and mu0(I) that of the eta = 0 runs: c/p =
+// mu - mu0(I), p = sigma_yy the imposed normal stress, error
+// hypot(mu_err, mu0_err); eta = f_a/(p d^2) is the scene's cohesion_number.
+// The model and I_c = I/(1 + alpha eta)^(1/2) are 2D's. A fit mixes no
+// dimensions.
+//
 // Error bars. q/p and I are steady means with block-averaging errors
 // (steady.hpp). sin phi(I) carries the reference's error (the mu(I) fit's
 // covariance, or the two bracketing runs' errors) and that of I through the
@@ -26,11 +35,17 @@ namespace cda {
 // window of q_over_p, eta and the imposed I from scene.toml.
 struct SteadyPoint {
   std::string run;
+  int dim = 2;               // the run's dimension (scene.toml)
   double eta = 0;
   double I_imposed = 0;      // nan when scene.toml has no [shear] inertial_number
   double I = 0, I_err = 0;   // measured inertial_number
-  double mu = 0, mu_err = 0; // q_over_p
+  double mu = 0, mu_err = 0; // q_over_p (2D), shear_stress_ratio (3D)
 };
+// The friction column of a run of dimension dim, and the names of the
+// reference friction and of the cohesion formula, for messages and tables.
+const char* cohesion_mu_column(int dim);
+const char* cohesion_ref_name(int dim);      // "sin phi" (2D), "mu0" (3D)
+const char* cohesion_formula(int dim);       // "c/p = (q/p - sin phi)/cos phi", "c/p = mu - mu0(I)"
 // Throws AnalysisError naming the run when series.csv or scene.toml is
 // missing, [contact] cohesion_number is absent or negative, or the run has
 // no steady window.
@@ -57,12 +72,14 @@ class SinPhiReference {
   bool uses_fit() const { return use_fit_; }
   const FitResult& fit() const { return fit_; }
   const std::vector<SteadyPoint>& points() const { return points_; }
+  int dim() const { return dim_; }
 
  private:
   std::pair<double, double> raw(double I) const;  // value, error at I exactly
   std::vector<SteadyPoint> points_;               // sorted by I, distinct I
   bool use_fit_ = false;
   FitResult fit_;
+  int dim_ = 2;
 };
 
 struct CohesionPoint {
@@ -70,10 +87,12 @@ struct CohesionPoint {
   SinPhiReference::Value ref;
   double c_over_p = 0, c_over_p_err = 0;
 };
+// Throws AnalysisError when p and the reference differ in dimension.
 CohesionPoint cohesion_point(const SteadyPoint& p, const SinPhiReference& ref);
 
 // c/p against I per eta with the model curves: <dir>/cohesion.{png,svg,gp}
-// and cohesion_data.csv, cohesion_fit.csv.
+// and cohesion_data.csv (2D: q_over_p, sin_phi columns; 3D: mu, mu0),
+// cohesion_fit.csv.
 bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts, const FitResult& r);
 
 }  // namespace cda

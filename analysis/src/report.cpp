@@ -614,10 +614,11 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       sum.plots_ok = plot_cohesion(out_dir, cps, r) && sum.plots_ok;
       sum.fits.push_back("cohesion");
       html_fit += fmt::format("<h3>Cohesion c/p</h3><img src='cohesion.png' width=600><p>{}: k0 = {:.4g} ± {:.2g}, "
-                              "β = {:.4g} ± {:.2g}, α = {:.4g} ± {:.2g}, χ²/dof = {:.2f}; sin φ(I) from {} η = 0 "
+                              "β = {:.4g} ± {:.2g}, α = {:.4g} ± {:.2g}, χ²/dof = {:.2f}; {} from {} η = 0 "
                               "runs by {}</p>\n",
                               html_escape(cohesion().formula), r["k0"], r.err("k0"), r["beta"], r.err("beta"),
-                              r["alpha"], r.err("alpha"), r.chi2_dof, ref_pts.size(),
+                              r["alpha"], r.err("alpha"), r.chi2_dof,
+                              ref.dim() == 3 ? "c/p = μ − μ0(I), μ0(I)" : "sin φ(I)", ref_pts.size(),
                               ref.uses_fit() ? "the μ(I) fit" : "interpolation in ln I") +
                   made_by(report_cmd, fmt::format("cdanalysis fit cohesion {} --out DIR", campaign));
     } catch (const AnalysisError& e) {

@@ -46,6 +46,16 @@
 // Writes DIR/tensile.csv (one line a run), DIR/history.csv (sigma against
 // the ceiling's travel, first seed), DIR/machine.csv, DIR/plots.gp and, with
 // gnuplot, DIR/tensile.png.
+//
+// 3D (after the 2D study, or alone with --dim 3; issue 13 item 3): sphere
+// blocks with closed-form strengths (cd/bench/tensile3.hpp: a chain, f_a; a
+// simple-cubic block of k x k columns, k^2 f_a; an FCC block stacked along
+// [001], bonds at 45 degrees, (spheres a layer) 4 f_a / sqrt(2)) pulled
+// at the same V, delta_a, mu and eps_f over the same time steps, in units
+// d = 1, m = 1 (a sphere), f_a = 1, t_a = 1. Writes DIR/tensile3.csv,
+// DIR/plots3.gp and, with gnuplot, DIR/tensile3.png; fails if a block is
+// not within 2 eps_f f_a dt/(m V) + 1e-3 of its closed form while its
+// bonds open by less than 1.9 delta_a a step.
 #include <omp.h>
 
 #include <algorithm>
@@ -66,6 +76,7 @@
 
 #include "machine.hpp"
 #include "pile.hpp"
+#include "tensile3.hpp"
 
 namespace {
 
@@ -93,6 +104,7 @@ struct Options {
   std::vector<std::pair<double, double>> slow = {{0.1, 1e-4}, {1.0, 1e-4}, {2.5, 1e-4}, {1.0, 1e-5}};
   int max_iter = 20000;
   bool quick = false, plot = true;
+  std::string dim = "both";  // 2, 3 or both (2D first, its output unchanged)
 };
 
 // ---------------------------------------------------------------- samples
@@ -416,6 +428,94 @@ void write_gnuplot(const std::string& path, const Options& o) {
   g << "set xrange [0:6]\n" << plot << "\nunset multiplot\n";
 }
 
+// ---------------------------------------------------------------- 3D
+
+// The 3D blocks at every dt (tensile3.hpp); returns false if a closed form
+// fails below the cliff.
+bool study3(const Options& o) {
+  cdbench::Pull3Options p;
+  p.speed = o.speed;
+  p.debond = o.debond;
+  p.mu = o.mu;
+  p.tol = o.tol;
+  p.max_iter = o.max_iter;
+  const std::vector<cdbench::Block3> blocks =
+      o.quick ? std::vector<cdbench::Block3>{cdbench::chain3(8), cdbench::cubic3(3, 8), cdbench::fcc3(2, 8)}
+              : std::vector<cdbench::Block3>{cdbench::chain3(8), cdbench::cubic3(3, 8), cdbench::fcc3(2, 8),
+                                             cdbench::fcc3(3, 8)};
+  bool ok = true;
+  std::ofstream f(o.out + "/tensile3.csv");
+  f << "kind,spheres,dynamic,exact_over_fa,dt_over_ta,v_open_dt_over_debond,solver_error_over_v,eps_f,steps,"
+       "sigma_t_over_fa,relative_error,ceiling_max_over_fa,bonds0,sweeps_per_step,cap_hits,overlap_max_d,wall_s\n";
+  std::cout << fmt::format("\n3D: sphere blocks (d = 1, m = 1, f_a = 1, t_a = 1), V = {:g} d/t_a, delta_a = {:g} d, "
+                           "mu = {:g}, eps_f = {:g}\n",
+                           o.speed, o.debond, o.mu, o.tol);
+  std::cout << fmt::format("{:>7} {:>5} {:>8} {:>11} {:>6} {:>10} {:>10} {:>9} {:>8} {:>8} {:>8}\n", "kind",
+                           "N", "dt/t_a", "V_n dt/d_a", "steps", "sigma_t", "exact", "rel err", "sweeps",
+                           "wall s", "overlap");
+  for (const cdbench::Block3& b : blocks)
+    for (double dt : o.dt) {
+      const auto t0 = Clock::now();
+      cdbench::Pull3 r = cdbench::pull3(b, dt, p);
+      r.wall = std::chrono::duration<double>(Clock::now() - t0).count();
+      const double vn = o.speed * b.opening * dt / o.debond;  // the bonds' opening a step, in delta_a
+      const double err = std::abs(r.sigma_t / b.exact - 1);
+      const double allowed = 2 * cdbench::pull3_solver_error(o.tol, dt, o.speed) + 1e-3;
+      if (vn < 1.9 && err > allowed) {
+        ok = false;
+        std::cerr << fmt::format("tensile: SANITY FAILED: {} at dt = {:g} t_a: sigma_t = {:.6f} f_a, exact {:.6f}, "
+                                 "relative error {:.2g} > {:.2g}\n",
+                                 b.kind, dt, r.sigma_t, b.exact, err, allowed);
+      }
+      f << fmt::format("{},{},{},{:.6g},{:g},{:.6g},{:.4g},{:g},{},{:.8g},{:.4g},{:.6g},{},{:.4g},{},{:.4g},{:.4g}\n",
+                       b.kind, b.x.size(), b.dynamic(), b.exact, dt, vn,
+                       cdbench::pull3_solver_error(o.tol, dt, o.speed), o.tol, r.steps, r.sigma_t, err,
+                       r.ceiling_max, r.bonds0, r.sweeps, r.cap_hits, r.overlap_max, r.wall);
+      std::cout << fmt::format("{:>7} {:>5} {:>8.1e} {:>11.3f} {:>6} {:>10.5f} {:>10.5f} {:>9.2e} {:>8.1f} {:>8.2f} "
+                               "{:>8.1e}\n",
+                               b.kind, b.x.size(), dt, vn, r.steps, r.sigma_t, b.exact, err, r.sweeps, r.wall,
+                               r.overlap_max);
+    }
+  f.close();
+  std::ofstream g(o.out + "/plots3.gp");
+  g << "# gnuplot script written by tensile (3D); run from this folder: gnuplot plots3.gp\n"
+       "set datafile separator ','\n"
+       "set terminal pngcairo size 1400,600 font ',11'\n"
+       "set output 'tensile3.png'\n"
+       "set grid\nset logscale x\nset key bottom left\n"
+    << fmt::format("set multiplot layout 1,2 title 'Cohesive sphere blocks pulled apart: V = {:g} d/t_a, delta_a = "
+                   "{:g} d, mu = {:g}, eps_f = {:g}'\n",
+                   o.speed, o.debond, o.mu, o.tol)
+    << "set title 'Strength'\nset xlabel 'dt / t_a'\nset ylabel 'sigma_t / closed form'\nset yrange [0:1.1]\n"
+       "f = 'tensile3.csv'\n"
+       "plot f using 5:(strcol(1) eq 'chain3' ? column(10) / column(4) : NaN) with linespoints pt 5 title 'chain (f_a)', \\\n"
+       "     f using 5:(strcol(1) eq 'cubic3' ? column(10) / column(4) : NaN) with linespoints pt 7 title 'simple cubic, 3 x 3 columns (9 f_a)', \\\n"
+       "     f using 5:(strcol(1) eq 'fcc3' ? column(10) / column(4) : NaN) with points pt 9 ps 1.5 "
+       "title 'FCC [001], bonds at 45 deg (8 or 18 spheres a layer)'\n"
+       "set title 'Distance to the closed form (dashed: the solver bound 2 eps_f f_a dt / (m V))'\n"
+       "set logscale y\nset yrange [1e-7:0.1]\nset ylabel '|sigma_t / closed form - 1|'\nset key top left\n"
+       "nz(x) = x > 0 && x < 0.5 ? x : NaN\n"
+       "plot f using 5:(strcol(1) eq 'chain3' ? nz(column(11)) : NaN) with linespoints pt 5 title 'chain', \\\n"
+       "     f using 5:(strcol(1) eq 'cubic3' ? nz(column(11)) : NaN) with linespoints pt 7 title 'simple cubic', "
+       "\\\n"
+       "     f using 5:(strcol(1) eq 'fcc3' ? nz(column(11)) : NaN) with points pt 9 ps 1.5 title 'FCC', \\\n"
+       "     f using 5:(2 * column(7)) with lines dt 2 lc black title 'bound'\n"
+       "unset multiplot\n";
+  g.close();
+  if (o.plot) {
+    const std::string cmd = "cd '" + o.out + "' && gnuplot plots3.gp";
+    if (std::system(cmd.c_str()) != 0)
+      std::cerr << "tensile: gnuplot failed or is missing; plots3.gp is in " << o.out << "\n";
+  }
+  std::cout << "tensile: wrote " << o.out << "/{tensile3.csv,plots3.gp" << (o.plot ? ",tensile3.png" : "") << "}\n";
+  if (ok)
+    std::cout << "tensile: 3D closed-form checks (chain f_a, cubic k^2 f_a, FCC 4 f_a/sqrt(2) a sphere) hold "
+                 "while the bonds open by less than 2 delta_a a step\n";
+  else
+    std::cerr << "tensile: a 3D closed-form check failed\n";
+  return ok;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -436,6 +536,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--quick", o.quick, "about 20 s: N = 200, one seed, six time steps");
   app.add_flag("!--no-plot", o.plot, "write plots.gp but do not run gnuplot");
+  app.add_option("--dim", o.dim, "2, 3 or both (2D first; 3D: the sphere blocks of tensile3.hpp)")
+      ->check(CLI::IsMember({"2", "3", "both"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (o.quick) {
     o.n = 200;
@@ -446,6 +549,11 @@ int main(int argc, char** argv) {
   }
   omp_set_num_threads(1);  // a few hundred rows: below the solver's parallel threshold
   std::filesystem::create_directories(o.out);
+  if (o.dim == "3") {
+    const bool ok3 = study3(o);
+    cdbench::write_machine_csv(o.out + "/machine.csv", cdbench::machine(load_start));
+    return ok3 ? 0 : 1;
+  }
   std::cerr << fmt::format("tensile: t_a = {:.4g}, V = {:g} d/t_a, delta_a = {:g} d: V dt = "
                            "delta_a at dt = {:g} t_a\n",
                            kTa, o.speed, o.debond, o.debond / o.speed);
@@ -513,9 +621,10 @@ int main(int argc, char** argv) {
             << (o.plot ? ",tensile.png" : "") << "}\n";
   if (!ok) {
     std::cerr << "tensile: a closed-form check failed\n";
-    return 1;
+  } else {
+    std::cout << "tensile: closed-form checks (chain f_a, square lattice f_a / d) hold below "
+                 "V dt = 2 delta_a\n";
   }
-  std::cout << "tensile: closed-form checks (chain f_a, square lattice f_a / d) hold below "
-               "V dt = 2 delta_a\n";
-  return 0;
+  const bool ok3 = o.dim == "both" ? study3(o) : true;
+  return ok && ok3 ? 0 : 1;
 }

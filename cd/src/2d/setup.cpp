@@ -99,6 +99,12 @@ double shear_rate(const Scene& s) {
   return tp > 0 ? s.inertial_number / tp : 0.0;
 }
 
+double pull_off_force(const Scene& s) {
+  if (!(s.cohesion_number > 0)) return s.adhesion;
+  const double d = mean_diameter(s);
+  return s.cohesion_number * s.pressure * (s.dimension == 3 ? d * d : d);
+}
+
 double time_step(const Scene& s) { return s.dt_tp > 0 ? s.dt_tp * pressure_time(s) : s.dt; }
 
 double run_duration(const Scene& s) {
@@ -170,8 +176,12 @@ void check_derived(const Scene& s) {
                        tp, gd));
   }
   if (s.adhesion > 0 || s.cohesion_number > 0) {
-    const double fa = s.cohesion_number > 0 ? s.cohesion_number * s.pressure * mean_diameter(s) : s.adhesion;
-    if (!std::isfinite(fa)) fail(fmt::format("the pull-off force f_a = {} N must be finite", fa));
+    const double fa = pull_off_force(s);
+    if (!std::isfinite(fa))
+      fail(fmt::format("the pull-off force f_a = {} N must be finite ({})", fa,
+                       s.cohesion_number > 0 ? (s.dimension == 3 ? "contact.cohesion_number x shear.pressure x d^2"
+                                                                 : "contact.cohesion_number x shear.pressure x d")
+                                             : "contact.adhesion"));
   }
   const double T = run_duration(s);
   const char* T_from = s.strain > 0 ? "shear.strain / shear rate" : "time.duration";
@@ -215,7 +225,7 @@ WorldParams world_params(const Scene& s0) {
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
   p.overlap_projection = s.overlap_projection;
-  p.adhesion = s.cohesion_number > 0 ? s.cohesion_number * s.pressure * p.d_ref : s.adhesion;
+  p.adhesion = pull_off_force(s);  // eta p d, d = p.d_ref
   p.debond = s.debond * p.d_ref;
   if (s.shear_mode != "none") {
     CellParams& c = p.cell;

@@ -28,6 +28,13 @@ void check_derived(const Scene& s);
 // pressure time t_p = d sqrt(rho/p); 0 when the scene imposes no pressure.
 double shear_rate(const Scene& s);
 double pressure_time(const Scene& s);
+// The pull-off force f_a of the adhesion law: contact.adhesion, or from
+// contact.cohesion_number eta at the imposed shear.pressure p, with d =
+// mean_diameter (particles.d_mean for a shear.start sample, the number mean
+// of the size law or of particles.diameters otherwise; the d of t_p and I):
+// f_a = eta p d in 2D (p a force per length), eta p d^2 in 3D (p a force
+// per area).
+double pull_off_force(const Scene& s);
 // Time step and simulated time after the [shear] overrides (dt_tp, strain).
 double time_step(const Scene& s);
 double run_duration(const Scene& s);

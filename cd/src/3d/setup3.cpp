@@ -25,8 +25,14 @@ double cell_pitch3(const Scene& s) { return 1.02 * diameter_bounds(s).second; }
 void check_cell3(const Scene& s) {
   // The protocol's keys (2D's, docs/3d.md "Tri-periodic protocol"): what
   // each needs, by name.
-  if (s.cohesion_number != 0)
-    fail3("contact.cohesion_number: cohesion at imposed pressure is 2D only; use contact.adhesion");
+  // The cohesion number (2D's rules): f_a = eta p d^2 (pull_off_force),
+  // so it needs the imposed pressure, and excludes a given f_a.
+  if (s.cohesion_number > 0) {
+    if (s.pressure <= 0)
+      fail3("contact.cohesion_number > 0 needs shear.pressure > 0 (f_a = eta p d^2, p in N/m^2); without an "
+            "imposed pressure give the pull-off force itself, contact.adhesion (N)");
+    if (s.adhesion > 0) fail3("give contact.adhesion or contact.cohesion_number, not both");
+  }
   if (s.pressure <= 0) {
     const std::pair<const char*, bool> need_p[] = {
         {"shear.inertial_number", s.inertial_number != 0}, {"shear.isotropic", s.isotropic},
@@ -184,7 +190,7 @@ WorldParams3 world_params3(const Scene& s0) {
   p.d_ref = mean_diameter(s);
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
-  p.adhesion = s.adhesion;
+  p.adhesion = pull_off_force(s);  // contact.adhesion, or eta p d^2 with d = p.d_ref
   p.debond = s.debond * p.d_ref;
   p.e_n = s.e_n;  // restitution by mean velocities (method.md section 14)
   p.e_t = s.e_t;
