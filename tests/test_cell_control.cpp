@@ -1,0 +1,230 @@
+// The pressure control of a periodic cell at high inertial number (issue
+// 13 item 2; docs/shear.md, "The pressure control at high I"): simple shear
+// at imposed normal stress p from a sample compacted in the test, 2D at
+// I = 0.6 and 3D at I = 1, with a light cell (shear.cell_mass = 0.01): the
+// time mean of sigma_yy + K_yy is p, the height stays bounded, and the run
+// does not depend on the thread count.
+#include <gtest/gtest.h>
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "checkpoint.hpp"
+#include "checkpoint3.hpp"
+#include "cli_util.hpp"
+#include "config.hpp"
+#include "setup.hpp"
+#include "setup3.hpp"
+#include "world3.hpp"
+#include "world3_hash.hpp"
+#include "world_util.hpp"
+
+namespace {
+
+// ---- steady shear at high I ---------------------------------------------
+
+// Mean and standard error of the means of nb consecutive blocks.
+std::pair<double, double> block_mean(const std::vector<double>& x, int nb) {
+  const std::size_t len = x.size() / nb;
+  std::vector<double> m(nb, 0.0);
+  for (int b = 0; b < nb; ++b) {
+    for (std::size_t k = 0; k < len; ++k) m[b] += x[b * len + k];
+    m[b] /= len;
+  }
+  double mean = 0, var = 0;
+  for (double v : m) mean += v / nb;
+  for (double v : m) var += (v - mean) * (v - mean) / (nb - 1);
+  return {mean, std::sqrt(var / nb)};
+}
+
+// configs/shear-prep.toml's units: d = 1 mm, rho = 2.6 kg/m^2, p = 100 N/m.
+constexpr double kP = 100.0;
+
+std::string keys2() {
+  return "[gravity]\ng = [0.0, 0.0]\n[contact]\nmu = 0.4\nalert = 0.1\n"
+         "[solver]\ntol = 1e-3\nmax_iter = 2000\n";
+}
+
+// 100 disks (size ratio 2) compacted isotropically at p from a loose
+// lattice in a square cell, as in test_shear.
+std::string prep2(int n, double side) {
+  const std::string L = std::to_string(side);
+  return "name = \"prep\"\n[time]\nduration = 1.0\n" + keys2() + "[particles]\nn = " + std::to_string(n) +
+         "\nd_mean = 1e-3\nsize_ratio = 2.0\ndensity = 2.6\n[shear]\nmode = \"periodic\"\nwidth = " + L +
+         "\nheight = " + L + "\npressure = 100.0\nisotropic = true\ndt_tp = 0.05\n";
+}
+
+// Shear at I from `start`, the campaigns' time step dt = 0.005/I t_p,
+// cell_mass as given.
+std::string shear2(const std::string& start, double I, double strain, double cell_mass) {
+  return "name = \"shear\"\n" + keys2() + "[particles]\nn = 0\nd_mean = 1e-3\ndensity = 2.6\n"
+         "[shear]\nmode = \"periodic\"\nwidth = 0.02\nheight = 0.02\npressure = 100.0\n"
+         "inertial_number = " + std::to_string(I) + "\nstrain = " + std::to_string(strain) +
+         "\ndt_tp = " + std::to_string(0.005 / I) + "\ncell_mass = " + std::to_string(cell_mass) +
+         "\nstart = \"" + start + "\"\n";
+}
+
+}  // namespace
+
+// Simple shear at I = 0.6 of 100 disks from a sample compacted in the test,
+// with a light cell (shear.cell_mass = 0.01; with the default 0.1 the
+// height overshoots for several units of strain: docs/shear.md, "The
+// pressure control at high I"). The start-up (a jammed sample sheared at
+// once at I = 0.6) dilates the sample by up to ~50 % (measured: L_y at most
+// 1.50 L_y0; a runaway doubles it within 3 units of strain); from strain 3
+// on, the time mean of sigma_yy + K_yy is p within 3 standard errors of 9
+// unit-strain blocks plus 5 % (measured 1.03 +- 0.08 p). The 5 %: the height
+// and the sample's dilation are a slow mode, period ~ I L_y/d ~ 6 units of
+// strain here, so unit-strain blocks are not independent and their error
+// bar is too small (as in test_shear3). Once steady, L_y stays within a
+// band of 0.3 L_y0 (measured 1.17-1.38 L_y0), and never falls below 0.9
+// L_y0 (no collapse). The same run is bit-identical on 1 and 2 threads
+// (every loop parallel) over its first 300 steps, the dilating start.
+TEST(CellControl, ShearAtInertialNumber06HoldsThePressure2D) {
+  const auto dir = cdtest::scratch_dir("test_cell_control", "shear2");
+  const std::string ckpt = (dir / "prep.bin").string();
+  {
+    cd::World w = cd::build_world(cd::parse_scene(prep2(100, 0.0167), "prep.toml"));
+    for (int k = 0; k < 500; ++k) w.step();
+    cd::save_checkpoint(ckpt, w, 1);
+  }
+  const double I = 0.6, strain = 12.0, steady = 3.0;
+  const cd::Scene s = cd::parse_scene(shear2(ckpt, I, strain, 0.01), "shear.toml");
+  const auto threads = [&](int t) {
+    omp_set_num_threads(t);
+    cd::World w = cd::build_world(s);
+    cd::WorldParams p = w.params();
+    p.solver.min_parallel = 0;
+    w.set_params(p);
+    for (int k = 0; k < 300; ++k) w.step();
+    omp_set_num_threads(1);
+    return cdtest::state_hash(w);
+  };
+  const std::uint64_t h1 = threads(1), h2 = threads(2);
+  EXPECT_EQ(h1, h2);
+  omp_set_num_threads(1);
+
+  cd::World w = cd::build_world(s);
+  const double H0 = w.cell.height;
+  const long n = std::llround(cd::run_duration(s) / w.params().dt);
+  std::vector<double> load;
+  double hmax = H0, smin = INFINITY, smax = 0.0;  // over the run; over the steady part
+  for (long k = 0; k < n; ++k) {
+    w.step();
+    ASSERT_TRUE(cdtest::all_finite(w)) << "step " << k;
+    hmax = std::max(hmax, w.cell.height);
+    ASSERT_GT(w.cell.height, 0.9 * H0) << "step " << k;  // no collapse
+    if (w.cell.strain < steady) continue;
+    smin = std::min(smin, w.cell.height);
+    smax = std::max(smax, w.cell.height);
+    load.push_back((w.contact_stress()(1, 1) + w.kinetic_stress()(1, 1)) / kP);
+  }
+  const auto [m, se] = block_mean(load, 9);
+  std::printf("[ I = 0.6 ] (sigma_yy + K_yy)/p = %.3f +- %.3f over strain %.0f-%.0f; L_y / L_y0: at most %.3f, "
+              "in [%.3f, %.3f] over the steady part\n", m, se, steady, strain, hmax / H0, smin / H0, smax / H0);
+  EXPECT_NEAR(m, 1.0, 3 * se + 0.05);
+  EXPECT_LT(hmax, 1.75 * H0);           // no runaway
+  EXPECT_LT(smax - smin, 0.3 * H0);    // bounded fluctuations once steady
+}
+
+namespace {
+
+// A compacted 3D sample as in test_shear3 (150 spheres, size ratio 1.5,
+// brake 0.1/t_p, 300 steps), its checkpoint for shear.start.
+std::string prepared3(int n, int steps) {
+  cd::Scene s;
+  s.dimension = 3;
+  s.gravity = {0, 0, 0};
+  s.shear_mode = "periodic";
+  s.n = n;
+  s.d_mean = 1e-3;
+  s.size_ratio = 1.5;
+  s.density = 2600;
+  s.mu = 0.4;
+  s.alert = 0.1;
+  s.tol = 1e-3;
+  s.max_iter = 1000;
+  s.pressure = 1e5;
+  s.isotropic = true;
+  s.dt_tp = 0.05;
+  s.compaction_rate = 0.1;
+  s.duration = 1.0;
+  s.series_interval = 1.0;
+  cd::World3 w = cd::build_world3(s);
+  for (int k = 0; k < steps; ++k) w.step();
+  const auto dir = cdtest::scratch_dir("test_cell_control", "prep3");
+  const std::string path = (dir / "checkpoint.bin").string();
+  cd::save_checkpoint3(path, w, 1);
+  return path;
+}
+
+}  // namespace
+
+// The same in the tri-periodic cell at I = 1: 150 spheres compacted in the
+// test, cell_mass 0.01, dt = 0.005 t_p, strain 6, the steady part from
+// strain 2 in 8 blocks (tolerances as above; measured (sigma_yy + K_yy)/p
+// = 1.02 +- 0.05, L_y at most 1.32 L_y0 and within 1.23-1.32 L_y0 once
+// steady), and 1 and 2 threads bit-identical over the first 200 steps.
+TEST(CellControl, ShearAtInertialNumber1HoldsThePressure3D) {
+  const std::string start = prepared3(150, 300);
+  cd::Scene s;
+  s.dimension = 3;
+  s.gravity = {0, 0, 0};
+  s.shear_mode = "periodic";
+  s.n = 0;
+  s.d_mean = 1e-3;
+  s.density = 2600;
+  s.mu = 0.4;
+  s.alert = 0.1;
+  s.tol = 1e-3;
+  s.max_iter = 1000;
+  s.pressure = 1e5;
+  s.inertial_number = 1.0;
+  s.dt_tp = 0.005;
+  s.cell_mass = 0.01;
+  s.start = start;
+  s.strain = 6.0;
+  s.series_interval = 1.0;
+  const auto threads = [&](int t) {
+    omp_set_num_threads(t);
+    cd::World3 w = cd::build_world3(s);
+    cd::WorldParams3 p = w.params();
+    p.solver.min_parallel = 1;
+    w.set_params(p);
+    for (int k = 0; k < 200; ++k) w.step();
+    omp_set_num_threads(1);
+    return cdtest::world3_hash(w);
+  };
+  const std::uint64_t h1 = threads(1), h2 = threads(2);
+  EXPECT_EQ(h1, h2);
+  omp_set_num_threads(1);
+
+  cd::World3 w = cd::build_world3(s);
+  const double L0 = w.params().cell.y(), gd = w.shear_rate();
+  const long n = std::lround(s.strain / gd / w.params().dt);
+  const double steady = 2.0;
+  std::vector<double> load;
+  double lmax = L0, smin = INFINITY, smax = 0.0;
+  for (long k = 0; k < n; ++k) {
+    w.step();
+    const double L = w.params().cell.y();
+    ASSERT_TRUE(std::isfinite(L)) << "step " << k;
+    ASSERT_GT(L, 0.9 * L0) << "step " << k;  // no collapse
+    lmax = std::max(lmax, L);
+    if (w.params().strain < steady) continue;
+    smin = std::min(smin, L);
+    smax = std::max(smax, L);
+    load.push_back((w.contact_stress()(1, 1) + w.kinetic_stress()(1, 1)) / s.pressure);
+  }
+  const auto [m, se] = block_mean(load, 8);
+  std::printf("[ I = 1, 3D ] (sigma_yy + K_yy)/p = %.3f +- %.3f over strain %.0f-%.0f; L_y / L_y0: at most %.3f, "
+              "in [%.3f, %.3f] over the steady part\n", m, se, steady, s.strain, lmax / L0, smin / L0, smax / L0);
+  EXPECT_NEAR(m, 1.0, 3 * se + 0.05);
+  EXPECT_LT(lmax, 1.75 * L0);          // no runaway
+  EXPECT_LT(smax - smin, 0.3 * L0);   // bounded fluctuations once steady
+}
