@@ -1,5 +1,8 @@
 // The pressure control of a periodic cell at high inertial number (issue
-// 13 item 2; docs/shear.md, "The pressure control at high I"): simple shear
+// 13 item 2; docs/shear.md, "The pressure control at high I"). A length at
+// imposed stress is loaded by (p - K_aa) times its face, K the kinetic
+// stress, which must not count the grains' own dilation flow (closed-form
+// tests, no contacts). Then simple shear
 // at imposed normal stress p from a sample compacted in the test, 2D at
 // I = 0.6 and 3D at I = 1, with a light cell (shear.cell_mass = 0.01): the
 // time mean of sigma_yy + K_yy is p, the height stays bounded, and the run
@@ -25,6 +28,80 @@
 #include "world_util.hpp"
 
 namespace {
+
+// Grains far apart (no contacts), dilating with the cell: v_y = eps y, the
+// height growing at eps H. Nothing but the imposed stress acts on the
+// height, so it is a mass M under the constant force p W (2D) or p A (3D):
+// dH/dt = eps H0 - (p W / M) t, H = H0 + eps H0 t - (p W / M) t^2 / 2 (the
+// midpoint rule is exact for a constant force), until a grain crosses a
+// face (none does here). The grains keep their velocities; their flow stays
+// linear in y (v_y = eps y0 at y = y0 (1 + eps t)), so its kinetic stress is
+// 0 to round-off. Counting the flow as kinetic stress (the control before
+// the fix) took K_yy = sum m (eps y - <eps y>)^2 / V off the load: the height
+// decelerated by that much less (here 3e-5 of eps H0 over the run, against a
+// round-off tolerance of 1e-12).
+TEST(CellControl, DilationWithTheGrainsIsNotKineticStress2D) {
+  const double W = 6.0, H = 5.0, eps = 0.2, P = 1.0, M = 6.0, dt = 1e-3, r = 0.2;
+  cd::WorldParams p = cdtest::params(dt, 0.0, 0.0);
+  p.alert = 0.0;
+  p.cell.mode = cd::CellParams::Mode::LeesEdwards;
+  p.cell.width = W;
+  p.cell.pressure = P;
+  p.cell.mass = M;
+  cd::World w(p);
+  w.cell.width = W;
+  w.cell.height = H;
+  w.cell.hdot = eps * H;
+  for (const auto& [x, y] : {std::pair{1.0, 1.0}, {3.0, 2.0}, {5.0, 3.0}, {2.0, 0.5}})
+    w.bodies.add_disk({x, y}, r, 1.0, {0.0, eps * y});
+  const double a = P * W / M;
+  const int n = 100;
+  for (int k = 0; k < n; ++k) {
+    w.step();
+    ASSERT_EQ(w.rows().size(), 0u) << k;
+  }
+  const double t = n * dt;
+  const Eigen::Matrix2d K = w.kinetic_stress();
+  std::printf("dH/dt %.12g (closed form %.12g); H %.12g (%.12g); K_yy %.3g\n", w.cell.hdot,
+              eps * H - a * t, w.cell.height, H + eps * H * t - 0.5 * a * t * t, K(1, 1));
+  EXPECT_NEAR(w.cell.hdot, eps * H - a * t, 1e-12 * eps * H);
+  EXPECT_NEAR(w.cell.height, H + eps * H * t - 0.5 * a * t * t, 1e-12 * H);
+  EXPECT_LT(std::abs(K(1, 1)), 1e-12 * P);
+  EXPECT_EQ(w.cell.width, W);
+}
+
+// The same in the tri-periodic cell: L_y a dof loaded by p L_x L_z, spheres
+// far apart dilating with it (v_y = eps (y - origin_y)).
+TEST(CellControl, DilationWithTheGrainsIsNotKineticStress3D) {
+  cd::WorldParams3 p;
+  p.dt = 1e-5;
+  p.cell = cd::Vec3(0.02, 0.05, 0.03);
+  p.cell_origin = cd::Vec3(0.001, -0.002, 0.0);
+  p.periodic = {true, true, true};
+  p.pressure = 2e3;
+  p.cell_mass = 0.5;
+  p.cell_dof = {false, true, false};
+  const double eps = 20.0;  // 1/s
+  p.cell_rate = cd::Vec3(0.0, eps * p.cell.y(), 0.0);
+  cd::World3 w(p);
+  for (const auto& c : {cd::Vec3(0.005, 0.004, 0.01), cd::Vec3(0.015, 0.016, 0.02), cd::Vec3(0.010, 0.030, 0.005)})
+    w.bodies.add_sphere(c, 0.002, 1000, cd::Vec3(0.0, eps * (c.y() - p.cell_origin.y()), 0.0));
+  const double A = p.cell.x() * p.cell.z(), a = p.pressure * A / p.cell_mass;
+  const double L = p.cell.y(), v0 = eps * L;
+  const int n = 200;
+  for (int k = 0; k < n; ++k) {
+    w.step();
+    ASSERT_EQ(w.rows().size(), 0u) << k;
+  }
+  const double t = n * p.dt;
+  const Eigen::Matrix3d K = w.kinetic_stress();
+  std::printf("dL_y/dt %.12g (closed form %.12g); L_y %.12g (%.12g); K_yy %.3g\n", w.params().cell_rate.y(),
+              v0 - a * t, w.params().cell.y(), L + v0 * t - 0.5 * a * t * t, K(1, 1));
+  EXPECT_NEAR(w.params().cell_rate.y(), v0 - a * t, 1e-12 * v0);
+  EXPECT_NEAR(w.params().cell.y(), L + v0 * t - 0.5 * a * t * t, 1e-12 * L);
+  EXPECT_LT(std::abs(K(1, 1)), 1e-12 * p.pressure);
+  EXPECT_EQ(w.params().cell.x(), p.cell.x());
+}
 
 // ---- steady shear at high I ---------------------------------------------
 

@@ -87,7 +87,9 @@ const std::vector<Case>& cases() {
       {"compaction", "shear-prep.toml", {"particles.n=120", "shear.width=0.0165",
                                          "shear.height=0.0185", "solver.tol=1e-3",
                                          "shear.compaction_rate=0", "contact.overlap_projection=0"},
-       120, 0x97cc3d83742e16b8ull},
+       // Changed with the kinetic stress about the grains' own profile along a
+       // controlled length (the control's load, issue 13 item 2).
+       120, 0x7803c4d049119bf6ull},
       {"prep_controlled", "shear-prep.toml", {"particles.n=120", "shear.width=0.0165",
                                               "shear.height=0.0185", "solver.tol=1e-3"},
        700, 0xfa84acc4596fbaafull},
@@ -95,7 +97,9 @@ const std::vector<Case>& cases() {
        {"particles.n=120", "shear.width=0.0165", "shear.height=0.0185", "shear.isotropic=false",
         "shear.inertial_number=0.1", "solver.tol=1e-3",
         // a shear run: without the preparation's compaction bound and projection
-        "shear.compaction_rate=0", "contact.overlap_projection=0"}, 120, 0xa8911de31c1bebdbull},
+        "shear.compaction_rate=0", "contact.overlap_projection=0"},
+       // changed with the kinetic stress about the grains' own profile (as above)
+       120, 0x5f18b3d49377be18ull},
       // The walls scenes changed with the mu_wall fix (a driven body is now
       // body 1 of its contacts: the glued grains' contacts are reversed,
       // the same physics in other round-off). Before it: 0xfaf171a2af56d23f

@@ -351,11 +351,31 @@ Eigen::Matrix2d World::kinetic_stress() const {
       std::visit([](const auto& b) { return std::decay_t<decltype(b)>::cell; }, boundary_);
   if (!has_cell || V <= 0.0) return k;
   const double gd = shear_rate();
+  // A length at imposed stress: the velocities along it are taken about
+  // the grains' own linear profile along it (core/cell_dof.hpp, Profile).
+  const bool le = std::holds_alternative<LeesEdwardsCell>(boundary_) &&
+                  prm_.cell.pressure > 0.0 && prm_.cell.mass > 0.0;
+  const bool fx = le && prm_.cell.isotropic;
+  double bx = 0.0, by = 0.0;
+  if (le) {
+    cell_dof::Profile px, py;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (!bodies.is_dynamic(i)) continue;
+      py.add(bodies.mass[i], bodies.pos[i].y(), bodies.vel[i].vy);
+      if (fx) px.add(bodies.mass[i], bodies.pos[i].x(), bodies.vel[i].vx - gd * bodies.pos[i].y());
+    }
+    by = py.slope();
+    bx = px.slope();
+  }
   double m = 0.0;
   Vec2 mv = Vec2::Zero();
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (!bodies.is_dynamic(i)) continue;
-    const Vec2 u(bodies.vel[i].vx - gd * bodies.pos[i].y(), bodies.vel[i].vy);
+    Vec2 u(bodies.vel[i].vx - gd * bodies.pos[i].y(), bodies.vel[i].vy);
+    if (le) {
+      u.y() -= by * bodies.pos[i].y();
+      if (fx) u.x() -= bx * bodies.pos[i].x();
+    }
     m += bodies.mass[i];
     mv += bodies.mass[i] * u;
     k += bodies.mass[i] * u * u.transpose();

@@ -463,12 +463,31 @@ Eigen::Matrix3d World3::kinetic_stress() const {
   const double V = cell_volume();
   if (V <= 0.0) return k;
   const double gd = shear_rate();
+  // A length at imposed stress: the velocities along it are taken about
+  // the spheres' own linear profile along it (core/cell_dof.hpp, Profile).
+  Vec3 b = Vec3::Zero();
+  if (dofs_on_) {
+    std::array<cell_dof::Profile, 3> pr;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (!bodies.is_dynamic(i)) continue;
+      for (int a = 0; a < 3; ++a) {
+        if (!prm_.cell_dof[a]) continue;
+        double v = bodies.vel[i].v[a];
+        if (a == 0) v -= gd * (bodies.pos[i].y() - prm_.cell_origin.y());
+        pr[a].add(bodies.mass[i], bodies.pos[i][a] - prm_.cell_origin[a], v);
+      }
+    }
+    for (int a = 0; a < 3; ++a) b[a] = prm_.cell_dof[a] ? pr[a].slope() : 0.0;
+  }
   double m = 0.0;
   Vec3 mv = Vec3::Zero();
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (!bodies.is_dynamic(i)) continue;
     Vec3 u = bodies.vel[i].v;
     u.x() -= gd * (bodies.pos[i].y() - prm_.cell_origin.y());
+    if (dofs_on_)
+      for (int a = 0; a < 3; ++a)
+        if (prm_.cell_dof[a]) u[a] -= b[a] * (bodies.pos[i][a] - prm_.cell_origin[a]);
     m += bodies.mass[i];
     mv += bodies.mass[i] * u;
     k += bodies.mass[i] * u * u.transpose();

@@ -47,4 +47,24 @@ inline double damped_step(double v0, double v, double inv_mass, double s, double
   return res / (1.0 + inv_mass * k);
 }
 
+// The velocity profile a controlled length's kinetic stress is taken about:
+// the mass-weighted least-squares line v_a = c + b x_a of the velocity
+// component along the length against the coordinate along it. add() each
+// grain, then slope() = b (0 with fewer than two distinct coordinates).
+struct Profile {
+  double m = 0.0, mx = 0.0, mxx = 0.0, mv = 0.0, mxv = 0.0;
+  void add(double mi, double x, double v) {
+    m += mi;
+    mx += mi * x;
+    mxx += mi * x * x;
+    mv += mi * v;
+    mxv += mi * x * v;
+  }
+  double slope() const {
+    if (!(m > 0.0)) return 0.0;
+    const double var = mxx - mx * mx / m;
+    return var > 0.0 ? (mxv - mx * mv / m) / var : 0.0;
+  }
+};
+
 }  // namespace cd::cell_dof
