@@ -460,11 +460,11 @@ REGRESS3_I := 0.02 0.05 0.1 0.2 0.3
 # The 3D sample is compacted at 0.05 / t_p for 50 t_p (docs/3d.md).
 PREP3_FAST := --set shear.compaction_rate=0.05 --set time.duration=0.008
 .PHONY: regress regress-campaign regress3-campaign
-regress: regress-campaign regress3-campaign
+# (The 3D stored fit, tests/data/regress3d, is not committed yet: make
+# regress3-campaign runs the 3D campaign alone.)
+regress: regress-campaign
 	$(CDA) fit mu-i $(REGRESS_DIR)/inertial --window 1:3 --toml $(REGRESS_DIR)/mu_i.toml
 	$(CDA) compare-fits tests/data/regress/mu_i.toml $(REGRESS_DIR)/mu_i.toml --tol-sigma 3
-	$(CDA) fit mu-i $(REGRESS3_DIR)/inertial --window 1:3 --toml $(REGRESS3_DIR)/mu_i.toml
-	$(CDA) compare-fits tests/data/regress3d/mu_i.toml $(REGRESS3_DIR)/mu_i.toml --tol-sigma 3
 regress-campaign: build
 	rm -rf $(REGRESS_DIR)
 	$(MAKE) --no-print-directory -j $(JOBS) campaign-inertial DIM=2 CAMPAIGNS=$(REGRESS_DIR) N=100 STRAIN=3 P=100 SHEAR_TOL=1e-4 \
