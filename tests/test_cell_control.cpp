@@ -25,6 +25,7 @@
 #include "setup3.hpp"
 #include "world3.hpp"
 #include "world3_hash.hpp"
+#include "shear3_util.hpp"
 #include "world_util.hpp"
 
 namespace {
@@ -214,24 +215,7 @@ namespace {
 // A compacted 3D sample as in test_shear3 (150 spheres, size ratio 1.5,
 // brake 0.1/t_p, 300 steps), its checkpoint for shear.start.
 std::string prepared3(int n, int steps) {
-  cd::Scene s;
-  s.dimension = 3;
-  s.gravity = {0, 0, 0};
-  s.shear_mode = "periodic";
-  s.n = n;
-  s.d_mean = 1e-3;
-  s.size_ratio = 1.5;
-  s.density = 2600;
-  s.mu = 0.4;
-  s.alert = 0.1;
-  s.tol = 1e-3;
-  s.max_iter = 1000;
-  s.pressure = 1e5;
-  s.isotropic = true;
-  s.dt_tp = 0.05;
-  s.compaction_rate = 0.1;
-  s.duration = 1.0;
-  s.series_interval = 1.0;
+  cd::Scene s = cdtest::shear3_prep_scene(n);
   cd::World3 w = cd::build_world3(s);
   for (int k = 0; k < steps; ++k) w.step();
   const auto dir = cdtest::scratch_dir("test_cell_control", "prep3");

@@ -24,33 +24,14 @@
 
 #include <omp.h>
 
+#include "shear3_util.hpp"
+
 using namespace cd;
 
 namespace {
 
-// A small frictional sample at p = 1e5 Pa (configs/shear3-prep.toml's
-// units: d = 1 mm, rho = 2600 kg/m^3, t_p = d sqrt(rho/p) = 1.61e-4 s).
-Scene prep_scene(int n) {
-  Scene s;
-  s.dimension = 3;
-  s.gravity = {0, 0, 0};
-  s.shear_mode = "periodic";
-  s.n = n;
-  s.d_mean = 1e-3;
-  s.size_ratio = 1.5;
-  s.density = 2600;
-  s.mu = 0.4;
-  s.alert = 0.1;
-  s.tol = 1e-3;
-  s.max_iter = 1000;
-  s.pressure = 1e5;
-  s.isotropic = true;
-  s.dt_tp = 0.05;
-  s.compaction_rate = 0.1;
-  s.duration = 1.0;
-  s.series_interval = 1.0;
-  return s;
-}
+// The tri-periodic tests' small sample (shear3_util.hpp).
+Scene prep_scene(int n) { return cdtest::shear3_prep_scene(n); }
 
 double tp(const Scene& s) { return s.d_mean * std::sqrt(s.density / s.pressure); }
 

@@ -1,0 +1,33 @@
+// The small frictional 3D sample the tri-periodic tests compact and shear
+// (test_shear3, test_cohesion3, test_cell_control): configs/shear3-prep.toml's
+// units, d = 1 mm, rho = 2600 kg/m^3, p = 1e5 Pa, t_p = d sqrt(rho/p) =
+// 1.61e-4 s; size ratio 1.5, mu 0.4, tol 1e-3, brake 0.1/t_p.
+#pragma once
+
+#include "scene.hpp"
+
+namespace cdtest {
+
+inline cd::Scene shear3_prep_scene(int n) {
+  cd::Scene s;
+  s.dimension = 3;
+  s.gravity = {0, 0, 0};
+  s.shear_mode = "periodic";
+  s.n = n;
+  s.d_mean = 1e-3;
+  s.size_ratio = 1.5;
+  s.density = 2600;
+  s.mu = 0.4;
+  s.alert = 0.1;
+  s.tol = 1e-3;
+  s.max_iter = 1000;
+  s.pressure = 1e5;
+  s.isotropic = true;
+  s.dt_tp = 0.05;
+  s.compaction_rate = 0.1;
+  s.duration = 1.0;
+  s.series_interval = 1.0;
+  return s;
+}
+
+}  // namespace cdtest
