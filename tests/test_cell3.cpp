@@ -103,6 +103,7 @@ TEST(Cell3Observables, SimpleCubicImpactStressThroughXImage) {
   EXPECT_NEAR(c.at("q_over_p"), 3.0, 1e-12);
   EXPECT_EQ(c.at("shear_stress_ratio"), 0.0);  // sigma_yy = 0
   EXPECT_EQ(c.at("shear_rate"), 0.0);
+  EXPECT_EQ(c.at("strain"), 0.0);  // no shear: gamma stays 0
   EXPECT_NEAR(c.at("packing_fraction"), std::numbers::pi / 6, 1e-14);
   EXPECT_EQ(c.at("z"), 0.0);
   EXPECT_EQ(c.at("non_rattler"), 0.0);
@@ -111,7 +112,7 @@ TEST(Cell3Observables, SimpleCubicImpactStressThroughXImage) {
   EXPECT_DOUBLE_EQ(c.at("cell_depth"), 3 * d);
   // At rest after the impacts: no kinetic stress.
   for (const char* k : {"kxx", "kxy", "kxz", "kyy", "kyz", "kzz"}) EXPECT_NEAR(c.at(k), 0.0, 1e-20) << k;
-  EXPECT_EQ(c.size(), 1 + 9 + 8 + 3 + 6u);
+  EXPECT_EQ(c.size(), 2 + 9 + 8 + 3 + 6u);
 }
 
 // Two spheres in contact through the Lees-Edwards image: A near the top of
@@ -357,7 +358,7 @@ TEST(Cell3Scene, RunWritesTheCellColumns) {
   ASSERT_EQ(names.size(), vals.size());
   std::map<std::string, double> row;
   for (std::size_t i = 0; i < names.size(); ++i) row[names[i]] = std::stod(vals[i]);
-  for (const char* k : {"sxx", "sxy", "sxz", "syx", "syy", "syz", "szx", "szy", "szz", "p", "q", "q_over_p",
+  for (const char* k : {"strain", "shear_rate", "sxx", "sxy", "sxz", "syx", "syy", "syz", "szx", "szy", "szz", "p", "q", "q_over_p",
                         "shear_stress_ratio", "inertial_number", "packing_fraction", "z", "non_rattler",
                         "cell_width", "cell_height", "cell_depth", "kxx", "kxy", "kxz", "kyy", "kyz", "kzz"})
     EXPECT_TRUE(row.count(k)) << k;

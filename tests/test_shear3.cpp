@@ -417,6 +417,30 @@ TEST(Shear3Cell, CheckpointByStrain) {
   opt.fresh = true;
   run3(w, s, opt);
   EXPECT_NEAR(w.params().strain, 0.5, 1e-9);
+  // series.csv's strain column (as in 2D) is gamma-dot t at every row: the
+  // rate is imposed, so row k (every 5 steps) is at 5 k dt gd; the last 0.5.
+  {
+    std::ifstream f(dir / "series.csv");
+    std::string line;
+    std::getline(f, line);
+    int col = -1, k = 0;
+    std::istringstream h(line);
+    for (std::string name; std::getline(h, name, ','); ++k)
+      if (name == "strain") col = k;
+    ASSERT_GE(col, 0) << "series.csv has no strain column";
+    int rows = 0;
+    double strain = -1;
+    while (std::getline(f, line)) {
+      std::istringstream r(line);
+      std::string v;
+      for (int j = 0; j <= col; ++j) std::getline(r, v, ',');
+      strain = std::stod(v);
+      ++rows;
+      EXPECT_NEAR(strain, 5 * rows * dt * gd, 1e-9) << "row " << rows;
+    }
+    EXPECT_EQ(rows, 20);
+    EXPECT_NEAR(strain, 0.5, 1e-9);
+  }
   World3 c = build_world3(s);
   load_checkpoint3((dir / "checkpoint.bin").string(), c);
   EXPECT_EQ(c.params().strain, w.params().strain);
