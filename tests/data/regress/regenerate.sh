@@ -2,7 +2,7 @@
 # Regenerates a reference campaign of `make regress` and of
 # test_analysis_regress (SimulatorCampaign*): the same runs as `make regress`
 # (2D: 100 disks, p = 100 N/m, I = 0.01 ... 0.4, into tests/data/regress;
-# 3D: 200 spheres, p = 1e5 N/m^2, I = 0.02 ... 0.3, into tests/data/regress3d;
+# 3D: 200 spheres, p = 1e5 N/m^2, I = 0.02 ... 1, into tests/data/regress3d;
 # strain 3 both), their series cut to the columns the mu(I) fit reads, and the
 # stored fit. Run on purpose only, when a change of the physics or numerics is
 # meant to move the curve, from the repository root:
