@@ -383,6 +383,13 @@ TEST(Stress3, SnapshotMatchesTheSeriesOfARealRun) {
   for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it)
     times[std::stoi((*it)[2].str())] = std::stod((*it)[1].str());
   ASSERT_GT(times.size(), 10u);
+  // snapshot_times reads the same collection (cdsim's own).
+  const auto st = snapshot_times(dir.string(), "contacts");
+  ASSERT_EQ(st.size(), times.size());
+  for (const auto& [k, t] : times) {
+    ASSERT_TRUE(st.at(static_cast<std::size_t>(k))) << k;
+    EXPECT_EQ(*st[static_cast<std::size_t>(k)], t) << k;
+  }
   const auto& time = series.column("time");
   const char* names[3][3] = {{"sxx", "sxy", "sxz"}, {"syx", "syy", "syz"}, {"szx", "szy", "szz"}};
   std::size_t compared = 0, snaps = 0;
@@ -654,6 +661,23 @@ TEST(Commands3, ReportFitAndRefusals) {
   const auto l = cdtest::run_command(fmt::format("{} fabric {}", exe.string(), lone.string()));
   EXPECT_EQ(l.code, 2) << l.out;
   EXPECT_NE(l.out.find("is a 3D contact snapshot"), std::string::npos) << l.out;
+}
+
+// A snapshot's x: the series' strain interpolated at its time; nan outside
+// the rows' times.
+TEST(Snapshot3, StrainAtASnapshotTime) {
+  Table t({"time", "strain"});
+  t.add_row({0.1, 1});
+  t.add_row({0.2, 2});
+  t.add_row({0.3, 4});
+  EXPECT_DOUBLE_EQ(x_at_time(t, "strain", 0.25), 3);
+  EXPECT_EQ(x_at_time(t, "strain", 0.2), 2);
+  EXPECT_EQ(x_at_time(t, "strain", 0.1), 1);
+  EXPECT_EQ(x_at_time(t, "strain", 0.3), 4);
+  EXPECT_TRUE(std::isnan(x_at_time(t, "strain", 0.05)));
+  EXPECT_TRUE(std::isnan(x_at_time(t, "strain", 0.35)));
+  EXPECT_EQ(x_at_time(t, "strain", 0.3 + 1e-12), 4);  // the last row, its time rounded in series.csv
+  EXPECT_EQ(x_at_time(t, "time", 0.05), 0.05);
 }
 
 // fit cohesion on 3D runs (docs/analysis.md "3D runs"): eta = 0 runs on
