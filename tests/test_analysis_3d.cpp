@@ -383,6 +383,13 @@ TEST(Stress3, SnapshotMatchesTheSeriesOfARealRun) {
   for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it)
     times[std::stoi((*it)[2].str())] = std::stod((*it)[1].str());
   ASSERT_GT(times.size(), 10u);
+  // snapshot_times reads the same collection (cdsim's own).
+  const auto st = snapshot_times(dir.string(), "contacts");
+  ASSERT_EQ(st.size(), times.size());
+  for (const auto& [k, t] : times) {
+    ASSERT_TRUE(st.at(static_cast<std::size_t>(k))) << k;
+    EXPECT_EQ(*st[static_cast<std::size_t>(k)], t) << k;
+  }
   const auto& time = series.column("time");
   const char* names[3][3] = {{"sxx", "sxy", "sxz"}, {"syx", "syy", "syz"}, {"szx", "szy", "szz"}};
   std::size_t compared = 0, snaps = 0;
@@ -419,11 +426,17 @@ namespace {
 const fs::path exe = fs::path(CDLAB_BINARY_DIR) / "analysis" / "cdanalysis";
 
 // A synthetic 3D shear run in the format of cdsim's 3D series (the columns
-// the analysis reads): shear_stress_ratio = mu + AR(1) noise, q_over_p (von
-// Mises, set 0.2 above mu so that reading it for mu would show), I, phi, z,
-// p; scene.toml with dimension = 3; one contact snapshot drawn from the
-// harmonic forms (l = d n between spheres of diameter d) and its spheres
-// snapshot.
+// the analysis reads): shear_stress_ratio = mu + AR(1) noise (plus, when
+// asked, a decaying transient or a drift), q_over_p (von Mises, set 0.2
+// above mu so that reading it for mu would show), I, phi, z, p; strain
+// 0.01 per row, time = strain / rate; scene.toml with dimension = 3; one
+// contact snapshot drawn from the harmonic forms (l = d n between spheres
+// of diameter d) and its spheres snapshot, or a sequence of them at given
+// strains with contacts.pvd giving their times, as cdsim writes it.
+struct Snap3 {
+  double strain = 0;
+  Forms forms;
+};
 struct Run3Spec {
   double mu = 0.4, I = 0.01, noise = 0.01;
   int rows = 300;
@@ -432,7 +445,33 @@ struct Run3Spec {
   std::size_t contacts = 0;  // 0: no snapshot
   std::string extra_scene;
   double q_offset = 0.2;     // q_over_p - shear_stress_ratio
+  double rate = 1;           // shear rate: time = strain / rate
+  double transient = 0;      // + transient exp(-strain / 0.15) on shear_stress_ratio
+  double drift = 0;          // + drift strain on shear_stress_ratio
+  std::vector<Snap3> snaps;  // contacts_NNNNN.vtp (`contacts` each) with contacts.pvd
 };
+
+// contacts_NNNNN.vtp and spheres_NNNNN.vtp: N contacts sampled from F, bodies
+// in pairs (2k, 2k+1), each a sphere of the snapshot.
+void write_snapshot3(const fs::path& dir, int num, const Forms& F, std::size_t N, std::uint64_t seed) {
+  auto cs = sample(F, N, seed);
+  ParticleSet ps;
+  for (std::size_t k = 0; k < cs.size(); ++k) {
+    cs[k].c.b1 = static_cast<int>(2 * k);
+    cs[k].c.b2 = static_cast<int>(2 * k + 1);
+    for (int b = 0; b < 2; ++b) {
+      Particle p;
+      p.id = static_cast<int>(2 * k + b);
+      p.radius = 0.5 * F.d;
+      p.x = static_cast<double>(k) * 3 * F.d + b * cs[k].c.l[0];
+      p.y = b * cs[k].c.l[1];
+      p.z = b * cs[k].c.l[2];
+      ps.push_back(p);
+    }
+  }
+  write_contacts3((dir / fmt::format("contacts_{:05d}.vtp", num)).string(), cs, ps);
+  write_particles((dir / fmt::format("spheres_{:05d}.vtp", num)).string(), ps);
+}
 
 void write_run3(const fs::path& dir, const Run3Spec& s) {
   fs::create_directories(dir);
@@ -442,33 +481,23 @@ void write_run3(const fs::path& dir, const Run3Spec& s) {
   csv << "step,time,strain,shear_rate,shear_stress_ratio,q_over_p,inertial_number,packing_fraction,z,p\n";
   for (int i = 0; i < s.rows; ++i) {
     const double gamma = 0.01 * i;
-    csv << fmt::format("{},{:.6g},{:.6g},1,{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},100\n", i, gamma, gamma,
-                       s.mu + s.noise * e, s.mu + s.q_offset + s.noise * e, s.I, 0.6 - 0.3 * s.I + 0.002 * e,
-                       4.5 + 0.05 * e);
+    const double mu = s.mu + s.transient * std::exp(-gamma / 0.15) + s.drift * gamma + s.noise * e;
+    csv << fmt::format("{},{:.10g},{:.10g},{},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},100\n", i, gamma / s.rate, gamma,
+                       s.rate, mu, mu + s.q_offset, s.I, 0.6 - 0.3 * s.I + 0.002 * e, 4.5 + 0.05 * e);
     e = 0.5 * e + std::sqrt(0.75) * G();
   }
   std::ofstream(dir / "scene.toml") << fmt::format(
       "# synthetic 3D run (tests/test_analysis_3d.cpp)\ndimension = 3\n{}\n[shear]\ninertial_number = {}\n",
       s.extra_scene, s.I);
-  if (s.contacts) {
-    auto cs = sample(s.forms, s.contacts, s.seed + 100);
-    // Bodies: pairs (2k, 2k+1), each a sphere of the snapshot.
-    ParticleSet ps;
-    for (std::size_t k = 0; k < cs.size(); ++k) {
-      cs[k].c.b1 = static_cast<int>(2 * k);
-      cs[k].c.b2 = static_cast<int>(2 * k + 1);
-      for (int b = 0; b < 2; ++b) {
-        Particle p;
-        p.id = static_cast<int>(2 * k + b);
-        p.radius = 0.5 * s.forms.d;
-        p.x = static_cast<double>(k) * 3 * s.forms.d + b * cs[k].c.l[0];
-        p.y = b * cs[k].c.l[1];
-        p.z = b * cs[k].c.l[2];
-        ps.push_back(p);
-      }
+  if (s.contacts && s.snaps.empty()) write_snapshot3(dir, 0, s.forms, s.contacts, s.seed + 100);
+  if (!s.snaps.empty()) {
+    std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+    for (std::size_t k = 0; k < s.snaps.size(); ++k) {
+      write_snapshot3(dir, static_cast<int>(k), s.snaps[k].forms, s.contacts, s.seed + 100 + k);
+      pvd += fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"contacts_{:05d}.vtp\"/>\n",
+                         s.snaps[k].strain / s.rate, k);
     }
-    write_contacts3((dir / "contacts_00000.vtp").string(), cs, ps);
-    write_particles((dir / "spheres_00000.vtp").string(), ps);
+    std::ofstream(dir / "contacts.pvd") << pvd + "  </Collection>\n</VTKFile>\n";
   }
 }
 
@@ -654,6 +683,164 @@ TEST(Commands3, ReportFitAndRefusals) {
   const auto l = cdtest::run_command(fmt::format("{} fabric {}", exe.string(), lone.string()));
   EXPECT_EQ(l.code, 2) << l.out;
   EXPECT_NE(l.out.find("is a 3D contact snapshot"), std::string::npos) << l.out;
+}
+
+// The 3D report's fabric over the steady window (docs/analysis.md, "Commands
+// in 3D"): six contact snapshots at strains 0.105, 0.305 (in a decaying
+// transient of mu, before the steady window; isotropic contacts) and 1.905,
+// 2.205, 2.505, 2.805 (in it; planar anisotropies a_c, a_n, a_t = 0.15,
+// 0.25, 0.08), 20000 contacts each, at times strain/4 in contacts.pvd (a
+// time read as a strain misplaces them: 3 in the window, the wrong ones). fabric.csv:
+// fabric_snapshots = 4, the means near the in-window forms (the mean over
+// all six would be 1/3 lower), each mean and _err the mean and sd/sqrt(4)
+// of the four snapshots' own values (run_fabric3 here) to 1e-9, check_rel
+// from the means.
+TEST(Commands3, ReportAveragesTheFabricOverTheSteadyWindow) {
+  ASSERT_TRUE(fs::exists(exe)) << "cdanalysis not built: " << exe;
+  const auto camp = cdtest::scratch_dir("test_analysis_3d", "window_fabric");
+  Forms F;
+  const double t = 3 * std::numbers::pi / 4;
+  F.Ac = planar(0.15, t);
+  F.An = planar(0.25, t);
+  F.At = planar(0.08, t);
+  F.d = 0.01;
+  Forms iso;
+  iso.d = 0.01;
+  Run3Spec s;
+  s.seed = 41;
+  s.rate = 4;
+  s.transient = 0.3;
+  s.contacts = 20000;
+  s.snaps = {{0.105, iso}, {0.305, iso}, {1.905, F}, {2.205, F}, {2.505, F}, {2.805, F}};
+  const fs::path run = camp / "run";
+  write_run3(run, s);
+  const auto out = camp.parent_path() / "window_fabric_report";
+  fs::remove_all(out);
+  const auto rep = cdtest::run_command(fmt::format("{} report {} --out {}", exe.string(), camp.string(), out.string()));
+  ASSERT_EQ(rep.code, 0) << rep.out;
+  // The design holds: the window starts after the transient's snapshots and
+  // before the steady ones.
+  const double wb = csv_value(out / "steady.csv", "window_begin"), we = csv_value(out / "steady.csv", "window_end");
+  ASSERT_GT(wb, 0.305);
+  ASSERT_LT(wb, 1.905);
+  ASSERT_GT(we, 2.805);
+  const Table fab = Table::read_csv((out / "fabric.csv").string(), true);
+  ASSERT_EQ(fab.rows(), 1u);
+  EXPECT_EQ(fab.column("fabric_snapshots")[0], 4);
+  // 4 x 20000 contacts: errors ~0.003.
+  EXPECT_NEAR(fab.column("a_c")[0], 0.15, 0.015);
+  EXPECT_NEAR(fab.column("a_n")[0], 0.25, 0.015);
+  EXPECT_NEAR(fab.column("a_t")[0], 0.08, 0.015);
+  // Each column against the four snapshots' own values.
+  const std::vector<std::string> cols = {"a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p",
+                                         "q_vm_over_p", "mu", "sliding", "z", "non_floating"};
+  std::map<std::string, std::vector<double>> per;
+  for (int k = 2; k < 6; ++k) {
+    const auto f = run_fabric3(run.string(), k, -1);
+    ASSERT_TRUE(f.aniso) << f.aniso_problem;
+    ASSERT_TRUE(f.connectivity);
+    const auto& a = *f.aniso;
+    const std::vector<double> v = {a.a_c(), a.a_n(), a.a_t(), a.sum_2_5(), a.sum_2_5_tensor(),
+                                   f.stress.q_over_p(), f.stress.q_vm() / f.stress.p(), f.stress.mu(),
+                                   f.sliding, f.connectivity->z, f.connectivity->non_floating};
+    for (std::size_t i = 0; i < cols.size(); ++i) per[cols[i]].push_back(v[i]);
+  }
+  auto near = [](double got, double want, const std::string& what) {
+    if (std::isnan(want)) EXPECT_TRUE(std::isnan(got)) << what;
+    else EXPECT_NEAR(got, want, 1e-9 * std::abs(want) + 1e-15) << what;
+  };
+  std::size_t spread = 0;
+  for (const auto& c : cols) {
+    ASSERT_TRUE(fab.has(c + "_err")) << c;
+    const auto& v = per[c];
+    double m = 0, s2 = 0;
+    for (double x : v) m += x / 4;
+    for (double x : v) s2 += (x - m) * (x - m) / 3;
+    near(fab.column(c)[0], m, c);
+    near(fab.column(c + "_err")[0], std::sqrt(s2 / 4), c + "_err");
+    spread += s2 > 0;
+  }
+  EXPECT_GE(spread, 6u) << "the snapshots hardly differ: the sem is not tested";
+  const double qp = fab.column("q_over_p")[0], s25 = fab.column("sum_2_5")[0];
+  near(fab.column("check_rel")[0], (s25 - qp) / qp, "check_rel");
+  EXPECT_LT(std::abs(fab.column("check_rel")[0]), 0.15);  // the relation on the forms (first order)
+  EXPECT_GT(fab.column("check_rel_err")[0], 0);
+  std::ifstream html(out / "index.html");
+  const std::string page((std::istreambuf_iterator<char>(html)), {});
+  EXPECT_NE(page.find("mean ± sem over 4 snapshots in the steady window γ = "), std::string::npos) << page;
+  EXPECT_NE(page.find("contacts_00002.vtp … contacts_00005.vtp"), std::string::npos) << page;
+  EXPECT_NE(page.find("relative deviation"), std::string::npos) << page;
+}
+
+// A snapshot's x: the series' strain interpolated at its time; nan outside
+// the rows' times.
+TEST(Snapshot3, StrainAtASnapshotTime) {
+  Table t({"time", "strain"});
+  t.add_row({0.1, 1});
+  t.add_row({0.2, 2});
+  t.add_row({0.3, 4});
+  EXPECT_DOUBLE_EQ(x_at_time(t, "strain", 0.25), 3);
+  EXPECT_EQ(x_at_time(t, "strain", 0.2), 2);
+  EXPECT_EQ(x_at_time(t, "strain", 0.1), 1);
+  EXPECT_EQ(x_at_time(t, "strain", 0.3), 4);
+  EXPECT_TRUE(std::isnan(x_at_time(t, "strain", 0.05)));
+  EXPECT_TRUE(std::isnan(x_at_time(t, "strain", 0.35)));
+  EXPECT_EQ(x_at_time(t, "strain", 0.3 + 1e-12), 4);  // the last row, its time rounded in series.csv
+  EXPECT_EQ(x_at_time(t, "time", 0.05), 0.05);
+}
+
+// The fallback to the last snapshot alone, said in fabric.csv
+// (fabric_snapshots = 1, _err nan) and on the page with the reason: no
+// steady window (mu drifts), no contacts.pvd, one snapshot in the window.
+TEST(Commands3, ReportFabricFallsBackToTheLastSnapshot) {
+  ASSERT_TRUE(fs::exists(exe)) << "cdanalysis not built: " << exe;
+  const auto camp = cdtest::scratch_dir("test_analysis_3d", "fallback_fabric");
+  Forms F;
+  F.Ac = planar(0.15, 3 * std::numbers::pi / 4);
+  F.d = 0.01;
+  Forms iso;
+  iso.d = 0.01;
+  Run3Spec s;
+  s.seed = 43;
+  s.contacts = 3000;
+  s.snaps = {{0.105, iso}, {0.305, iso}, {1.905, iso}, {2.805, F}};
+  Run3Spec drift = s;
+  drift.drift = 0.5;
+  write_run3(camp / "a_drift", drift);
+  Run3Spec nopvd = s;
+  nopvd.transient = 0.3;
+  write_run3(camp / "b_nopvd", nopvd);
+  fs::remove(camp / "b_nopvd" / "contacts.pvd");
+  Run3Spec one = s;
+  one.transient = 0.3;
+  one.snaps = {{0.105, iso}, {0.205, iso}, {0.305, iso}, {2.805, F}};
+  write_run3(camp / "c_one", one);
+  const auto out = camp.parent_path() / "fallback_fabric_report";
+  fs::remove_all(out);
+  const auto rep = cdtest::run_command(fmt::format("{} report {} --out {}", exe.string(), camp.string(), out.string()));
+  ASSERT_EQ(rep.code, 0) << rep.out;
+  const Table st = Table::read_csv((out / "steady.csv").string(), true);
+  ASSERT_EQ(st.rows(), 2u);  // a_drift has no window
+  ASSERT_EQ(st.column("run")[1], 2);
+  ASSERT_GT(st.column("window_begin")[1], 0.305);  // c_one: one snapshot in its window
+  ASSERT_LT(st.column("window_begin")[1], 2.805);
+  const Table fab = Table::read_csv((out / "fabric.csv").string(), true);
+  ASSERT_EQ(fab.rows(), 3u);
+  for (std::size_t r = 0; r < 3; ++r) {
+    EXPECT_EQ(fab.column("fabric_snapshots")[r], 1) << r;
+    EXPECT_TRUE(std::isnan(fab.column("a_c_err")[r])) << r;
+    EXPECT_TRUE(std::isnan(fab.column("check_rel_err")[r])) << r;
+    EXPECT_NEAR(fab.column("a_c")[r], 0.15, 0.03) << r;  // the last snapshot's, not an isotropic one's
+  }
+  const auto last = run_fabric3((camp / "c_one").string(), -1, -1);
+  EXPECT_EQ(fab.column("a_c")[2], last.aniso->a_c());
+  std::ifstream html(out / "index.html");
+  const std::string page((std::istreambuf_iterator<char>(html)), {});
+  for (const char* why : {"last snapshot contacts_00003.vtp alone (no steady window;",
+                          "last snapshot contacts_00003.vtp alone (run folder",  // ... has no contacts.pvd
+                          "has no contacts.pvd: the snapshots' times are unknown",
+                          "alone (1 of the 4 contact snapshots in the steady window γ = "})
+    EXPECT_NE(page.find(why), std::string::npos) << why << "\n" << page;
 }
 
 // fit cohesion on 3D runs (docs/analysis.md "3D runs"): eta = 0 runs on

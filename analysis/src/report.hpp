@@ -64,8 +64,10 @@ struct ReportSummary {
 // I, and index.html with a table of points (physics and cost) and the
 // campaign's total wall and CPU time. A 3D campaign (dimension = 3 in the
 // first run's scene.toml) takes mu = shear_stress_ratio and writes the 3D
-// anisotropies into fabric.csv (docs/analysis.md, "3D runs"); runs of the
-// other dimension are listed under problems and skipped.
+// anisotropies into fabric.csv, each the mean ± sem over the contact
+// snapshots in the run's steady window, else of the last snapshot alone
+// (docs/analysis.md, "Commands in 3D"); runs of the other dimension are
+// listed under problems and skipped.
 ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins = 36);
 
 }  // namespace cda

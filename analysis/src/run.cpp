@@ -4,8 +4,13 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -164,6 +169,77 @@ RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double 
   if (mu > 0) f.sliding_coulomb = static_cast<double>(coulomb) / nb;
   if (const auto pfile = companion_snapshot(f.file, "spheres")) f.connectivity = connectivity(raw, read_particles(*pfile), f_eps);
   return f;
+}
+
+std::vector<std::optional<double>> snapshot_times(const std::string& run_dir, const std::string& prefix) {
+  const fs::path pvd = fs::path(run_dir) / (prefix + ".pvd");
+  std::ifstream in(pvd);
+  if (!in) throw AnalysisError(fmt::format("run folder '{}' has no {}.pvd: the snapshots' times are unknown",
+                                           run_dir, prefix));
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string s = text.str();
+  // One <DataSet .../> per frame; its timestep and file attributes in either order.
+  const std::regex dataset(R"(<DataSet\b[^>]*>)"), timestep(R"re(\btimestep="([^"]*)")re"),
+      file(R"re(\bfile="([^"]*)")re");
+  std::map<std::string, double> times;
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), dataset); it != std::sregex_iterator(); ++it) {
+    const std::string tag = it->str();
+    std::smatch t, f;
+    if (!std::regex_search(tag, t, timestep) || !std::regex_search(tag, f, file)) continue;
+    char* end = nullptr;
+    const double v = std::strtod(t[1].str().c_str(), &end);
+    if (end == t[1].str().c_str() || *end || !std::isfinite(v))
+      throw AnalysisError(fmt::format("'{}': timestep \"{}\" is not a number", pvd.string(), t[1].str()));
+    times[fs::path(f[1].str()).filename().string()] = v;
+  }
+  if (times.empty()) throw AnalysisError(fmt::format("'{}' lists no frame", pvd.string()));
+  std::vector<std::optional<double>> out;
+  for (const auto& path : list_snapshots(run_dir, prefix)) {
+    const auto it = times.find(fs::path(path).filename().string());
+    out.push_back(it == times.end() ? std::nullopt : std::optional<double>(it->second));
+  }
+  return out;
+}
+
+double x_at_time(const Table& series, const std::string& x_column, double t) {
+  if (x_column == "time") return t;
+  const auto& time = series.column("time");
+  const auto& x = series.column(x_column);
+  const double nan = std::nan("");
+  if (time.empty() || !std::is_sorted(time.begin(), time.end())) return nan;
+  // series.csv prints 10 digits, the .pvd the shortest exact text: a
+  // snapshot on the first or last row may fall just outside by rounding.
+  const double tol = 1e-9 * std::max(std::abs(time.front()), std::abs(time.back()));
+  if (t < time.front() - tol || t > time.back() + tol) return nan;
+  t = std::clamp(t, time.front(), time.back());
+  const auto it = std::lower_bound(time.begin(), time.end(), t);  // first row with time >= t
+  const std::size_t r = static_cast<std::size_t>(it - time.begin());
+  if (time[r] == t || r == 0) return x[r];
+  const double u = (t - time[r - 1]) / (time[r] - time[r - 1]);
+  return x[r - 1] + u * (x[r] - x[r - 1]);
+}
+
+WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& series,
+                                    const std::string& x_column, const Window& w) {
+  WindowSnapshots ws;
+  ws.total = list_snapshots(run_dir, "contacts").size();
+  std::vector<std::optional<double>> times;
+  try {
+    times = snapshot_times(run_dir, "contacts");
+  } catch (const AnalysisError& e) {
+    ws.problem = e.what();
+    return ws;
+  }
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (!times[k]) continue;
+    const double x = x_at_time(series, x_column, *times[k]);
+    if (x >= w.x_begin && x <= w.x_end) {  // false for nan
+      ws.index.push_back(static_cast<int>(k));
+      ws.x.push_back(x);
+    }
+  }
+  return ws;
 }
 
 std::pair<double, double> parse_range(const std::string& s) {

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "anisotropy.hpp"
 #include "coordination.hpp"
@@ -99,6 +100,34 @@ struct RunFabric3 {
 };
 RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double mu = 0,
                        double sliding_tol = 1e-4);
+
+// The simulated time of each snapshot `prefix`_NNNNN.vtp of a run, in the
+// order of list_snapshots, read from the run's `prefix`.pvd collection
+// (cdsim writes <DataSet timestep="t" file="contacts_00003.vtp"/> per
+// frame, t the world's time, the clock of series.csv's time column):
+// nullopt for a file the collection does not list. Throws AnalysisError
+// when the collection is missing or lists no frame.
+std::vector<std::optional<double>> snapshot_times(const std::string& run_dir, const std::string& prefix);
+
+// The series' x column at time t: t itself when x is `time`, else linear
+// interpolation between the two rows whose times bracket t (a row at t
+// exactly: its x). NaN when t is outside the rows' times by more than
+// their rounding in series.csv (1e-9 relative; e.g. the snapshot at t = 0,
+// before the first row) or the time column decreases.
+double x_at_time(const Table& series, const std::string& x_column, double t);
+
+// The contact snapshots whose x (x_at_time of their .pvd time) lies in the
+// window [w.x_begin, w.x_end]: their indices (list_snapshots order) and x.
+// `problem` says why none could be placed (no contacts.pvd); snapshots the
+// collection does not list are left out.
+struct WindowSnapshots {
+  std::vector<int> index;
+  std::vector<double> x;
+  std::size_t total = 0;  // contact snapshots of the run
+  std::string problem;
+};
+WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& series,
+                                    const std::string& x_column, const Window& w);
 
 // The column that is mu in the rheology of a run of this dimension: 2D
 // q_over_p (sin phi of the Mohr circle, method.md §11), 3D

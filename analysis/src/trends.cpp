@@ -21,22 +21,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 Val of(const SteadyStats& s) { return {s.mean, s.error()}; }
 
-// Mean and standard error of per-snapshot values (nan values skipped).
-Val mean_sem(const std::vector<double>& x) {
-  std::vector<double> v;
-  for (double a : x)
-    if (std::isfinite(a)) v.push_back(a);
-  if (v.empty()) return {};
-  double m = 0;
-  for (double a : v) m += a;
-  m /= static_cast<double>(v.size());
-  if (v.size() < 2) return {m, kNaN};
-  double s2 = 0;
-  for (double a : v) s2 += (a - m) * (a - m);
-  s2 /= static_cast<double>(v.size() - 1);
-  return {m, std::sqrt(s2 / static_cast<double>(v.size()))};
-}
-
 // The steady window of a run: on its mu column (mu_column: 2D q_over_p, 3D
 // shear_stress_ratio) when the series has it, else on packing_fraction (an
 // isotropic compaction).
@@ -63,6 +47,21 @@ Val series_val(const SteadyRun& s, const std::string& col) {
 }
 
 }  // namespace
+
+Val mean_sem(const std::vector<double>& x) {
+  std::vector<double> v;
+  for (double a : x)
+    if (std::isfinite(a)) v.push_back(a);
+  if (v.empty()) return {};
+  double m = 0;
+  for (double a : v) m += a;
+  m /= static_cast<double>(v.size());
+  if (v.size() < 2) return {m, kNaN};
+  double s2 = 0;
+  for (double a : v) s2 += (a - m) * (a - m);
+  s2 /= static_cast<double>(v.size() - 1);
+  return {m, std::sqrt(s2 / static_cast<double>(v.size()))};
+}
 
 const std::vector<std::string> kAngularityPlots = {"angularity_mu",         "angularity_nu",
                                                    "angularity_z",          "angularity_anisotropy",

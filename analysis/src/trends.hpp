@@ -49,6 +49,10 @@ struct Val {
   double err = std::numeric_limits<double>::quiet_NaN();
 };
 
+// Mean and standard error sd/sqrt(n) of per-snapshot values, nan values
+// skipped (sd with n - 1); err nan with one value, both nan with none.
+Val mean_sem(const std::vector<double>& x);
+
 struct AngularityOptions {
   int snapshots = 5;  // last K contact snapshots for the fabric
   int bins = 36;
