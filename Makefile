@@ -428,16 +428,19 @@ $(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(eva
 CDA := $(BUILD)/analysis/cdanalysis
 ANALYSIS := outputs/analysis$(if $(dim3),3d)
 
+# WINDOW=a:b (strain) or a%:b% (of each run's span, e.g. 50%:100%) fixes the
+# steady window of the fits (cdanalysis --window); default: detected per run.
+fit_window = $(if $(WINDOW),--window $(WINDOW))
 analyze-inertial: build
 	$(CDA) report $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial
-	$(CDA) fit mu-i $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/mu_I --toml $(ANALYSIS)/inertial/mu_i.toml
-	$(CDA) fit nu-i $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/nu_i --toml $(ANALYSIS)/inertial/nu_i.toml
+	$(CDA) fit mu-i $(CAMPAIGNS)/inertial $(fit_window) --out $(ANALYSIS)/inertial/mu_I --toml $(ANALYSIS)/inertial/mu_i.toml
+	$(CDA) fit nu-i $(CAMPAIGNS)/inertial $(fit_window) --out $(ANALYSIS)/inertial/nu_i --toml $(ANALYSIS)/inertial/nu_i.toml
 	$(if $(dim3),,$(CDA) fit dilatancy $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/dilatancy --toml $(ANALYSIS)/inertial/dilatancy.toml)
 
 # The eta = 0 reference runs (eta_0_I_*) must be in the cohesive campaign.
 analyze-cohesive: build
 	$(CDA) report $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive
-	$(CDA) fit cohesion $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive/cohesion --toml $(ANALYSIS)/cohesive/cohesion.toml
+	$(CDA) fit cohesion $(CAMPAIGNS)/cohesive $(fit_window) --out $(ANALYSIS)/cohesive/cohesion --toml $(ANALYSIS)/cohesive/cohesion.toml
 
 analyze-pressure analyze-pressure-ladder: analyze-%: build
 	$(CDA) report $(CAMPAIGNS)/$* --out $(ANALYSIS)/$*
@@ -445,8 +448,8 @@ analyze-pressure analyze-pressure-ladder: analyze-%: build
 
 analyze-inertial-ladder: build
 	$(CDA) report $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder
-	$(CDA) fit mu-i $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder/mu_I --toml $(ANALYSIS)/inertial-ladder/mu_i.toml
-	$(CDA) fit nu-i $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder/nu_i --toml $(ANALYSIS)/inertial-ladder/nu_i.toml
+	$(CDA) fit mu-i $(CAMPAIGNS)/inertial-ladder $(fit_window) --out $(ANALYSIS)/inertial-ladder/mu_I --toml $(ANALYSIS)/inertial-ladder/mu_i.toml
+	$(CDA) fit nu-i $(CAMPAIGNS)/inertial-ladder $(fit_window) --out $(ANALYSIS)/inertial-ladder/nu_i --toml $(ANALYSIS)/inertial-ladder/nu_i.toml
 
 analyze-angularity: build
 	$(CDA) report $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity

@@ -4,6 +4,8 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -187,6 +189,21 @@ TEST(AnalysisIo, RunFolderSteadyAndFabric) {
             std::string::npos);
   EXPECT_NE(message([&] { read_series((d / "nope").string()); }).find("run folder"), std::string::npos);
   EXPECT_NE(message([&] { parse_range("5:3"); }).find("a < b"), std::string::npos);
+  // --window in percent of a run's own span of x: x from 1 to 5 here, so
+  // 50%:100% is 3:5 and gives the window "3:5" gives; absolute specs pass
+  // through; mixed or out-of-range percentages are refused by name.
+  const std::vector<double> x = {1, 2, 3, 4, 5};
+  EXPECT_EQ(resolve_window("50%:100%", x), (std::pair<double, double>{3.0, 5.0}));
+  EXPECT_EQ(resolve_window("25%:75%", x), (std::pair<double, double>{2.0, 4.0}));
+  EXPECT_EQ(resolve_window("1.5:2", x), (std::pair<double, double>{1.5, 2.0}));
+  for (const char* bad : {"50%:4", "3:100%", "50%:120%", "60%:50%", "%:50%", "a%:50%"})
+    EXPECT_NE(message([&] { resolve_window(bad, x); }).find("a%:b%"), std::string::npos) << bad;
+  const auto& xs = series.column("strain");
+  const double span = xs.back() - xs.front();
+  const auto half = run_steady((d / "a").string(), series, "q_over_p", "strain",
+                               resolve_window("50%:100%", xs));
+  EXPECT_DOUBLE_EQ(half.stats.window.x_begin, xs[std::lower_bound(xs.begin(), xs.end(), xs.front() + span / 2) - xs.begin()]);
+  EXPECT_DOUBLE_EQ(half.stats.window.x_end, xs.back());
   fs::create_directories(d / "empty_run");
   EXPECT_NE(message([&] { read_series((d / "empty_run").string()); }).find("has no series.csv"), std::string::npos);
 }

@@ -183,6 +183,30 @@ TEST(AnalysisRuns, CohesionFromRunsRecoversTheModel) {
   }
 }
 
+// Reference runs all in the linear part of mu(I) (I << I0: mu = 0.36 +
+// 0.6 I exactly, as 3D runs up to I = 0.3 nearly are) do not determine mu2
+// and I0: --reference mu-i refuses, and auto falls back to the
+// interpolation in ln I instead of refusing the whole cohesion fit.
+TEST(AnalysisRuns, CohesionReferenceAutoFallsBackWhenTheMuIFitIsUndetermined) {
+  std::vector<SteadyPoint> ref;
+  for (double I : {0.01, 0.03, 0.1, 0.3}) {
+    SteadyPoint p;
+    p.run = fmt::format("I_{:g}", I);
+    p.dim = 3;
+    p.I = I;
+    p.I_err = 1e-4 * I;
+    p.mu = 0.36 + 0.6 * I;
+    p.mu_err = 0.005;
+    ref.push_back(p);
+  }
+  EXPECT_THROW(SinPhiReference(ref, SinPhiReference::Mode::MuI), AnalysisError);
+  const SinPhiReference sr(ref, SinPhiReference::Mode::Auto);
+  EXPECT_FALSE(sr.uses_fit());
+  // Linear in ln I between the runs at 0.03 and 0.1.
+  const double I = 0.05, t = std::log(I / 0.03) / std::log(0.1 / 0.03);
+  EXPECT_NEAR(sr.at(I, 0).sin_phi, (1 - t) * (0.36 + 0.6 * 0.03) + t * (0.36 + 0.6 * 0.1), 1e-12);
+}
+
 TEST(AnalysisRuns, CohesionWithoutReferenceOrSceneIsAClearError) {
   const auto d = scratch("cohesion_bad");
   synth::RunSpec s;

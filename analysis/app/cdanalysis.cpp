@@ -124,7 +124,8 @@ int main(int argc, char** argv) {
   steady->add_option("run", run, "run folder (holding series.csv)")->required();
   steady->add_option("--column", column, "column of series.csv (default: q_over_p; 3D runs: shear_stress_ratio)");
   steady->add_option("--x", xcol, "abscissa column (default: strain if present, else time)");
-  steady->add_option("--window", window, "steady window a:b in the abscissa (default: detected)");
+  steady->add_option("--window", window, "steady window a:b in the abscissa, or a%:b% of the run's span of it "
+                                         "(default: detected)");
   steady->add_option("--out", out, "folder for the time-series plot (png, svg) and its data");
 
   // fabric
@@ -151,8 +152,8 @@ int main(int argc, char** argv) {
   mu_i->add_option("--table", table, "CSV with columns I, mu and optionally mu_err, instead of runs");
   mu_i->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
   mu_i->add_option("--out", out, "folder for the plot mu_I.png/svg (points, fit, 1-sigma band)");
-  mu_i->add_option("--window", window, "steady window a:b of each run's abscissa (strain) "
-                                       "(default: detected per run)");
+  mu_i->add_option("--window", window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
+                                       "run's span of it, e.g. 50%:100% the second half (default: detected per run)");
   auto* coh = fit->add_subcommand(
       "cohesion",
       "c/p = k0 eta/(1 - beta ln(1 - I/(1 + alpha eta)^(1/2))) over steady runs: eta from scene.toml "
@@ -169,6 +170,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   coh->add_option("--out", out, "folder for c/p data, model curves and the plot (png, svg)");
   coh->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
+  coh->add_option("--window", window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
+                                      "run's span of it (default: detected per run)");
   auto* dil = fit->add_subcommand(
       "dilatancy",
       "sin phi = sin phi_c + sin psi over the rows of shear runs (transient and steady), sin phi = q/p, "
@@ -203,6 +206,8 @@ int main(int argc, char** argv) {
   nui->add_option("--table", table, "CSV with columns I, nu and optionally nu_err, instead of runs");
   nui->add_option("--out", out, "folder for the plot nu_I.png/svg and its data");
   nui->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
+  nui->add_option("--window", window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
+                                      "run's span of it (default: detected per run)");
   auto* comp = fit->add_subcommand(
       "compaction", "e = e0 - lambda ln(p/p0) over steady (or compacted) runs at several p: e = 1/nu - 1 "
                     "from the steady packing_fraction, p the steady mean of the series' p (else the scene's "
@@ -258,7 +263,7 @@ int main(int argc, char** argv) {
       if (column.empty()) column = mu_column(run_dimension(run));
       const std::string x = xcol.empty() ? default_x_column(series) : xcol;
       std::optional<std::pair<double, double>> range;
-      if (!window.empty()) range = parse_range(window);
+      if (!window.empty()) range = resolve_window(window, series.column(x));
       const auto r = run_steady(run, series, column, x, range);
       print_stats(r);
       if (!out.empty()) {
@@ -327,8 +332,6 @@ int main(int argc, char** argv) {
         err = col_or_empty(t, "mu_err");
       } else {
         if (runs.empty()) throw AnalysisError("fit mu-i: give run folders or --table");
-        std::optional<std::pair<double, double>> range;
-        if (!window.empty()) range = parse_range(window);
         const auto all = expand_runs(runs);
         const int dim = common_dimension(all, "fit mu-i");
         if (dim == 3) {
@@ -338,6 +341,8 @@ int main(int argc, char** argv) {
         for (const auto& r : all) {
           const auto series = read_series(r);
           const auto x = default_x_column(series);
+          std::optional<std::pair<double, double>> range;
+          if (!window.empty()) range = resolve_window(window, series.column(x));
           const auto s = run_steady(r, series, mu_column(dim), x, range);
           const auto si = measured_inertial_number(series, x, s.stats.window);
           I.push_back(si.mean);
@@ -371,7 +376,7 @@ int main(int argc, char** argv) {
         const auto all = expand_runs(runs);
         const int dim = common_dimension(all, "fit cohesion");
         for (const auto& r : all) {
-          const auto p = steady_point(r);
+          const auto p = steady_point(r, window);
           (p.eta == 0 ? ref_pts : coh_pts).push_back(p);
         }
         if (coh_pts.empty()) throw AnalysisError("fit cohesion: no run with eta > 0 among the given runs");
@@ -530,7 +535,7 @@ int main(int argc, char** argv) {
         const auto all = expand_runs(runs);
         common_dimension(all, is_nu ? "fit nu-i" : "fit compaction");
         for (const auto& r : all) {
-          const auto s = state_point(r);
+          const auto s = state_point(r, is_nu ? window : std::string());
           if (is_nu)
             fmt::print("{}: I = {:.4g} +- {:.2g}, nu = {:.5f} +- {:.5f}\n", r, s.I.v, s.I.err, s.nu.v, s.nu.err);
           else

@@ -23,7 +23,7 @@ const char* cohesion_formula(int dim) {
   return dim == 3 ? "c/p = mu - mu0(I)" : "c/p = (q/p - sin phi)/cos phi";
 }
 
-SteadyPoint steady_point(const std::string& run_dir) {
+SteadyPoint steady_point(const std::string& run_dir, const std::string& window) {
   SteadyPoint p;
   p.run = run_dir;
   const auto scene = read_scene_info(run_dir);
@@ -33,7 +33,9 @@ SteadyPoint steady_point(const std::string& run_dir) {
   p.I_imposed = scene.inertial_number.value_or(std::numeric_limits<double>::quiet_NaN());
   const auto series = read_series(run_dir);
   const auto x = default_x_column(series);
-  const auto s = run_steady(run_dir, series, cohesion_mu_column(p.dim), x, std::nullopt);
+  std::optional<std::pair<double, double>> range;
+  if (!window.empty()) range = resolve_window(window, series.column(x));
+  const auto s = run_steady(run_dir, series, cohesion_mu_column(p.dim), x, range);
   const auto si = measured_inertial_number(series, x, s.stats.window);
   p.mu = s.stats.mean;
   p.mu_err = s.stats.error();
@@ -62,8 +64,20 @@ SinPhiReference::SinPhiReference(std::vector<SteadyPoint> pts, Mode mode) {
       mu.push_back(p.mu);
       e.push_back(p.mu_err);
     }
-    fit_ = fit_mu_I(I, mu, e);
-    use_fit_ = fit_.converged || mode == Mode::MuI;
+    if (mode == Mode::MuI) {
+      fit_ = fit_mu_I(I, mu, e);
+      use_fit_ = true;
+    } else {
+      // auto: a fit the data do not determine (a singular Jacobian: e.g.
+      // every reference run in the linear part of mu(I), I << I0) is
+      // refused by fit_mu_I; the interpolation serves instead.
+      try {
+        fit_ = fit_mu_I(I, mu, e);
+        use_fit_ = fit_.converged;
+      } catch (const AnalysisError&) {
+        use_fit_ = false;
+      }
+    }
   } else if (mode == Mode::MuI) {
     throw AnalysisError(fmt::format("fit cohesion: --reference mu-i needs 4 eta = 0 runs, {} given", pts.size()));
   }

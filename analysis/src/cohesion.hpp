@@ -49,7 +49,8 @@ const char* cohesion_formula(int dim);       // "c/p = (q/p - sin phi)/cos phi",
 // Throws AnalysisError naming the run when series.csv or scene.toml is
 // missing, [contact] cohesion_number is absent or negative, or the run has
 // no steady window.
-SteadyPoint steady_point(const std::string& run_dir);
+// window: as fit mu-i's --window (run.hpp resolve_window); "": detected.
+SteadyPoint steady_point(const std::string& run_dir, const std::string& window = "");
 
 // sin phi(I) of the cohesionless reference.
 //   mu-i:   the mu(I) fit of the reference runs (needs 4: 3 parameters and

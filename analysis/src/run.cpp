@@ -253,4 +253,22 @@ std::pair<double, double> parse_range(const std::string& s) {
   return {va, vb};
 }
 
+std::pair<double, double> resolve_window(const std::string& spec, std::span<const double> x) {
+  const auto colon = spec.find(':');
+  const bool pa = colon != std::string::npos && colon > 0 && spec[colon - 1] == '%';
+  const bool pb = !spec.empty() && spec.back() == '%';
+  if (!pa && !pb) return parse_range(spec);
+  auto bad = [&] {
+    return AnalysisError(fmt::format("window '{}' is not of the form a:b, or a%:b% with 0 <= a < b <= 100", spec));
+  };
+  if (!pa || !pb) throw bad();
+  const std::string a = spec.substr(0, colon - 1), b = spec.substr(colon + 1, spec.size() - colon - 2);
+  char *ea = nullptr, *eb = nullptr;
+  const double fa = std::strtod(a.c_str(), &ea), fb = std::strtod(b.c_str(), &eb);
+  if (a.empty() || b.empty() || *ea || *eb || !(fa >= 0 && fa < fb && fb <= 100)) throw bad();
+  if (x.empty()) throw AnalysisError(fmt::format("window '{}': the series has no rows", spec));
+  const double x0 = x.front(), span = x.back() - x.front();
+  return {x0 + fa / 100 * span, x0 + fb / 100 * span};
+}
+
 }  // namespace cda

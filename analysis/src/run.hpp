@@ -4,6 +4,7 @@
 #pragma once
 #include <cmath>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -136,5 +137,12 @@ inline const char* mu_column(int dimension) { return dimension == 3 ? "shear_str
 
 // "a:b" -> (a, b); throws AnalysisError on bad syntax or a >= b.
 std::pair<double, double> parse_range(const std::string& s);
+// A run's steady window from the --window option: "a:b" in the abscissa x
+// (parse_range), or "a%:b%" as percentages of the run's own span of x, from
+// its first row to its last (0 <= a < b <= 100): "50%:100%" is the second
+// half of every run whatever its length, for campaigns whose runs differ in
+// strain. Throws AnalysisError naming the spec when it is neither, or when
+// x is empty.
+std::pair<double, double> resolve_window(const std::string& spec, std::span<const double> x);
 
 }  // namespace cda

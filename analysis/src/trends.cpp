@@ -30,12 +30,14 @@ struct SteadyRun {
   Window w;
   SteadyStats main;
 };
-SteadyRun steady_run(const std::string& run_dir) {
+SteadyRun steady_run(const std::string& run_dir, const std::string& window = "") {
   SteadyRun s{read_series(run_dir), "", {}, {}};
   s.x = default_x_column(s.series);
   const std::string mu = mu_column(run_dimension(run_dir));  // 3D: shear_stress_ratio
   const std::string col = s.series.has(mu) ? mu : "packing_fraction";
-  const auto r = run_steady(run_dir, s.series, col, s.x, std::nullopt);
+  std::optional<std::pair<double, double>> range;
+  if (!window.empty()) range = resolve_window(window, s.series.column(s.x));
+  const auto r = run_steady(run_dir, s.series, col, s.x, range);
   s.w = r.stats.window;
   s.main = r.stats;
   return s;
@@ -271,10 +273,10 @@ bool plot_angularity(const std::string& dir, const std::vector<AngularityPoint>&
   return ok;
 }
 
-StatePoint state_point(const std::string& run_dir) {
+StatePoint state_point(const std::string& run_dir, const std::string& window) {
   StatePoint s;
   s.run = run_dir;
-  const auto r = steady_run(run_dir);
+  const auto r = steady_run(run_dir, window);
   if (!r.series.has("packing_fraction"))
     throw AnalysisError(fmt::format("run '{}' has no packing_fraction column", run_dir));
   s.nu = series_val(r, "packing_fraction");

@@ -104,7 +104,8 @@ struct StatePoint {
   double e() const { return 1 / nu.v - 1; }
   double e_err() const { return nu.err / (nu.v * nu.v); }
 };
-StatePoint state_point(const std::string& run_dir);
+// window: as fit mu-i's --window (run.hpp resolve_window); "": detected.
+StatePoint state_point(const std::string& run_dir, const std::string& window = "");
 
 // nu(I) and its plot nu_I.{png,svg} (data nu_I_data.csv, nu_I_fit.csv).
 FitResult fit_nu_I_points(const std::vector<StatePoint>& pts);
