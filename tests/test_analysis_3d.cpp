@@ -561,6 +561,20 @@ TEST(Snapshot3, ReadersRefuseTheOtherDimension) {
   }
 }
 
+// The anisotropic forms of a simple-shear flow (planar, along the
+// compression axis 3 pi/4): a_c, a_n, a_t = 0.15, 0.25, 0.08, d = 0.01.
+namespace {
+Forms shear_forms() {
+  Forms F;
+  const double t = 3 * std::numbers::pi / 4;
+  F.Ac = planar(0.15, t);
+  F.An = planar(0.25, t);
+  F.At = planar(0.08, t);
+  F.d = 0.01;
+  return F;
+}
+}  // namespace
+
 // A 3D campaign through the command line: report (tables with mu =
 // shear_stress_ratio, the 3D anisotropies of each snapshot, the mu(I) fit),
 // fit mu-i, fabric; and the 2D-only commands refused by name.
@@ -569,12 +583,7 @@ TEST(Commands3, ReportFitAndRefusals) {
   const auto camp = cdtest::scratch_dir("test_analysis_3d", "campaign");
   const double mu1 = 0.38, mu2 = 0.9, I0 = 0.3;
   const std::vector<double> Is = {0.003, 0.01, 0.03, 0.1, 0.2, 0.4};
-  Forms F;
-  const double t = 3 * std::numbers::pi / 4;
-  F.Ac = planar(0.15, t);
-  F.An = planar(0.25, t);
-  F.At = planar(0.08, t);
-  F.d = 0.01;
+  const Forms F = shear_forms();
   for (std::size_t k = 0; k < Is.size(); ++k) {
     Run3Spec s;
     s.I = Is[k];
@@ -698,12 +707,7 @@ TEST(Commands3, ReportFitAndRefusals) {
 TEST(Commands3, ReportAveragesTheFabricOverTheSteadyWindow) {
   ASSERT_TRUE(fs::exists(exe)) << "cdanalysis not built: " << exe;
   const auto camp = cdtest::scratch_dir("test_analysis_3d", "window_fabric");
-  Forms F;
-  const double t = 3 * std::numbers::pi / 4;
-  F.Ac = planar(0.15, t);
-  F.An = planar(0.25, t);
-  F.At = planar(0.08, t);
-  F.d = 0.01;
+  const Forms F = shear_forms();
   Forms iso;
   iso.d = 0.01;
   Run3Spec s;
