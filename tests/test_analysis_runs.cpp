@@ -207,6 +207,40 @@ TEST(AnalysisRuns, CohesionReferenceAutoFallsBackWhenTheMuIFitIsUndetermined) {
   EXPECT_NEAR(sr.at(I, 0).sin_phi, (1 - t) * (0.36 + 0.6 * 0.03) + t * (0.36 + 0.6 * 0.1), 1e-12);
 }
 
+// When the runs do not determine the model (here two cohesive runs, one I,
+// for three parameters) the command still writes the c/p points and their
+// plot with --out, then refuses the fit (exit 1).
+TEST(AnalysisRuns, CohesionPointsAreWrittenWhenTheModelIsRefused) {
+  const auto d = scratch("cohesion_points");
+  std::uint64_t seed = 5;
+  for (double I : {0.005, 0.02, 0.08}) {
+    synth::RunSpec s;
+    s.I = I;
+    s.mu = synth::mu_of_I(0.26, 0.6, 0.08, I);
+    s.seed = seed++;
+    synth::write_run(d / fmt::format("eta_0_I_{:g}", I), s);
+  }
+  for (double eta : {1.0, 3.0}) {
+    synth::RunSpec s;
+    s.I = 0.02;
+    s.eta = eta;
+    s.mu = synth::mu_of_I(0.26, 0.6, 0.08, 0.02);
+    s.c_over_p = 0.1 * eta;
+    s.seed = seed++;
+    synth::write_run(d / fmt::format("eta_{:g}_I_0.02", eta), s);
+  }
+  ASSERT_TRUE(fs::exists(exe)) << "cdanalysis not built: " << exe;
+  const auto out = d / "out";
+  auto r = cdtest::run_command(fmt::format("'{}' fit cohesion '{}' --out '{}'", exe.string(), d.string(), out.string()));
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("refused"), std::string::npos) << r.out;
+  ASSERT_TRUE(fs::exists(out / "cohesion_data.csv")) << r.out;
+  const auto t = Table::read_csv((out / "cohesion_data.csv").string());
+  ASSERT_EQ(t.rows(), 2u);
+  for (std::size_t i = 0; i < 2; ++i)  // c/p = 0.1 eta within the synthetic noise (4 error bars)
+    EXPECT_NEAR(t.column("c_over_p")[i], 0.1 * t.column("eta")[i], 4 * t.column("c_over_p_err")[i]);
+}
+
 TEST(AnalysisRuns, CohesionWithoutReferenceOrSceneIsAClearError) {
   const auto d = scratch("cohesion_bad");
   synth::RunSpec s;

@@ -409,7 +409,17 @@ int main(int argc, char** argv) {
           c.push_back(cp.c_over_p);
           ce.push_back(cp.c_over_p_err);
         }
-        const auto r = fit_cohesion(eta, I, c, ce);
+        FitResult r;
+        try {
+          r = fit_cohesion(eta, I, c, ce);
+        } catch (const AnalysisError&) {
+          // The c/p points are a result on their own: written and plotted
+          // before the refusal (exit 1) when the model is not determined.
+          if (!out.empty() && !plot_cohesion(out, pts, nullptr))
+            fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
+          if (!out.empty()) fmt::print("wrote the c/p points (no model) in {}\n", out);
+          throw;
+        }
         print_fit(r, cohesion());
         std::vector<FitResult> fits = {r};
         std::vector<Model> models = {cohesion()};
@@ -418,7 +428,7 @@ int main(int argc, char** argv) {
           models.push_back(mu_of_I());
         }
         write_toml(toml_out, fits, models);
-        if (!out.empty() && !plot_cohesion(out, pts, r))
+        if (!out.empty() && !plot_cohesion(out, pts, &r))
           fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
       }
     } else if (dil->parsed()) {

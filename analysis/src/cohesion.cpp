@@ -146,7 +146,7 @@ CohesionPoint cohesion_point(const SteadyPoint& p, const SinPhiReference& ref) {
   return c;
 }
 
-bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts, const FitResult& r) {
+bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts, const FitResult* r) {
   fs::create_directories(dir);
   const bool d3 = !pts.empty() && pts.front().run.dim == 3;
   Table data({"eta", "I", "I_err", d3 ? "mu" : "q_over_p", d3 ? "mu_err" : "q_over_p_err", d3 ? "mu0" : "sin_phi",
@@ -170,14 +170,19 @@ bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts
   int k = 0;
   for (double eta : etas) {
     if (k) curves += "\n\n";
-    for (int i = 0; i <= 100; ++i) {
+    for (int i = 0; r && i <= 100; ++i) {
       const double x[2] = {eta, lo * std::pow(hi / lo, i / 100.0)};
-      curves += fmt::format("{},{}\n", x[1], predict(m, r, x));
+      curves += fmt::format("{},{}\n", x[1], predict(m, *r, x));
     }
-    plot += fmt::format("{}'cohesion_fit.csv' index {} using 1:2 with lines lc {} title 'model, η = {:g}', \\\n"
-                        "     'cohesion_data.csv' every ::1 using ($1=={:.17g}?$2:1/0):8:3:9 with xyerrorbars "
-                        "pt 7 lc {} notitle",
-                        k ? ", \\\n     " : "", k, k + 1, eta, eta, k + 1);
+    if (r)
+      plot += fmt::format("{}'cohesion_fit.csv' index {} using 1:2 with lines lc {} title 'model, η = {:g}', \\\n"
+                          "     'cohesion_data.csv' every ::1 using ($1=={:.17g}?$2:1/0):8:3:9 with xyerrorbars "
+                          "pt 7 lc {} notitle",
+                          k ? ", \\\n     " : "", k, k + 1, eta, eta, k + 1);
+    else  // no model: the points, joined per eta
+      plot += fmt::format("{}'cohesion_data.csv' every ::1 using ($1=={:.17g}?$2:1/0):8:3:9 with xyerrorlines "
+                          "pt 7 lc {} title 'η = {:g}'",
+                          k ? ", \\\n     " : "", eta, k + 1, eta);
     ++k;
   }
   {
@@ -186,8 +191,10 @@ bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts
   }
   const std::string body = fmt::format(
       "set datafile separator ','\nset logscale x\nset xlabel 'I (measured)'\nset ylabel 'c/p'\n"
-      "set key outside right\nset grid\nset title 'k_0 = {:.4g}, β = {:.3g}, α = {:.3g}'\n{}\n",
-      r["k0"], r["beta"], r["alpha"], plot);
+      "set key outside right\nset grid\nset title '{}'\n{}\n",
+      r ? fmt::format("k_0 = {:.4g}, β = {:.3g}, α = {:.3g}", (*r)["k0"], (*r)["beta"], (*r)["alpha"])
+        : std::string("the model is not determined by these runs (fit refused)"),
+      plot);
   return plot_both(dir, "cohesion", body, 900, 500);
 }
 

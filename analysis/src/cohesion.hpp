@@ -93,7 +93,7 @@ CohesionPoint cohesion_point(const SteadyPoint& p, const SinPhiReference& ref);
 
 // c/p against I per eta with the model curves: <dir>/cohesion.{png,svg,gp}
 // and cohesion_data.csv (2D: q_over_p, sin_phi columns; 3D: mu, mu0),
-// cohesion_fit.csv.
-bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts, const FitResult& r);
+// cohesion_fit.csv. r null: the points alone (the model fit was refused).
+bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts, const FitResult* r);
 
 }  // namespace cda

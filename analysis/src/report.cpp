@@ -690,7 +690,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       const auto r = fit_cohesion(eta, I, c, ce);
       fits.push_back(r);
       models.push_back(cohesion());
-      sum.plots_ok = plot_cohesion(out_dir, cps, r) && sum.plots_ok;
+      sum.plots_ok = plot_cohesion(out_dir, cps, &r) && sum.plots_ok;
       sum.fits.push_back("cohesion");
       html_fit += fmt::format("<h3>Cohesion c/p</h3><img src='cohesion.png' width=600><p>{}: k0 = {:.4g} ± {:.2g}, "
                               "β = {:.4g} ± {:.2g}, α = {:.4g} ± {:.2g}, χ²/dof = {:.2f}; {} from {} η = 0 "
