@@ -44,9 +44,9 @@ help:
 	@echo "make campaign-pressure[-ladder]  steady shear at PRESSURE_I under each p of PRESSURE_P (ladder: lowest p up)"
 	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
 	@echo "make frozen-shear   steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into $(FROZEN)/ [FS_N=1000]"
-	@echo "make regress        re-run the reference campaign, refit mu(I), compare with tests/data/regress/"
+	@echo "make regress        re-run the 2D and 3D reference campaigns, refit mu(I), compare with tests/data/regress*/"
 	@echo "make prep-overlap   ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N (1000): fails if an overlap reaches 0.01 d_small"
-	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity"
+	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity [DIM=3] [WINDOW=50%:100%]"
 	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
 
 # Idempotent: asks dpkg which packages are missing and installs only those.
