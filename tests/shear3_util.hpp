@@ -4,6 +4,8 @@
 // 1.61e-4 s; size ratio 1.5, mu 0.4, tol 1e-3, brake 0.1/t_p.
 #pragma once
 
+#include <string>
+
 #include "scene.hpp"
 
 namespace cdtest {
@@ -27,6 +29,19 @@ inline cd::Scene shear3_prep_scene(int n) {
   s.compaction_rate = 0.1;
   s.duration = 1.0;
   s.series_interval = 1.0;
+  return s;
+}
+
+// The shear of that sample: the same scene with no particles of its own,
+// started from the compacted checkpoint `start`, at inertial number I to
+// strain 1 (callers change what they need).
+inline cd::Scene shear3_shear_scene(const std::string& start, double I) {
+  cd::Scene s = shear3_prep_scene(0);
+  s.isotropic = false;
+  s.compaction_rate = 0;
+  s.inertial_number = I;
+  s.start = start;
+  s.strain = 1.0;
   return s;
 }
 

@@ -233,24 +233,10 @@ std::string prepared3(int n, int steps) {
 // steady), and 1 and 2 threads bit-identical over the first 200 steps.
 TEST(CellControl, ShearAtInertialNumber1HoldsThePressure3D) {
   const std::string start = prepared3(150, 300);
-  cd::Scene s;
-  s.dimension = 3;
-  s.gravity = {0, 0, 0};
-  s.shear_mode = "periodic";
-  s.n = 0;
-  s.d_mean = 1e-3;
-  s.density = 2600;
-  s.mu = 0.4;
-  s.alert = 0.1;
-  s.tol = 1e-3;
-  s.max_iter = 1000;
-  s.pressure = 1e5;
-  s.inertial_number = 1.0;
+  cd::Scene s = cdtest::shear3_shear_scene(start, 1.0);
   s.dt_tp = 0.005;
   s.cell_mass = 0.01;
-  s.start = start;
   s.strain = 6.0;
-  s.series_interval = 1.0;
   const auto threads = [&](int t) {
     omp_set_num_threads(t);
     cd::World3 w = cd::build_world3(s);

@@ -37,12 +37,7 @@ namespace {
 Scene prep_scene(int n) { return cdtest::shear3_prep_scene(n); }
 
 Scene shear_scene(const std::string& start, double I, double eta) {
-  Scene s = prep_scene(0);
-  s.isotropic = false;
-  s.compaction_rate = 0;
-  s.inertial_number = I;
-  s.start = start;
-  s.strain = 1.0;
+  Scene s = cdtest::shear3_shear_scene(start, I);
   s.cohesion_number = eta;
   return s;
 }

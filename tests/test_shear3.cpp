@@ -166,15 +166,7 @@ TEST(Shear3Cell, IsotropicCompactionReachesThePressureOnAllThreeAxes) {
 namespace {
 
 // The shear scene started from a sample: I, p, dt_tp as given.
-Scene shear_scene(const std::string& start, double I) {
-  Scene s = prep_scene(0);
-  s.isotropic = false;
-  s.compaction_rate = 0;
-  s.inertial_number = I;
-  s.start = start;
-  s.strain = 1.0;
-  return s;
-}
+Scene shear_scene(const std::string& start, double I) { return cdtest::shear3_shear_scene(start, I); }
 
 // A compacted sample of n spheres in a checkpoint (the dofs' path of
 // shear.start: a preparation's checkpoint).
