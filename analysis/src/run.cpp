@@ -262,13 +262,16 @@ std::pair<double, double> resolve_window(const std::string& spec, std::span<cons
     return AnalysisError(fmt::format("window '{}' is not of the form a:b, or a%:b% with 0 <= a < b <= 100", spec));
   };
   if (!pa || !pb) throw bad();
-  const std::string a = spec.substr(0, colon - 1), b = spec.substr(colon + 1, spec.size() - colon - 2);
-  char *ea = nullptr, *eb = nullptr;
-  const double fa = std::strtod(a.c_str(), &ea), fb = std::strtod(b.c_str(), &eb);
-  if (a.empty() || b.empty() || *ea || *eb || !(fa >= 0 && fa < fb && fb <= 100)) throw bad();
+  std::pair<double, double> f;
+  try {  // the numbers as parse_range reads them, the % signs removed
+    f = parse_range(spec.substr(0, colon - 1) + spec.substr(colon, spec.size() - colon - 1));
+  } catch (const AnalysisError&) {
+    throw bad();
+  }
+  if (!(f.first >= 0 && f.second <= 100)) throw bad();
   if (x.empty()) throw AnalysisError(fmt::format("window '{}': the series has no rows", spec));
   const double x0 = x.front(), span = x.back() - x.front();
-  return {x0 + fa / 100 * span, x0 + fb / 100 * span};
+  return {x0 + f.first / 100 * span, x0 + f.second / 100 * span};
 }
 
 }  // namespace cda
