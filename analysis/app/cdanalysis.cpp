@@ -262,8 +262,7 @@ int main(int argc, char** argv) {
       const auto series = read_series(run);
       if (column.empty()) column = mu_column(run_dimension(run));
       const std::string x = xcol.empty() ? default_x_column(series) : xcol;
-      std::optional<std::pair<double, double>> range;
-      if (!window.empty()) range = resolve_window(window, series.column(x));
+      const auto range = window_range(window, series.column(x));
       const auto r = run_steady(run, series, column, x, range);
       print_stats(r);
       if (!out.empty()) {
@@ -341,8 +340,7 @@ int main(int argc, char** argv) {
         for (const auto& r : all) {
           const auto series = read_series(r);
           const auto x = default_x_column(series);
-          std::optional<std::pair<double, double>> range;
-          if (!window.empty()) range = resolve_window(window, series.column(x));
+          const auto range = window_range(window, series.column(x));
           const auto s = run_steady(r, series, mu_column(dim), x, range);
           const auto si = measured_inertial_number(series, x, s.stats.window);
           I.push_back(si.mean);

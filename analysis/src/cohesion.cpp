@@ -33,8 +33,7 @@ SteadyPoint steady_point(const std::string& run_dir, const std::string& window) 
   p.I_imposed = scene.inertial_number.value_or(std::numeric_limits<double>::quiet_NaN());
   const auto series = read_series(run_dir);
   const auto x = default_x_column(series);
-  std::optional<std::pair<double, double>> range;
-  if (!window.empty()) range = resolve_window(window, series.column(x));
+  const auto range = window_range(window, series.column(x));
   const auto s = run_steady(run_dir, series, cohesion_mu_column(p.dim), x, range);
   const auto si = measured_inertial_number(series, x, s.stats.window);
   p.mu = s.stats.mean;

@@ -53,11 +53,6 @@ std::vector<double> cost_values(const std::optional<RunCost>& c) {
   return {c->wall_time, c->cpu_time, c->steps, c->sweeps_per_step, c->cap_share};
 }
 
-// The per-snapshot quantities of a 3D run's fabric.csv row, in this order
-// (each followed by its _err there).
-const std::vector<std::string> kFabric3Columns = {"a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p",
-                                                  "q_vm_over_p", "mu", "sliding", "z", "non_floating"};
-
 // A value for a text table: "n/a" when not measured.
 std::string or_na(double v, const char* spec = "{:.4g}") {
   return std::isfinite(v) ? fmt::format(fmt::runtime(spec), v) : "n/a";
@@ -412,94 +407,37 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       html_runs += fmt::format("<img src='{}_series.png' width=600>\n", stem);
       if (dim == 3 && !list_snapshots(run, "contacts").empty()) {
         try {
-          // The contact snapshots inside the steady window (each placed by
-          // its contacts.pvd time, interpolated in the series' x), averaged;
-          // the last snapshot alone when there is no window or fewer than 2.
+          const auto fw = window_fabric3(run, series, xc, have_window ? &w : nullptr);
+          sum.problems.insert(sum.problems.end(), fw.problems.begin(), fw.problems.end());
           const char* xs = xc == "strain" ? "γ" : "t";
-          std::vector<int> picks;
-          std::string alone;  // why the last snapshot alone
-          if (!have_window) {
-            alone = "no steady window";
-          } else {
-            const auto ws = snapshots_in_window(run, series, xc, w);
-            if (!ws.problem.empty()) alone = ws.problem;
-            else if (ws.index.size() < 2)
-              alone = fmt::format("{} of the {} contact snapshots in the steady window {} = {:.4g}–{:.4g}, 2 "
-                                  "needed", ws.index.size(), ws.total, xs, w.x_begin, w.x_end);
-            else picks = ws.index;
-          }
-          const bool averaged = !picks.empty();
-          if (!averaged) picks = {-1};
-          std::vector<std::vector<double>> per(kFabric3Columns.size());
-          std::vector<double> diff;  // (2/5) sum a - q/p, per snapshot
-          std::vector<std::string> files;
-          double bearing = 0;
-          for (const int snap : picks) {
-            RunFabric3 f;
-            try {
-              f = run_fabric3(run, snap, -1);
-            } catch (const AnalysisError& e) {
-              if (!averaged) throw;
-              sum.problems.push_back(fmt::format("{}: {} (left out of the window's mean)", run, e.what()));
-              continue;
-            }
-            if (!f.aniso) sum.problems.push_back(f.aniso_problem);
-            const double nan = std::nan("");
-            const Anisotropy3 a = f.aniso.value_or(Anisotropy3{});
-            const bool ok = f.aniso.has_value();
-            const std::vector<double> v = {ok ? a.a_c() : nan, ok ? a.a_n() : nan, ok ? a.a_t() : nan,
-                                           ok ? a.sum_2_5() : nan, ok ? a.sum_2_5_tensor() : nan,
-                                           f.stress.q_over_p(), f.stress.q_vm() / f.stress.p(),
-                                           f.stress.mu(), f.sliding,
-                                           f.connectivity ? f.connectivity->z : nan,
-                                           f.connectivity ? f.connectivity->non_floating : nan};
-            for (std::size_t i = 0; i < v.size(); ++i) per[i].push_back(v[i]);
-            diff.push_back(v[3] - v[5]);  // sum_2_5 - q_over_p
-            files.push_back(fs::path(f.file).filename().string());
-            bearing += static_cast<double>(f.physical_contacts);
-          }
-          if (files.empty())
-            throw AnalysisError(fmt::format("none of the {} contact snapshots in the steady window could be read",
-                                            picks.size()));
-          std::vector<Val> m;
           std::vector<double> frow = {static_cast<double>(k)};
-          for (const auto& x : per) {
-            m.push_back(mean_sem(x));
-            frow.push_back(m.back().v);
-            frow.push_back(m.back().err);
-          }
-          const auto mean_of = [&](const char* c) {
-            return m[std::find(kFabric3Columns.begin(), kFabric3Columns.end(), c) - kFabric3Columns.begin()];
-          };
-          // (2/5) sum a against q/p: relative deviation of the means, its
-          // error from the per-snapshot differences (paired: their common
-          // fluctuation cancels).
-          const double qp = mean_of("q_over_p").v, rel = (mean_of("sum_2_5").v - qp) / qp,
-                       rel_err = mean_sem(diff).err / std::abs(qp);
-          frow.insert(frow.end(), {rel, rel_err, static_cast<double>(files.size())});
+          for (const auto& m : fw.mean) frow.insert(frow.end(), {m.v, m.err});
+          const double rel = fw.check_rel, rel_err = fw.check_rel_err;
+          frow.insert(frow.end(), {rel, rel_err, static_cast<double>(fw.files.size())});
           frow.insert(frow.end(), cost.begin(), cost.end());
           fabric.add_row(frow);
           ++sum.fabric;
+          const double qp = fw.of("q_over_p").v;
           const std::string what =
-              averaged ? fmt::format("mean ± sem over {} snapshots in the steady window {} = {:.4g}–{:.4g} ({} … {}; "
-                                     "{:.0f} force-bearing contacts each on average)",
-                                     files.size(), xs, w.x_begin, w.x_end, html_escape(files.front()),
-                                     html_escape(files.back()), bearing / static_cast<double>(files.size()))
-                       : fmt::format("last snapshot {} alone ({}; no error bars from one snapshot; {:.0f} "
-                                     "force-bearing contacts)",
-                                     html_escape(files.front()), html_escape(alone), bearing);
+              fw.averaged ? fmt::format("mean ± sem over {} snapshots in the steady window {} = {:.4g}–{:.4g} ({} … {}; "
+                                        "{:.0f} force-bearing contacts each on average)",
+                                        fw.files.size(), xs, w.x_begin, w.x_end, html_escape(fw.files.front()),
+                                        html_escape(fw.files.back()), fw.bearing)
+                          : fmt::format("last snapshot {} alone ({}; no error bars from one snapshot; {:.0f} "
+                                        "force-bearing contacts)",
+                                        html_escape(fw.files.front()), html_escape(fw.alone), fw.bearing);
           html_runs += fmt::format(
               "<p>fabric: {}: a_c = {}, a_n = {}, a_t = {}; q/p = {} (q = (σ1 − σ3)/3) against "
               "(2/5)(a_c + a_n + a_t) = {}: relative deviation ((2/5)Σa − q/p)/(q/p) = {}; "
               "μ = −σ_xy/σ_yy = {}; z = {}</p>\n",
-              what, or_na(mean_of("a_c").v, mean_of("a_c").err), or_na(mean_of("a_n").v, mean_of("a_n").err),
-              or_na(mean_of("a_t").v, mean_of("a_t").err), or_na(qp, mean_of("q_over_p").err),
-              or_na(mean_of("sum_2_5").v, mean_of("sum_2_5").err),
+              what, or_na(fw.of("a_c").v, fw.of("a_c").err), or_na(fw.of("a_n").v, fw.of("a_n").err),
+              or_na(fw.of("a_t").v, fw.of("a_t").err), or_na(qp, fw.of("q_over_p").err),
+              or_na(fw.of("sum_2_5").v, fw.of("sum_2_5").err),
               std::isfinite(rel) ? (std::isfinite(rel_err)
                                         ? fmt::format("{:+.1f} % ± {:.1f} %", 100 * rel, 100 * rel_err)
                                         : fmt::format("{:+.1f} %", 100 * rel))
                                  : std::string("n/a"),
-              or_na(mean_of("mu").v, mean_of("mu").err), or_na(mean_of("z").v, mean_of("z").err));
+              or_na(fw.of("mu").v, fw.of("mu").err), or_na(fw.of("z").v, fw.of("z").err));
         } catch (const AnalysisError& e) {
           sum.problems.push_back(fmt::format("{}: {}", run, e.what()));
           html_runs += fmt::format("<p>fabric: {}</p>\n", html_escape(e.what()));

@@ -242,6 +242,71 @@ WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& ser
   return ws;
 }
 
+const std::vector<std::string> kFabric3Columns = {"a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p",
+                                                  "q_vm_over_p", "mu", "sliding", "z", "non_floating"};
+
+const Val& WindowFabric3::of(const std::string& column) const {
+  const auto i = std::find(kFabric3Columns.begin(), kFabric3Columns.end(), column);
+  if (i == kFabric3Columns.end()) throw AnalysisError(fmt::format("no 3D fabric column '{}'", column));
+  return mean.at(static_cast<std::size_t>(i - kFabric3Columns.begin()));
+}
+
+WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, const std::string& x_column,
+                             const Window* w) {
+  WindowFabric3 r;
+  const char* xs = x_column == "strain" ? "γ" : "t";
+  std::vector<int> picks;
+  if (!w) {
+    r.alone = "no steady window";
+  } else {
+    const auto ws = snapshots_in_window(run_dir, series, x_column, *w);
+    if (!ws.problem.empty()) r.alone = ws.problem;
+    else if (ws.index.size() < 2)
+      r.alone = fmt::format("{} of the {} contact snapshots in the steady window {} = {:.4g}–{:.4g}, 2 needed",
+                            ws.index.size(), ws.total, xs, w->x_begin, w->x_end);
+    else picks = ws.index;
+  }
+  r.averaged = !picks.empty();
+  if (!r.averaged) picks = {-1};  // the last snapshot
+  std::vector<std::vector<double>> per(kFabric3Columns.size());
+  std::vector<double> diff;  // (2/5) sum a - q/p, per snapshot
+  std::string first_error;
+  for (const int snap : picks) {
+    RunFabric3 f;
+    try {
+      f = run_fabric3(run_dir, snap, -1);
+    } catch (const AnalysisError& e) {
+      if (!r.averaged) throw;
+      r.problems.push_back(fmt::format("{}: {} (left out of the window's mean)", run_dir, e.what()));
+      if (first_error.empty()) first_error = e.what();
+      continue;
+    }
+    if (!f.aniso) r.problems.push_back(f.aniso_problem);
+    const double nan = std::nan("");
+    const Anisotropy3 a = f.aniso.value_or(Anisotropy3{});
+    const bool ok = f.aniso.has_value();
+    const std::vector<double> v = {ok ? a.a_c() : nan, ok ? a.a_n() : nan, ok ? a.a_t() : nan,
+                                   ok ? a.sum_2_5() : nan, ok ? a.sum_2_5_tensor() : nan,
+                                   f.stress.q_over_p(), f.stress.q_vm() / f.stress.p(),
+                                   f.stress.mu(), f.sliding,
+                                   f.connectivity ? f.connectivity->z : nan,
+                                   f.connectivity ? f.connectivity->non_floating : nan};
+    for (std::size_t i = 0; i < v.size(); ++i) per[i].push_back(v[i]);
+    diff.push_back(v[3] - v[5]);  // sum_2_5 - q_over_p
+    r.files.push_back(fs::path(f.file).filename().string());
+    r.bearing += static_cast<double>(f.physical_contacts);
+  }
+  if (r.files.empty())
+    throw AnalysisError(fmt::format("none of the {} contact snapshots in the steady window could be read (first: {})",
+                                    picks.size(), first_error));
+  r.bearing /= static_cast<double>(r.files.size());
+  for (const auto& x : per) r.mean.push_back(mean_sem(x));
+  const double qp = r.of("q_over_p").v;
+  r.check_rel = (r.of("sum_2_5").v - qp) / qp;
+  r.check_rel_err = mean_sem(diff).err / std::abs(qp);
+  return r;
+}
+
 std::pair<double, double> parse_range(const std::string& s) {
   const auto colon = s.find(':');
   auto bad = [&] { return AnalysisError(fmt::format("window '{}' is not of the form a:b with a < b", s)); };
@@ -272,6 +337,11 @@ std::pair<double, double> resolve_window(const std::string& spec, std::span<cons
   if (x.empty()) throw AnalysisError(fmt::format("window '{}': the series has no rows", spec));
   const double x0 = x.front(), span = x.back() - x.front();
   return {x0 + f.first / 100 * span, x0 + f.second / 100 * span};
+}
+
+std::optional<std::pair<double, double>> window_range(const std::string& spec, std::span<const double> x) {
+  if (spec.empty()) return std::nullopt;
+  return resolve_window(spec, x);
 }
 
 }  // namespace cda

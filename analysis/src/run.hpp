@@ -15,6 +15,7 @@
 #include "steady.hpp"
 #include "stress.hpp"
 #include "table.hpp"
+#include "trends.hpp"
 
 namespace cda {
 
@@ -130,6 +131,36 @@ struct WindowSnapshots {
 WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& series,
                                     const std::string& x_column, const Window& w);
 
+// The per-snapshot quantities of a 3D run's fabric, in the order of the
+// report's fabric.csv (each followed by its _err there): the
+// spherical-harmonic anisotropies a_c, a_n, a_t and (2/5) sum a (from the
+// harmonics and from the tensors; fabric3.hpp), q/p with q = (s1 - s3)/3,
+// von Mises' q/p, mu = -sxy/syy, the sliding share, z and the share of
+// non-floating particles.
+extern const std::vector<std::string> kFabric3Columns;
+
+// A 3D run's fabric over its steady window w: each kFabric3Columns
+// quantity's mean +- sem over the contact snapshots inside w
+// (snapshots_in_window), or the last snapshot's value alone (err nan) when
+// w is null or holds fewer than 2 snapshots (`alone` says why).
+// check_rel = ((2/5) sum a - q/p)/(q/p) of the means, its error the sem of
+// the per-snapshot differences over |q/p| (paired: their common fluctuation
+// cancels). In a window, a snapshot that cannot be read is left out and
+// named in `problems`, as is a failed anisotropy fit (its a columns nan,
+// skipped by the means). Throws AnalysisError when no snapshot can be read.
+struct WindowFabric3 {
+  std::vector<Val> mean;  // per kFabric3Columns
+  double check_rel = std::nan(""), check_rel_err = std::nan("");
+  std::vector<std::string> files;  // the snapshots used, in order
+  double bearing = 0;              // force-bearing contacts per snapshot, mean
+  bool averaged = false;           // false: the last snapshot alone
+  std::string alone;               // why, when not averaged
+  std::vector<std::string> problems;
+  const Val& of(const std::string& column) const;  // throws for an unknown column
+};
+WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, const std::string& x_column,
+                             const Window* w);
+
 // The column that is mu in the rheology of a run of this dimension: 2D
 // q_over_p (sin phi of the Mohr circle, method.md §11), 3D
 // shear_stress_ratio (-sigma_xy/sigma_yy; the 3D q_over_p is von Mises').
@@ -144,5 +175,8 @@ std::pair<double, double> parse_range(const std::string& s);
 // strain. Throws AnalysisError naming the spec when it is neither, or when
 // x is empty.
 std::pair<double, double> resolve_window(const std::string& spec, std::span<const double> x);
+// The same for an optional --window: nullopt when spec is empty (the
+// steady window is then detected).
+std::optional<std::pair<double, double>> window_range(const std::string& spec, std::span<const double> x);
 
 }  // namespace cda

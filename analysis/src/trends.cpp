@@ -35,8 +35,7 @@ SteadyRun steady_run(const std::string& run_dir, const std::string& window = "")
   s.x = default_x_column(s.series);
   const std::string mu = mu_column(run_dimension(run_dir));  // 3D: shear_stress_ratio
   const std::string col = s.series.has(mu) ? mu : "packing_fraction";
-  std::optional<std::pair<double, double>> range;
-  if (!window.empty()) range = resolve_window(window, s.series.column(s.x));
+  const auto range = window_range(window, s.series.column(s.x));
   const auto r = run_steady(run_dir, s.series, col, s.x, range);
   s.w = r.stats.window;
   s.main = r.stats;
