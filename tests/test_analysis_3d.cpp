@@ -473,17 +473,72 @@ void write_snapshot3(const fs::path& dir, int num, const Forms& F, std::size_t N
   write_particles((dir / fmt::format("spheres_{:05d}.vtp", num)).string(), ps);
 }
 
+// Particle snapshots for shear_profile (run.hpp): L_y = 0.01 (1 + 0.02
+// strain) (series.csv's cell_height, so L at a snapshot is interpolated),
+// spheres_NNNNN.vtp at the given strains with spheres.pvd (time = strain /
+// gd), each of 5 layers holding 40 particles placed symmetrically about its
+// centre, so a layer's mean y is its centre exactly and the expected rates
+// follow by hand. v_x(y) for y in [0, L): homogeneous (v = gd y), or, where
+// plug[k], all the shear in [0, 0.6 L) and the layers above a rigid plug at
+// v = gd L (the value the Lees-Edwards image of y = 0 has, so the profile is
+// periodic). Every third particle is written as its image at y + L (v_x +
+// gd L), every third + 1 at y - L, so the unwrapping is exercised; in odd
+// snapshots the profile is moved up by plug_shift layers (a band that
+// moves).
+constexpr double kL0 = 0.01;
+double cell_height_at(double strain) { return kL0 * (1 + 0.02 * strain); }
+
+double v_profile(double y, double L, double gd, bool plug) {
+  if (!plug) return gd * y;
+  const double yb = 0.6 * L;
+  return y < yb ? gd * y / 0.6 : gd * L;
+}
+
+void write_profile_snapshots(const fs::path& dir, double gd, const std::vector<double>& strains,
+                             const std::vector<bool>& plug, int plug_shift = 0) {
+  std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+  const int n = 5, m = 40;
+  for (std::size_t k = 0; k < strains.size(); ++k) {
+    const double L = cell_height_at(strains[k]);
+    const double shift = (k % 2 == 1) ? plug_shift * L / n : 0.0;
+    ParticleSet ps;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < m; ++j) {
+        Particle p;
+        p.id = static_cast<int>(ps.size());
+        p.radius = 1e-4;
+        const double y = (i + (j + 0.5) / m) * L / n;  // in [0, L)
+        double ys = y - shift, off = 0;                 // the moved profile, back in [0, L)
+        if (ys < 0) ys += L, off = -gd * L;
+        p.vx = v_profile(ys, L, gd, plug[k]) + off;
+        p.y = y;
+        p.x = 1e-3 * j;
+        p.z = 1e-3 * i;
+        const int img = (p.id % 3 == 0) ? 1 : (p.id % 3 == 1 ? -1 : 0);  // a Lees-Edwards image
+        p.y += img * L;
+        p.vx += img * gd * L;
+        ps.push_back(p);
+      }
+    write_particles((dir / fmt::format("spheres_{:05d}.vtp", k)).string(), ps);
+    pvd += fmt::format("    <DataSet timestep=\"{:.17g}\" group=\"\" part=\"0\" file=\"spheres_{:05d}.vtp\"/>\n",
+                       strains[k] / gd, k);
+  }
+  std::ofstream(dir / "spheres.pvd") << pvd + "  </Collection>\n</VTKFile>\n";
+}
+
 void write_run3(const fs::path& dir, const Run3Spec& s) {
   fs::create_directories(dir);
   synth::Normal G(s.seed);
   double e = G();
   std::ofstream csv(dir / "series.csv");
-  csv << "step,time,strain,shear_rate,shear_stress_ratio,q_over_p,inertial_number,packing_fraction,z,p\n";
+  csv << "step,time,strain,shear_rate,cell_height,shear_stress_ratio,q_over_p,inertial_number,packing_fraction,z,"
+         "p\n";
   for (int i = 0; i < s.rows; ++i) {
     const double gamma = 0.01 * i;
     const double mu = s.mu + s.transient * std::exp(-gamma / 0.15) + s.drift * gamma + s.noise * e;
-    csv << fmt::format("{},{:.10g},{:.10g},{},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},100\n", i, gamma / s.rate, gamma,
-                       s.rate, mu, mu + s.q_offset, s.I, 0.6 - 0.3 * s.I + 0.002 * e, 4.5 + 0.05 * e);
+    csv << fmt::format("{},{:.10g},{:.10g},{},{:.10g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},100\n", i, gamma / s.rate,
+                       gamma, s.rate, cell_height_at(gamma), mu, mu + s.q_offset, s.I, 0.6 - 0.3 * s.I + 0.002 * e,
+                       4.5 + 0.05 * e);
     e = 0.5 * e + std::sqrt(0.75) * G();
   }
   std::ofstream(dir / "scene.toml") << fmt::format(
@@ -923,8 +978,46 @@ TEST(Commands3, CohesionFitOnThreeDRuns) {
   const auto fitted = read_fit_toml(toml.string());
   const auto& params = fitted.models.at("cohesion").params;
   EXPECT_NEAR(params.at("k0").value, f["k0"], 1e-6 * std::abs(f["k0"]));
-  const Table data = Table::read_csv((d.parent_path() / "cohesion3_out" / "cohesion_data.csv").string());
+  const Table data = Table::read_csv((d.parent_path() / "cohesion3_out" / "cohesion_data.csv").string(), true);
   EXPECT_TRUE(data.has("mu0"));
+  EXPECT_TRUE(std::isnan(data.column("rate_min").at(0)));  // no particle snapshots: not measured (nan)
+  // Its data table fed back with --table (rate_min nan: read) gives the same
+  // fit; a nan where the fit reads is refused, naming line and column.
+  {
+    const auto csv = d.parent_path() / "cohesion3_out" / "cohesion_data.csv";
+    const auto tt = d.parent_path() / "cohesion3_table.toml";
+    const auto back = cdtest::run_command(
+        fmt::format("{} fit cohesion --table {} --toml {}", exe.string(), csv.string(), tt.string()));
+    ASSERT_EQ(back.code, 0) << back.out;
+    EXPECT_NEAR(read_fit_toml(tt.string()).models.at("cohesion").params.at("k0").value, f["k0"],
+                1e-6 * std::abs(f["k0"]));
+    std::ifstream in(csv);
+    std::string header, row, rest((std::istreambuf_iterator<char>(in)), {});
+    std::istringstream lines(rest);
+    std::getline(lines, header);
+    std::getline(lines, row);
+    auto fields = row;
+    std::size_t pos = 0;
+    for (int k = 0; k < 7; ++k) pos = fields.find(',', pos) + 1;  // the 8th field: c_over_p
+    fields.replace(pos, fields.find(',', pos) - pos, "nan");
+    const auto bad = d.parent_path() / "cohesion3_bad.csv";
+    std::ofstream(bad) << header << "\n" << fields << "\n";
+    const auto refused = cdtest::run_command(fmt::format("{} fit cohesion --table {}", exe.string(), bad.string()));
+    EXPECT_NE(refused.code, 0) << refused.out;
+    EXPECT_NE(refused.out.find("line 2, column 'c_over_p': not a finite number"), std::string::npos) << refused.out;
+  }
+  // The collapse: every run's c/p/eta at its I_c = I/(1 + alpha eta)^(1/2)
+  // (fitted alpha) on the one curve k0/(1 - beta ln(1 - I_c)) of the fitted
+  // k0, beta (synth's model at eta = 1, alpha = 0), within 4 error bars.
+  const Table col = Table::read_csv((d.parent_path() / "cohesion3_out" / "cohesion_collapse.csv").string(), true);
+  ASSERT_EQ(col.rows(), 12u);
+  for (std::size_t i = 0; i < col.rows(); ++i) {
+    const double ic = col.column("I_c")[i], eta_i = col.column("eta")[i];
+    const double I_i = ic * std::sqrt(1 + params.at("alpha").value * eta_i);
+    EXPECT_NEAR(col.column("c_over_p_per_eta")[i],
+                synth::cohesion_model(params.at("k0").value, params.at("beta").value, 0, 1, ic),
+                4 * col.column("c_over_p_per_eta_err")[i]) << "eta " << eta_i << " I " << I_i;
+  }
   // The report of the campaign: its cohesive section makes the same fit.
   const auto rep_dir = d.parent_path() / "cohesion3_report";
   fs::remove_all(rep_dir);
@@ -936,6 +1029,36 @@ TEST(Commands3, CohesionFitOnThreeDRuns) {
   std::ifstream html(rep_dir / "index.html");
   const std::string page((std::istreambuf_iterator<char>(html)), {});
   EXPECT_NE(page.find("μ0(I)"), std::string::npos) << "the page names the 3D construction";
+  // A banded cohesive run (its particle snapshots hold a rigid plug) with a
+  // c/p far off the model: --exclude-banded leaves it out, so the fit is the
+  // one above to round-off; without the flag it pulls k0 away.
+  {
+    Run3Spec s;
+    s.I = 0.05;
+    s.mu = synth::mu_of_I(mu1, mu2, I0, s.I) + 3 * synth::cohesion_model(k0, beta, alpha, 3, s.I);
+    s.seed = seed++;
+    s.extra_scene = scene(3);
+    const auto dir = d / "eta_3_I_0.05_banded";
+    write_run3(dir, s);
+    write_profile_snapshots(dir, s.rate, {1.5, 2.0, 2.5, 2.9}, {true, true, true, true});
+    const auto p = steady_point(dir.string());
+    EXPECT_NEAR(p.rate_min, 0, 1e-9);
+    EXPECT_TRUE(p.banded());
+    EXPECT_FALSE(std::isfinite(steady_point((d / "eta_3_I_0.25").string()).rate_min));  // no snapshots
+    const auto tx = d.parent_path() / "cohesion3_x.toml";
+    const auto x = cdtest::run_command(fmt::format("{} fit cohesion {} --exclude-banded --toml {}", exe.string(),
+                                                   d.string(), tx.string()));
+    ASSERT_EQ(x.code, 0) << x.out;
+    EXPECT_NE(x.out.find("BANDED (left out of the fit: --exclude-banded)"), std::string::npos) << x.out;
+    EXPECT_NEAR(read_fit_toml(tx.string()).models.at("cohesion").params.at("k0").value, f["k0"],
+                1e-6 * std::abs(f["k0"]));
+    const auto ti = d.parent_path() / "cohesion3_i.toml";
+    const auto in = cdtest::run_command(
+        fmt::format("{} fit cohesion {} --toml {}", exe.string(), d.string(), ti.string()));
+    ASSERT_EQ(in.code, 0) << in.out;
+    EXPECT_GT(std::abs(read_fit_toml(ti.string()).models.at("cohesion").params.at("k0").value - f["k0"]),
+              3 * f.err("k0"));
+  }
   // A 2D run among the 3D ones: one fit mixes no dimensions.
   synth::RunSpec s2;
   synth::write_run(d / "z_2d", s2);
@@ -950,4 +1073,108 @@ TEST(Commands3, CohesionFitOnThreeDRuns) {
   } catch (const AnalysisError& e) {
     EXPECT_NE(std::string(e.what()).find("mixes no dimensions"), std::string::npos) << e.what();
   }
+}
+
+// ---------------------------------------------------------------------------
+// shear_profile (run.hpp): the local shear rate across the layers of a
+// periodic Lees-Edwards run, on synthetic runs (write_profile_run).
+namespace {
+
+constexpr double kGd = 50;
+
+// A run for shear_profile alone: series.csv (time, strain, shear_rate =
+// kGd, cell_height unless series_cell is false) and write_profile_snapshots.
+void write_profile_run(const fs::path& dir, const std::vector<double>& strains, const std::vector<bool>& plug,
+                       int plug_shift = 0, bool series_cell = true) {
+  fs::create_directories(dir);
+  std::ofstream csv(dir / "series.csv");
+  csv << (series_cell ? "step,time,strain,shear_rate,cell_height,shear_stress_ratio\n"
+                      : "step,time,strain,shear_stress_ratio\n");
+  for (int i = 0; i <= 500; ++i) {
+    const double g = 0.01 * i;
+    if (series_cell)
+      csv << fmt::format("{},{:.10g},{:.10g},{},{:.10g},0.4\n", i, g / kGd, g, kGd, cell_height_at(g));
+    else
+      csv << fmt::format("{},{:.10g},{:.10g},0.4\n", i, g / kGd, g);
+  }
+  std::ofstream(dir / "scene.toml") << "dimension = 3\n[shear]\ninertial_number = 0.01\n";
+  write_profile_snapshots(dir, kGd, strains, plug, plug_shift);
+}
+
+Window strain_window(const Table& series, double a, double b) {
+  return window_from_range(series.column("strain"), a, b);
+}
+
+}  // namespace
+
+TEST(ShearProfile, HomogeneousShearGivesOneInEveryGapWhateverTheImages) {
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "profile_homog");
+  // a plugged snapshot at strain 0.5, outside the window [1, 4]: left out
+  write_profile_run(dir, {0.5, 1.3, 2.7, 3.9}, {true, false, false, false});
+  const auto series = read_series(dir.string());
+  const auto pr = shear_profile(dir.string(), series, "strain", strain_window(series, 1, 4), 5);
+  ASSERT_EQ(pr.snapshots, 3u);
+  ASSERT_EQ(pr.rate.size(), 5u);
+  for (const auto& r : pr.rate) EXPECT_NEAR(r.v, 1.0, 1e-9);  // round-off of the layer means
+  EXPECT_NEAR(pr.rate_min.v, 1.0, 1e-9);
+  EXPECT_NEAR(pr.max_rate.v, 1.0, 1e-9);
+  EXPECT_NEAR(pr.x.front(), 1.3, 1e-9);
+}
+
+TEST(ShearProfile, RigidPlugGivesTheHandComputedRates) {
+  // shear in [0, 0.6 L) at gd/0.6, layers 3 and 4 rigid: by hand, with layer
+  // means at the centres (i + 1/2) L/5, s = 1/0.6 in gaps 0-1 and 1-2,
+  // 5 (1 - 0.5/0.6) = 5/6 in gap 2-3, 0 in 3-4, and 5 (0.1/0.6) = 5/6 across
+  // the boundary (sum 5).
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "profile_plug");
+  write_profile_run(dir, {1.0, 2.0, 3.0}, {true, true, true});
+  const auto series = read_series(dir.string());
+  const auto pr = shear_profile(dir.string(), series, "strain", strain_window(series, 0.5, 5), 5);
+  ASSERT_EQ(pr.snapshots, 3u);
+  const double want[5] = {1 / 0.6, 1 / 0.6, 5.0 / 6, 0, 5.0 / 6};
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(pr.rate[i].v, want[i], 1e-9) << "gap " << i;
+  EXPECT_NEAR(pr.rate_min.v, 0, 1e-9);
+  EXPECT_LT(pr.rate_min.v, kBandedRateMin);
+  EXPECT_NEAR(pr.max_rate.v, 1 / 0.6, 1e-9);
+
+  // the same plug moved by 2 layers in every other snapshot: the window's
+  // mean rates smear it (no gap stays at 0) while max_rate still holds it
+  const auto dir2 = cdtest::scratch_dir("test_analysis_3d", "profile_moving");
+  write_profile_run(dir2, {1.0, 2.0, 3.0, 4.0}, {true, true, true, true}, 2);
+  const auto s2 = read_series(dir2.string());
+  const auto moving = shear_profile(dir2.string(), s2, "strain", strain_window(s2, 0.5, 5), 5);
+  EXPECT_GT(moving.rate_min.v, 0.3);
+  EXPECT_NEAR(moving.max_rate.v, 1 / 0.6, 1e-9);
+}
+
+TEST(ShearProfile, RefusesWhatItCannotMeasure) {
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "profile_bad");
+  write_profile_run(dir, {1.0, 2.0}, {false, false}, 0, /*series_cell=*/false);
+  const auto series = read_series(dir.string());
+  try {
+    shear_profile(dir.string(), series, "strain", strain_window(series, 0.5, 5), 5);
+    ADD_FAILURE() << "no cell_height: accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_NE(std::string(e.what()).find("cell_height"), std::string::npos) << e.what();
+  }
+  const auto ok = cdtest::scratch_dir("test_analysis_3d", "profile_one");
+  write_profile_run(ok, {1.0, 2.0}, {false, false});
+  const auto s = read_series(ok.string());
+  try {
+    shear_profile(ok.string(), s, "strain", strain_window(s, 1.5, 5), 5);  // one snapshot in it
+    ADD_FAILURE() << "one snapshot: accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_NE(std::string(e.what()).find("2 needed"), std::string::npos) << e.what();
+  }
+  // the command: banded runs are named, homogeneous ones not
+  const auto plug = cdtest::scratch_dir("test_analysis_3d", "profile_cli_plug");
+  write_profile_run(plug, {1.0, 2.0, 3.0}, {true, true, true});
+  const auto rp = cdtest::run_command(fmt::format("{} profile {} --window 0.5:5", exe.string(), plug.string()));
+  EXPECT_EQ(rp.code, 0) << rp.out;
+  EXPECT_NE(rp.out.find("banded"), std::string::npos) << rp.out;
+  const auto rh = cdtest::run_command(fmt::format("{} profile {} --window 0.5:5", exe.string(), ok.string()));
+  EXPECT_EQ(rh.code, 0) << rh.out;
+  EXPECT_EQ(rh.out.find("banded"), std::string::npos) << rh.out;
+  const auto bad = cdtest::run_command(fmt::format("{} profile {} --layers 1", exe.string(), ok.string()));
+  EXPECT_NE(bad.code, 0) << bad.out;
 }

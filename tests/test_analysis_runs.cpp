@@ -235,7 +235,7 @@ TEST(AnalysisRuns, CohesionPointsAreWrittenWhenTheModelIsRefused) {
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("refused"), std::string::npos) << r.out;
   ASSERT_TRUE(fs::exists(out / "cohesion_data.csv")) << r.out;
-  const auto t = Table::read_csv((out / "cohesion_data.csv").string());
+  const auto t = Table::read_csv((out / "cohesion_data.csv").string(), true);
   ASSERT_EQ(t.rows(), 2u);
   for (std::size_t i = 0; i < 2; ++i)  // c/p = 0.1 eta within the synthetic noise (4 error bars)
     EXPECT_NEAR(t.column("c_over_p")[i], 0.1 * t.column("eta")[i], 4 * t.column("c_over_p_err")[i]);

@@ -141,6 +141,16 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   fabric->add_option("--out", out, "folder for the angular profiles and polar plots");
 
+  // profile
+  auto* profile = app.add_subcommand("profile", "is the shear homogeneous? local shear rate across the layers of a "
+                                                "periodic shear run, over its steady window (run.hpp shear_profile)");
+  int layers = 5;
+  profile->add_option("run", run, "run folder (series.csv, particle snapshots and their .pvd)")->required();
+  profile->add_option("--layers", layers, "layers across the gradient direction y")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  profile->add_option("--window", window, "as steady's --window (default: the detected steady window of mu)");
+
   // fit
   auto* fit = app.add_subcommand("fit", "rheology fits (method.md section 11)");
   fit->require_subcommand(1);
@@ -172,6 +182,10 @@ int main(int argc, char** argv) {
   coh->add_option("--toml", toml_out, "write the fit parameters to this TOML file");
   coh->add_option("--window", window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
                                       "run's span of it (default: detected per run)");
+  bool exclude_banded = false;
+  coh->add_flag("--exclude-banded", exclude_banded,
+                "leave the cohesive runs whose shear is banded (profile's rate_min below 0.5: not a homogeneous "
+                "flow at the run's I) out of the model fit; they stay in the data and the plot (open circles)");
   auto* dil = fit->add_subcommand(
       "dilatancy",
       "sin phi = sin phi_c + sin psi over the rows of shear runs (transient and steady), sin phi = q/p, "
@@ -270,6 +284,23 @@ int main(int argc, char** argv) {
         if (!plot_series(out, "series_" + column, series, x, column, &r.stats.window))
           fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", out);
       }
+    } else if (profile->parsed()) {
+      const auto series = read_series(run);
+      const std::string x = default_x_column(series);
+      const auto r = run_steady(run, series, mu_column(run_dimension(run)), x, window_range(window, series.column(x)));
+      const auto& w = r.stats.window;
+      const auto pr = shear_profile(run, series, x, w, layers);
+      fmt::print("window     {} {:.4g} to {:.4g}: {} particle snapshots\n", x, w.x_begin, w.x_end, pr.snapshots);
+      fmt::print("local shear rate / mean rate between layer centres (1: homogeneous), mean +- sem over them:\n");
+      for (int i = 0; i < layers; ++i)
+        fmt::print("  gap {:>3}-{:<3} {:.3f} +- {:.3f}{}\n", i, (i + 1) % layers, pr.rate[i].v, pr.rate[i].err,
+                   i + 1 == layers ? "  (across the periodic boundary)" : "");
+      fmt::print("rate_min   {:.3f} +- {:.3f}{}\n", pr.rate_min.v, pr.rate_min.err,
+                 pr.rate_min.v < kBandedRateMin ? fmt::format("  banded: below {} (a layer moves nearly as a rigid "
+                                                              "plug; the run's I is not the local one)",
+                                                              kBandedRateMin)
+                                                : std::string());
+      fmt::print("max_rate   {:.3f} +- {:.3f} (per snapshot, then averaged)\n", pr.max_rate.v, pr.max_rate.err);
     } else if (fabric->parsed() && run_dimension(run) == 3) {
       if (!out.empty())
         throw AnalysisError(fmt::format("fabric --out (polar plots of the angular profiles) is 2D only: '{}' is "
@@ -363,7 +394,17 @@ int main(int argc, char** argv) {
     } else if (coh->parsed()) {
       if (!table.empty()) {
         if (!runs.empty()) throw AnalysisError("fit cohesion: give run folders or --table, not both");
-        const auto t = Table::read_csv(table);
+        // cohesion_data.csv of an earlier fit may be given: its rate_min is
+        // nan for runs without particle snapshots, so nan is read, and
+        // refused in the columns the fit uses.
+        const auto t = Table::read_csv(table, true);
+        for (const char* c : {"eta", "I", "c_over_p", "c_over_p_err"}) {
+          if (!t.has(c)) continue;
+          const auto& v = t.column(c);
+          for (std::size_t i = 0; i < v.size(); ++i)
+            if (!std::isfinite(v[i]))
+              throw InputError(fmt::format("'{}' line {}, column '{}': not a finite number", table, i + 2, c));
+        }
         const auto r = fit_cohesion(t.column("eta"), t.column("I"), t.column("c_over_p"),
                                     col_or_empty(t, "c_over_p_err"));
         print_fit(r, cohesion());
@@ -388,20 +429,28 @@ int main(int argc, char** argv) {
                      cohesion_mu_column(dim), cohesion_formula(dim));
         fmt::print("reference: {} eta = 0 runs, {}(I) by {}\n", ref_pts.size(), ref_name,
                    ref.uses_fit() ? "the mu(I) fit" : "interpolation in ln I");
+        // rate_min of shear_profile: is the run's shear homogeneous?
+        const auto homogeneity = [](const SteadyPoint& p) {
+          if (!std::isfinite(p.rate_min)) return std::string(", rate_min n/a (no particle snapshots to profile)");
+          return fmt::format(", rate_min = {:.2f} +- {:.2f}{}", p.rate_min, p.rate_min_err,
+                             p.banded() ? " BANDED" : "");
+        };
         for (const auto& p : ref.points())
-          fmt::print("  {}: I = {:.4g} +- {:.2g}, {} = {:.4f} +- {:.4f}\n", p.run, p.I, p.I_err, ref_name, p.mu,
-                     p.mu_err);
+          fmt::print("  {}: I = {:.4g} +- {:.2g}, {} = {:.4f} +- {:.4f}{}\n", p.run, p.I, p.I_err, ref_name, p.mu,
+                     p.mu_err, homogeneity(p));
         if (ref.uses_fit()) print_fit(ref.fit(), mu_of_I());
         std::vector<CohesionPoint> pts;
         std::vector<double> eta, I, c, ce;
         for (const auto& p : coh_pts) {
           const auto cp = cohesion_point(p, ref);
           fmt::print("{}: eta = {:g}, I = {:.4g} +- {:.2g} (imposed {:.4g}), {} = {:.4f} +- {:.4f}, "
-                     "{} = {:.4f} +- {:.4f}{}, c/p = {:.4f} +- {:.4f}\n",
+                     "{} = {:.4f} +- {:.4f}{}, c/p = {:.4f} +- {:.4f}{}{}\n",
                      p.run, p.eta, p.I, p.I_err, p.I_imposed, dim == 3 ? "mu" : "q/p", p.mu, p.mu_err, ref_name,
-                     cp.ref.sin_phi, cp.ref.err,
-                     cp.ref.extrapolated ? " (extrapolated)" : "", cp.c_over_p, cp.c_over_p_err);
+                     cp.ref.sin_phi, cp.ref.err, cp.ref.extrapolated ? " (extrapolated)" : "", cp.c_over_p,
+                     cp.c_over_p_err, homogeneity(p),
+                     exclude_banded && p.banded() ? " (left out of the fit: --exclude-banded)" : "");
           pts.push_back(cp);
+          if (exclude_banded && p.banded()) continue;
           eta.push_back(p.eta);
           I.push_back(p.I);
           c.push_back(cp.c_over_p);

@@ -40,6 +40,13 @@ SteadyPoint steady_point(const std::string& run_dir, const std::string& window) 
   p.mu_err = s.stats.error();
   p.I = si.mean;
   p.I_err = si.err;
+  try {
+    const auto pr = shear_profile(run_dir, series, x, s.stats.window, 5);
+    p.rate_min = pr.rate_min.v;
+    p.rate_min_err = pr.rate_min.err;
+  } catch (const AnalysisError& e) {
+    p.profile_problem = e.what();
+  }
   return p;
 }
 
@@ -122,6 +129,8 @@ SinPhiReference::Value SinPhiReference::at(double I, double I_err) const {
   return v;
 }
 
+bool SteadyPoint::banded() const { return rate_min < kBandedRateMin; }
+
 CohesionPoint cohesion_point(const SteadyPoint& p, const SinPhiReference& ref) {
   CohesionPoint c;
   c.run = p;
@@ -149,12 +158,14 @@ bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts
   fs::create_directories(dir);
   const bool d3 = !pts.empty() && pts.front().run.dim == 3;
   Table data({"eta", "I", "I_err", d3 ? "mu" : "q_over_p", d3 ? "mu_err" : "q_over_p_err", d3 ? "mu0" : "sin_phi",
-              d3 ? "mu0_err" : "sin_phi_err", "c_over_p", "c_over_p_err", "extrapolated"});
+              d3 ? "mu0_err" : "sin_phi_err", "c_over_p", "c_over_p_err", "extrapolated", "rate_min",
+              "rate_min_err", "banded"});
   std::set<double> etas;
   double lo = 1, hi = 0;
   for (const auto& c : pts) {
     data.add_row({c.run.eta, c.run.I, c.run.I_err, c.run.mu, c.run.mu_err, c.ref.sin_phi, c.ref.err, c.c_over_p,
-                  c.c_over_p_err, c.ref.extrapolated ? 1.0 : 0.0});
+                  c.c_over_p_err, c.ref.extrapolated ? 1.0 : 0.0, c.run.rate_min, c.run.rate_min_err,
+                  c.run.banded() ? 1.0 : 0.0});
     etas.insert(c.run.eta);
     lo = std::min(lo, c.run.I);
     hi = std::max(hi, c.run.I);
@@ -167,21 +178,29 @@ bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts
   const Model m = cohesion();
   std::string plot = "plot ";
   int k = 0;
+  bool banded_titled = false;
   for (double eta : etas) {
     if (k) curves += "\n\n";
     for (int i = 0; r && i <= 100; ++i) {
       const double x[2] = {eta, lo * std::pow(hi / lo, i / 100.0)};
       curves += fmt::format("{},{}\n", x[1], predict(m, *r, x));
     }
+    // banded runs (column 13, shear_profile): open circles
     if (r)
       plot += fmt::format("{}'cohesion_fit.csv' index {} using 1:2 with lines lc {} title 'model, η = {:g}', \\\n"
-                          "     'cohesion_data.csv' every ::1 using ($1=={:.17g}?$2:1/0):8:3:9 with xyerrorbars "
-                          "pt 7 lc {} notitle",
+                          "     'cohesion_data.csv' every ::1 using ($1=={:.17g} && $13==0?$2:1/0):8:3:9 with "
+                          "xyerrorbars pt 7 lc {} notitle",
                           k ? ", \\\n     " : "", k, k + 1, eta, eta, k + 1);
     else  // no model: the points, joined per eta
       plot += fmt::format("{}'cohesion_data.csv' every ::1 using ($1=={:.17g}?$2:1/0):8:3:9 with xyerrorlines "
                           "pt 7 lc {} title 'η = {:g}'",
                           k ? ", \\\n     " : "", eta, k + 1, eta);
+    if (std::any_of(pts.begin(), pts.end(), [&](const CohesionPoint& c) { return c.run.eta == eta && c.run.banded(); })) {
+      plot += fmt::format(", \\\n     'cohesion_data.csv' every ::1 using ($1=={:.17g} && $13==1?$2:1/0):8:3:9 "
+                          "with xyerrorbars pt 6 ps 2 lc {} {}",
+                          eta, k + 1, banded_titled ? "notitle" : "title 'banded (open)'");
+      banded_titled = true;
+    }
     ++k;
   }
   {
@@ -194,7 +213,51 @@ bool plot_cohesion(const std::string& dir, const std::vector<CohesionPoint>& pts
       r ? fmt::format("k_0 = {:.4g}, β = {:.3g}, α = {:.3g}", (*r)["k0"], (*r)["beta"], (*r)["alpha"])
         : std::string("the model is not determined by these runs (fit refused)"),
       plot);
-  return plot_both(dir, "cohesion", body, 900, 500);
+  if (!plot_both(dir, "cohesion", body, 900, 500)) return false;
+  if (!r) return true;
+  // The collapse: c/p/eta against I_c = I/(1 + alpha eta)^(1/2) with the
+  // fitted alpha, and the model's one curve k0/(1 - beta ln(1 - I_c)) (its
+  // c/p at eta = 1 and I = I_c (1 + alpha)^(1/2), over eta).
+  const double alpha = (*r)["alpha"];
+  Table col({"eta", "I_c", "c_over_p_per_eta", "c_over_p_per_eta_err", "banded"});
+  double clo = 1, chi = 0;
+  for (const auto& c : pts) {
+    const double scale = 1 + alpha * c.run.eta;
+    const double ic = scale > 0 ? c.run.I / std::sqrt(scale) : std::nan("");
+    col.add_row({c.run.eta, ic, c.c_over_p / c.run.eta, c.c_over_p_err / c.run.eta, c.run.banded() ? 1.0 : 0.0});
+    if (std::isfinite(ic)) clo = std::min(clo, ic), chi = std::max(chi, ic);
+  }
+  col.write_csv((fs::path(dir) / "cohesion_collapse.csv").string());
+  std::string master = "# I_c,c_over_p_per_eta\n";
+  if (1 + alpha > 0 && clo < chi) {
+    clo /= 2;
+    chi = std::min(chi * 2, 0.99);
+    for (int i = 0; i <= 100; ++i) {
+      const double ic = clo * std::pow(chi / clo, i / 100.0);
+      const double x[2] = {1.0, ic * std::sqrt(1 + alpha)};
+      if (x[1] < 1) master += fmt::format("{},{}\n", ic, predict(m, *r, x));
+    }
+  }
+  {
+    std::ofstream out(fs::path(dir) / "cohesion_collapse_fit.csv");
+    out << master;
+  }
+  std::string cplot = "plot 'cohesion_collapse_fit.csv' using 1:2 with lines lc 0 title 'k_0/(1 − β ln(1 − I_c))'";
+  k = 0;
+  for (double eta : etas) {
+    cplot += fmt::format(", \\\n     'cohesion_collapse.csv' every ::1 using ($1=={:.17g} && $5==0?$2:1/0):3:4 with "
+                         "yerrorbars pt 7 lc {} title 'η = {:g}'",
+                         eta, k + 1, eta);
+    cplot += fmt::format(", \\\n     'cohesion_collapse.csv' every ::1 using ($1=={:.17g} && $5==1?$2:1/0):3:4 with "
+                         "yerrorbars pt 6 ps 2 lc {} notitle",
+                         eta, k + 1);
+    ++k;
+  }
+  const std::string cbody = fmt::format(
+      "set datafile separator ','\nset logscale x\nset xlabel 'I_c = I/(1 + αη)^{{1/2}}'\nset ylabel 'c/(p η)'\n"
+      "set key bottom left\nset grid\nset title 'collapse: α = {:.3g} (open: banded runs)'\n{}\n",
+      alpha, cplot);
+  return plot_both(dir, "cohesion_collapse", cbody, 900, 500);
 }
 
 }  // namespace cda

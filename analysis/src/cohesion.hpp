@@ -24,6 +24,7 @@
 // dominates (it is small next to the q/p errors when the reference runs are
 // as long as the cohesive ones).
 #pragma once
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,12 @@ struct SteadyPoint {
   double I_imposed = 0;      // nan when scene.toml has no [shear] inertial_number
   double I = 0, I_err = 0;   // measured inertial_number
   double mu = 0, mu_err = 0; // q_over_p (2D), shear_stress_ratio (3D)
+  // Is the flow homogeneous? shear_profile's rate_min over the same window
+  // with 5 layers (run.hpp), nan with `profile_problem` when the run has no
+  // particle snapshots to measure it; banded: rate_min < kBandedRateMin.
+  double rate_min = std::numeric_limits<double>::quiet_NaN(), rate_min_err = rate_min;
+  std::string profile_problem;
+  bool banded() const;
 };
 // The friction column of a run of dimension dim, and the names of the
 // reference friction and of the cohesion formula, for messages and tables.
@@ -48,7 +55,7 @@ const char* cohesion_ref_name(int dim);      // "sin phi" (2D), "mu0" (3D)
 const char* cohesion_formula(int dim);       // "c/p = (q/p - sin phi)/cos phi", "c/p = mu - mu0(I)"
 // Throws AnalysisError naming the run when series.csv or scene.toml is
 // missing, [contact] cohesion_number is absent or negative, or the run has
-// no steady window.
+// no steady window (not when the shear profile cannot be measured).
 // window: as fit mu-i's --window (run.hpp resolve_window); "": detected.
 SteadyPoint steady_point(const std::string& run_dir, const std::string& window = "");
 

@@ -8,9 +8,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <regex>
 #include <sstream>
+
+#include "scene_info.hpp"
 
 namespace fs = std::filesystem;
 
@@ -221,12 +224,12 @@ double x_at_time(const Table& series, const std::string& x_column, double t) {
 }
 
 WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& series,
-                                    const std::string& x_column, const Window& w) {
+                                    const std::string& x_column, const Window& w, const std::string& prefix) {
   WindowSnapshots ws;
-  ws.total = list_snapshots(run_dir, "contacts").size();
+  ws.total = list_snapshots(run_dir, prefix).size();
   std::vector<std::optional<double>> times;
   try {
-    times = snapshot_times(run_dir, "contacts");
+    times = snapshot_times(run_dir, prefix);
   } catch (const AnalysisError& e) {
     ws.problem = e.what();
     return ws;
@@ -240,6 +243,62 @@ WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& ser
     }
   }
   return ws;
+}
+
+ShearProfile shear_profile(const std::string& run_dir, const Table& series, const std::string& x_column,
+                           const Window& w, int layers) {
+  if (layers < 2) throw AnalysisError(fmt::format("profile: {} layers, 2 or more needed", layers));
+  for (const char* c : {"time", "cell_height", "shear_rate"})
+    if (!series.has(c))
+      throw AnalysisError(fmt::format("'{}' has no {} column: not a periodic shear run", series.source(), c));
+  const std::string prefix = particles_prefix(run_dimension(run_dir));
+  const auto ws = snapshots_in_window(run_dir, series, x_column, w, prefix);
+  if (!ws.problem.empty()) throw AnalysisError(ws.problem);
+  if (ws.index.size() < 2)
+    throw AnalysisError(fmt::format("'{}': {} of its {} {} snapshots in the window {:.4g}–{:.4g}, 2 needed", run_dir,
+                                    ws.index.size(), ws.total, prefix, w.x_begin, w.x_end));
+  const auto times = snapshot_times(run_dir, prefix);
+  const auto files = list_snapshots(run_dir, prefix);
+  ShearProfile pr;
+  pr.layers = layers;
+  const auto n = static_cast<std::size_t>(layers);
+  std::vector<std::vector<double>> per(n);
+  std::vector<double> maxima;
+  for (std::size_t j = 0; j < ws.index.size(); ++j) {
+    const auto k = static_cast<std::size_t>(ws.index[j]);
+    const double t = *times[k];
+    const double L = x_at_time(series, "cell_height", t), gd = x_at_time(series, "shear_rate", t);
+    if (!(L > 0) || !std::isfinite(gd) || gd == 0)
+      throw AnalysisError(fmt::format("'{}': cell_height {} and shear_rate {} at t = {:.6g} give no shear profile",
+                                      files[k], L, gd, t));
+    std::vector<double> sum(n, 0.0);
+    std::vector<std::size_t> count(n, 0);
+    for (const auto& p : read_particles(files[k])) {
+      const double wrap = std::floor(p.y / L);
+      const double y = p.y - wrap * L, vx = p.vx - wrap * gd * L;
+      const auto b = std::min(n - 1, static_cast<std::size_t>(std::max(0.0, y / L * static_cast<double>(n))));
+      sum[b] += vx;
+      ++count[b];
+    }
+    for (std::size_t b = 0; b < n; ++b)
+      if (count[b] == 0) throw AnalysisError(fmt::format("'{}': layer {} of {} holds no particle", files[k], b, n));
+    double most = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double vi = sum[i] / static_cast<double>(count[i]);
+      const double vnext = i + 1 < n ? sum[i + 1] / static_cast<double>(count[i + 1])
+                                     : sum[0] / static_cast<double>(count[0]) + gd * L;
+      const double s = (vnext - vi) / (gd * L / static_cast<double>(n));
+      per[i].push_back(s);
+      most = std::max(most, s);
+    }
+    maxima.push_back(most);
+    pr.x.push_back(ws.x[j]);
+  }
+  pr.snapshots = maxima.size();
+  for (const auto& v : per) pr.rate.push_back(mean_sem(v));
+  pr.rate_min = *std::min_element(pr.rate.begin(), pr.rate.end(), [](const Val& a, const Val& b) { return a.v < b.v; });
+  pr.max_rate = mean_sem(maxima);
+  return pr;
 }
 
 const std::vector<std::string> kFabric3Columns = {"a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p",

@@ -128,8 +128,46 @@ struct WindowSnapshots {
   std::size_t total = 0;  // contact snapshots of the run
   std::string problem;
 };
+// prefix: the snapshots' (contacts; particles_prefix for the bodies).
 WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& series,
-                                    const std::string& x_column, const Window& w);
+                                    const std::string& x_column, const Window& w,
+                                    const std::string& prefix = "contacts");
+
+// Is the shear homogeneous? The profile of the local shear rate across the
+// gradient direction y of a periodic (Lees-Edwards) shear run, from the
+// particle snapshots (particles_/spheres_NNNNN.vtp) in the window w. Each
+// snapshot's particles are brought into one period [0, L_y) of the images
+// (y - k L_y with velocity v_x - k gd L_y, k = floor(y/L_y): the Lees-Edwards
+// image of the particle, so nothing depends on where the cell's origin is),
+// L_y and gd the series' cell_height and shear_rate at the snapshot's time
+// (interpolated); sorted into `layers` equal layers, whose mean v_x give
+// the rate of each gap between neighbouring layer centres, the last across
+// the periodic boundary (+ gd L_y):
+//   s_i = (v_{i+1} - v_i) / (gd L_y / layers),   sum_i s_i = layers exactly,
+// so s = 1 in every gap for a homogeneous shear, and a layer moving as a
+// rigid plug gives s near 0 on both sides of it. rate: each gap's s, mean
+// +- sem over the snapshots; rate_min: the smallest of those means (with
+// its sem), the plug indicator; max_rate: the per-snapshot max of s, mean
+// +- sem (a band that wanders between snapshots still shows there). The
+// per-snapshot noise of s is about sqrt(layers/n) times the particles'
+// velocity fluctuation in units of gd L_y / layers. Throws AnalysisError
+// when the series lacks cell_height, shear_rate (not a periodic shear run)
+// or time, no particle snapshot of the window can be placed (2 needed), or
+// layers < 2 or a layer is empty.
+struct ShearProfile {
+  int layers = 0;
+  std::vector<Val> rate;  // per gap i (between layers i and i+1; the last: across the boundary)
+  Val rate_min, max_rate;
+  std::size_t snapshots = 0;
+  std::vector<double> x;  // each snapshot's x (the window's column)
+};
+ShearProfile shear_profile(const std::string& run_dir, const Table& series, const std::string& x_column,
+                           const Window& w, int layers);
+// Below this rate_min a run is flagged as banded (not a homogeneous shear):
+// half the mean rate in a gap between layers, averaged over the window.
+// Measured with 5 layers on 1000 spheres (docs/3d.md): homogeneous runs
+// have rate_min 0.6-0.9, the banded cohesive runs 0.1-0.3.
+inline constexpr double kBandedRateMin = 0.5;
 
 // The per-snapshot quantities of a 3D run's fabric, in the order of the
 // report's fabric.csv (each followed by its _err there): the
