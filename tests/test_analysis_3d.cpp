@@ -1178,3 +1178,28 @@ TEST(ShearProfile, RefusesWhatItCannotMeasure) {
   const auto bad = cdtest::run_command(fmt::format("{} profile {} --layers 1", exe.string(), ok.string()));
   EXPECT_NE(bad.code, 0) << bad.out;
 }
+
+TEST(ShearProfile, ReportFlagsBandedRuns) {
+  // A campaign of two synthetic 3D runs, one with a rigid plug in its
+  // particle snapshots: the report's steady.csv gives rate_min 0 and 1, and
+  // the page and problems name the banded one.
+  const auto camp = cdtest::scratch_dir("test_analysis_3d", "profile_report");
+  for (const bool plug : {false, true}) {
+    Run3Spec s;
+    s.seed = plug ? 7 : 8;
+    const auto dir = camp / (plug ? "b_plug" : "a_homogeneous");
+    write_run3(dir, s);
+    write_profile_snapshots(dir, s.rate, {1.5, 2.0, 2.5, 2.9}, {plug, plug, plug, plug});
+  }
+  const auto out = camp.parent_path() / "profile_report_out";
+  fs::remove_all(out);
+  const auto rep = cdtest::run_command(fmt::format("{} report {} --out {}", exe.string(), camp.string(), out.string()));
+  ASSERT_EQ(rep.code, 0) << rep.out;
+  EXPECT_NEAR(csv_value(out / "steady.csv", "rate_min", 0), 1.0, 1e-9);
+  EXPECT_NEAR(csv_value(out / "steady.csv", "rate_min", 1), 0.0, 1e-9);
+  EXPECT_NE(rep.out.find("b_plug: banded shear"), std::string::npos) << rep.out;
+  EXPECT_EQ(rep.out.find("a_homogeneous: banded"), std::string::npos) << rep.out;
+  std::ifstream html(out / "index.html");
+  const std::string page((std::istreambuf_iterator<char>(html)), {});
+  EXPECT_NE(page.find("<b>banded</b>"), std::string::npos);
+}

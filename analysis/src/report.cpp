@@ -298,7 +298,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     names.push_back(q);
     names.push_back(q + "_err");
   }
-  names.insert(names.end(), {"window_begin", "window_end", "tau_int", "n_eff"});
+  names.insert(names.end(), {"window_begin", "window_end", "tau_int", "n_eff", "rate_min", "rate_min_err"});
   names.insert(names.end(), kCostColumns.begin(), kCostColumns.end());
   Table steady(names);
   // 3D: the spherical-harmonic anisotropies (fabric3.hpp), q/p with q =
@@ -391,6 +391,24 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
           }
         }
         row.insert(row.end(), {w.x_begin, w.x_end, tau, neff});
+        // Is the shear homogeneous over the window? (run.hpp shear_profile;
+        // nan for a run without particle snapshots or not a periodic shear)
+        Val rate_min;
+        try {
+          const auto pr = shear_profile(run, series, xc, w, 5);
+          rate_min = pr.rate_min;
+          html_runs += fmt::format("<p>shear profile: rate_min = {} over {} particle snapshots{}</p>\n",
+                                   or_na(pr.rate_min.v, pr.rate_min.err), pr.snapshots,
+                                   pr.rate_min.v < kBandedRateMin
+                                       ? " — <b>banded</b>: a layer moves nearly as a rigid plug; this run's I is "
+                                         "not the local one (cdanalysis profile)"
+                                       : "");
+          if (pr.rate_min.v < kBandedRateMin)
+            sum.problems.push_back(fmt::format("{}: banded shear (rate_min {:.2f} < {}; cdanalysis profile)", run,
+                                               pr.rate_min.v, kBandedRateMin));
+        } catch (const AnalysisError&) {
+        }
+        row.insert(row.end(), {rate_min.v, rate_min.err});
         row.insert(row.end(), cost.begin(), cost.end());
         steady.add_row(row);
         pt.mu = row[1], pt.mu_err = row[2], pt.I = row[3], pt.I_err = row[4];
