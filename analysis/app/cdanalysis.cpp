@@ -377,8 +377,12 @@ int main(int argc, char** argv) {
           I.push_back(si.mean);
           mu.push_back(s.stats.mean);
           err.push_back(s.stats.error());
-          fmt::print("{}: I = {:.4g} +- {:.2g}, mu = {:.4f} +- {:.4f}\n", r, si.mean, si.err,
-                     s.stats.mean, s.stats.error());
+          const Val rm = window_rate_min(r, series, x, s.stats.window);
+          fmt::print("{}: I = {:.4g} +- {:.2g}, mu = {:.4f} +- {:.4f}{}\n", r, si.mean, si.err, s.stats.mean,
+                     s.stats.error(), rate_min_note(rm.v, rm.err));
+          if (rm.v < kBandedRateMin)
+            fmt::print(stderr, "warning: {}: banded shear (rate_min {:.2f}): its I is not the local one "
+                               "(cdanalysis profile)\n", r, rm.v);
         }
       }
       const auto r = fit_mu_I(I, mu, err);
@@ -430,11 +434,7 @@ int main(int argc, char** argv) {
         fmt::print("reference: {} eta = 0 runs, {}(I) by {}\n", ref_pts.size(), ref_name,
                    ref.uses_fit() ? "the mu(I) fit" : "interpolation in ln I");
         // rate_min of shear_profile: is the run's shear homogeneous?
-        const auto homogeneity = [](const SteadyPoint& p) {
-          if (!std::isfinite(p.rate_min)) return std::string(", rate_min n/a (no particle snapshots to profile)");
-          return fmt::format(", rate_min = {:.2f} +- {:.2f}{}", p.rate_min, p.rate_min_err,
-                             p.banded() ? " BANDED" : "");
-        };
+        const auto homogeneity = [](const SteadyPoint& p) { return rate_min_note(p.rate_min, p.rate_min_err); };
         for (const auto& p : ref.points())
           fmt::print("  {}: I = {:.4g} +- {:.2g}, {} = {:.4f} +- {:.4f}{}\n", p.run, p.I, p.I_err, ref_name, p.mu,
                      p.mu_err, homogeneity(p));

@@ -40,13 +40,9 @@ SteadyPoint steady_point(const std::string& run_dir, const std::string& window) 
   p.mu_err = s.stats.error();
   p.I = si.mean;
   p.I_err = si.err;
-  try {
-    const auto pr = shear_profile(run_dir, series, x, s.stats.window, 5);
-    p.rate_min = pr.rate_min.v;
-    p.rate_min_err = pr.rate_min.err;
-  } catch (const AnalysisError& e) {
-    p.profile_problem = e.what();
-  }
+  const Val rm = window_rate_min(run_dir, series, x, s.stats.window);
+  p.rate_min = rm.v;
+  p.rate_min_err = rm.err;
   return p;
 }
 

@@ -42,10 +42,9 @@ struct SteadyPoint {
   double I = 0, I_err = 0;   // measured inertial_number
   double mu = 0, mu_err = 0; // q_over_p (2D), shear_stress_ratio (3D)
   // Is the flow homogeneous? shear_profile's rate_min over the same window
-  // with 5 layers (run.hpp), nan with `profile_problem` when the run has no
+  // with 5 layers (run.hpp window_rate_min), nan when the run has no
   // particle snapshots to measure it; banded: rate_min < kBandedRateMin.
   double rate_min = std::numeric_limits<double>::quiet_NaN(), rate_min_err = rate_min;
-  std::string profile_problem;
   bool banded() const;
 };
 // The friction column of a run of dimension dim, and the names of the

@@ -393,20 +393,17 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         row.insert(row.end(), {w.x_begin, w.x_end, tau, neff});
         // Is the shear homogeneous over the window? (run.hpp shear_profile;
         // nan for a run without particle snapshots or not a periodic shear)
-        Val rate_min;
-        try {
-          const auto pr = shear_profile(run, series, xc, w, 5);
-          rate_min = pr.rate_min;
-          html_runs += fmt::format("<p>shear profile: rate_min = {} over {} particle snapshots{}</p>\n",
-                                   or_na(pr.rate_min.v, pr.rate_min.err), pr.snapshots,
-                                   pr.rate_min.v < kBandedRateMin
+        const Val rate_min = window_rate_min(run, series, xc, w);
+        if (std::isfinite(rate_min.v)) {
+          html_runs += fmt::format("<p>shear profile (5 layers): rate_min = {}{}</p>\n",
+                                   or_na(rate_min.v, rate_min.err),
+                                   rate_min.v < kBandedRateMin
                                        ? " — <b>banded</b>: a layer moves nearly as a rigid plug; this run's I is "
                                          "not the local one (cdanalysis profile)"
                                        : "");
-          if (pr.rate_min.v < kBandedRateMin)
+          if (rate_min.v < kBandedRateMin)
             sum.problems.push_back(fmt::format("{}: banded shear (rate_min {:.2f} < {}; cdanalysis profile)", run,
-                                               pr.rate_min.v, kBandedRateMin));
-        } catch (const AnalysisError&) {
+                                               rate_min.v, kBandedRateMin));
         }
         row.insert(row.end(), {rate_min.v, rate_min.err});
         row.insert(row.end(), cost.begin(), cost.end());

@@ -301,6 +301,19 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
   return pr;
 }
 
+std::string rate_min_note(double v, double err) {
+  if (!std::isfinite(v)) return ", rate_min n/a (no particle snapshots to profile)";
+  return fmt::format(", rate_min = {:.2f} +- {:.2f}{}", v, err, v < kBandedRateMin ? " BANDED" : "");
+}
+
+Val window_rate_min(const std::string& run_dir, const Table& series, const std::string& x_column, const Window& w) {
+  try {
+    return shear_profile(run_dir, series, x_column, w, 5).rate_min;
+  } catch (const AnalysisError&) {
+    return {};
+  }
+}
+
 const std::vector<std::string> kFabric3Columns = {"a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p",
                                                   "q_vm_over_p", "mu", "sliding", "z", "non_floating"};
 

@@ -166,9 +166,15 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
 // Below this rate_min a run is flagged as banded (not a homogeneous shear):
 // half the mean rate in a gap between layers, averaged over the window.
 // Measured with 5 layers on 1000 spheres (docs/3d.md): homogeneous runs,
-// cohesive or not, have rate_min 0.75-0.98; the eta = 10 runs at I = 0.03
+// cohesive or not, have rate_min 0.71-0.98; the eta = 10 runs at I = 0.03
 // and 0.1, 0.08 and 0.41 (a plug of one to two fifths of the cell).
 inline constexpr double kBandedRateMin = 0.5;
+// ", rate_min = v +- err" (+ " BANDED" below kBandedRateMin), or ",
+// rate_min n/a (...)" for nan: the note the fits print after each run.
+std::string rate_min_note(double v, double err);
+// The rate_min of a run's window (shear_profile, 5 layers) or nan, nan
+// when it cannot be measured (no particle snapshots, not a periodic shear).
+Val window_rate_min(const std::string& run_dir, const Table& series, const std::string& x_column, const Window& w);
 
 // The per-snapshot quantities of a 3D run's fabric, in the order of the
 // report's fabric.csv (each followed by its _err there): the
