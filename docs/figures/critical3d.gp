@@ -26,6 +26,6 @@ plot dir.'/mu_I/mu_I_fit.csv' every ::1 using 1:3:4 with filledcurves fc rgb '#c
      dir.'/mu_I/mu_I_data.csv' every ::1 using 1:2:3 with yerrorbars pt 7 ps 1.2 lc rgb 'black' title 'cdsim, 1000 spheres, μ_p = 0.4'
 set ylabel "packing fraction φ"
 set key bottom left
-plot dir.'/nu_i/nu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' title 'φ_{max} − a I (χ²/dof 32)', \
+plot dir.'/nu_i/nu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' title 'φ_{max} − a I (χ²/dof 61)', \
      dir.'/nu_i/nu_I_data.csv' every ::1 using 1:3:2:4 with xyerrorbars pt 7 ps 1.2 lc rgb 'black' title 'cdsim'
 unset multiplot
