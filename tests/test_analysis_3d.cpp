@@ -1166,6 +1166,17 @@ TEST(ShearProfile, RefusesWhatItCannotMeasure) {
   } catch (const AnalysisError& e) {
     EXPECT_NE(std::string(e.what()).find("2 needed"), std::string::npos) << e.what();
   }
+  // a wall-bounded shear has no Lees-Edwards images to unwrap: refused
+  const auto walls = cdtest::scratch_dir("test_analysis_3d", "profile_walls");
+  write_profile_run(walls, {1.0, 2.0}, {false, false});
+  std::ofstream(walls / "scene.toml") << "dimension = 3\n[shear]\nmode = \"walls\"\n";
+  try {
+    const auto sw = read_series(walls.string());
+    shear_profile(walls.string(), sw, "strain", strain_window(sw, 0.5, 5), 5);
+    ADD_FAILURE() << "walls: accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_NE(std::string(e.what()).find("mode is 'walls'"), std::string::npos) << e.what();
+  }
   // the command: banded runs are named, homogeneous ones not
   const auto plug = cdtest::scratch_dir("test_analysis_3d", "profile_cli_plug");
   write_profile_run(plug, {1.0, 2.0, 3.0}, {true, true, true});

@@ -251,7 +251,11 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
   for (const char* c : {"time", "cell_height", "shear_rate"})
     if (!series.has(c))
       throw AnalysisError(fmt::format("'{}' has no {} column: not a periodic shear run", series.source(), c));
-  const std::string prefix = particles_prefix(run_dimension(run_dir));
+  const auto scene = read_scene_info(run_dir);
+  if (scene.shear_mode && *scene.shear_mode != "periodic")
+    throw AnalysisError(fmt::format("'{}': [shear] mode is '{}': the shear profile needs a periodic (Lees-Edwards) "
+                                    "cell", scene.file, *scene.shear_mode));
+  const std::string prefix = particles_prefix(scene.dimension);
   const auto ws = snapshots_in_window(run_dir, series, x_column, w, prefix);
   if (!ws.problem.empty()) throw AnalysisError(ws.problem);
   if (ws.index.size() < 2)

@@ -151,8 +151,8 @@ WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& ser
 // +- sem (a band that wanders between snapshots still shows there). The
 // per-snapshot noise of s is about sqrt(layers/n) times the particles'
 // velocity fluctuation in units of gd L_y / layers. Throws AnalysisError
-// when the series lacks cell_height, shear_rate (not a periodic shear run)
-// or time, no particle snapshot of the window can be placed (2 needed), or
+// when the scene's [shear] mode is not periodic (walls: no Lees-Edwards
+// images), the series lacks cell_height, shear_rate or time, no particle snapshot of the window can be placed (2 needed), or
 // layers < 2 or a layer is empty.
 struct ShearProfile {
   int layers = 0;

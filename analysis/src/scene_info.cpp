@@ -57,6 +57,11 @@ SceneInfo read_scene_info(const std::string& run_dir) {
   s.pressure = number(root, "shear", "pressure", s.file);
   s.friction = number(root, "contact", "mu", s.file);
   s.solver_tol = number(root, "solver", "tol", s.file);
+  if (root.is_table() && root.contains("shear") && root.at("shear").is_table() && root.at("shear").contains("mode")) {
+    const auto& m = root.at("shear").at("mode");
+    if (!m.is_string()) throw InputError(fmt::format("'{}': [shear] mode is not a string", s.file));
+    s.shear_mode = m.as_string();
+  }
   if (root.is_table() && root.contains("particles") && root.at("particles").is_table() &&
       root.at("particles").contains("nsides")) {
     const auto& v = root.at("particles").at("nsides");

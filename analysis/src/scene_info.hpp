@@ -24,6 +24,7 @@ struct SceneInfo {
   bool nsides_mixed = false;
   std::optional<double> friction;          // [contact] mu (interparticle friction)
   std::optional<double> solver_tol;        // [solver] tol (NLGS convergence)
+  std::optional<std::string> shear_mode;   // [shear] mode (none, periodic, walls)
 };
 
 // The angularity of a shape with n sides, alpha = 2 pi/n (disks, n = 0: 0).
