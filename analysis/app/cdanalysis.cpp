@@ -296,7 +296,7 @@ int main(int argc, char** argv) {
         fmt::print("  gap {:>3}-{:<3} {:.3f} +- {:.3f}{}\n", i, (i + 1) % layers, pr.rate[i].v, pr.rate[i].err,
                    i + 1 == layers ? "  (across the periodic boundary)" : "");
       fmt::print("rate_min   {:.3f} +- {:.3f}{}\n", pr.rate_min.v, pr.rate_min.err,
-                 pr.rate_min.v < kBandedRateMin ? fmt::format("  banded: below {} (a layer moves nearly as a rigid "
+                 is_banded(pr.rate_min.v) ? fmt::format("  banded: below {} (a layer moves nearly as a rigid "
                                                               "plug; the run's I is not the local one)",
                                                               kBandedRateMin)
                                                 : std::string());
@@ -380,7 +380,7 @@ int main(int argc, char** argv) {
           const Val rm = window_rate_min(r, series, x, s.stats.window);
           fmt::print("{}: I = {:.4g} +- {:.2g}, mu = {:.4f} +- {:.4f}{}\n", r, si.mean, si.err, s.stats.mean,
                      s.stats.error(), rate_min_note(rm.v, rm.err));
-          if (rm.v < kBandedRateMin)
+          if (is_banded(rm.v))
             fmt::print(stderr, "warning: {}: banded shear (rate_min {:.2f}): its I is not the local one "
                                "(cdanalysis profile)\n", r, rm.v);
         }

@@ -125,7 +125,7 @@ SinPhiReference::Value SinPhiReference::at(double I, double I_err) const {
   return v;
 }
 
-bool SteadyPoint::banded() const { return rate_min < kBandedRateMin; }
+bool SteadyPoint::banded() const { return is_banded(rate_min); }
 
 CohesionPoint cohesion_point(const SteadyPoint& p, const SinPhiReference& ref) {
   CohesionPoint c;

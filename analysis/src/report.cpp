@@ -397,11 +397,11 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         if (std::isfinite(rate_min.v)) {
           html_runs += fmt::format("<p>shear profile (5 layers): rate_min = {}{}</p>\n",
                                    or_na(rate_min.v, rate_min.err),
-                                   rate_min.v < kBandedRateMin
+                                   is_banded(rate_min.v)
                                        ? " — <b>banded</b>: a layer moves nearly as a rigid plug; this run's I is "
                                          "not the local one (cdanalysis profile)"
                                        : "");
-          if (rate_min.v < kBandedRateMin)
+          if (is_banded(rate_min.v))
             sum.problems.push_back(fmt::format("{}: banded shear (rate_min {:.2f} < {}; cdanalysis profile)", run,
                                                rate_min.v, kBandedRateMin));
         }

@@ -240,6 +240,7 @@ WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& ser
     if (x >= w.x_begin && x <= w.x_end) {  // false for nan
       ws.index.push_back(static_cast<int>(k));
       ws.x.push_back(x);
+      ws.time.push_back(*times[k]);
     }
   }
   return ws;
@@ -261,7 +262,6 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
   if (ws.index.size() < 2)
     throw AnalysisError(fmt::format("'{}': {} of its {} {} snapshots in the window {:.4g}–{:.4g}, 2 needed", run_dir,
                                     ws.index.size(), ws.total, prefix, w.x_begin, w.x_end));
-  const auto times = snapshot_times(run_dir, prefix);
   const auto files = list_snapshots(run_dir, prefix);
   ShearProfile pr;
   pr.layers = layers;
@@ -270,7 +270,7 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
   std::vector<double> maxima;
   for (std::size_t j = 0; j < ws.index.size(); ++j) {
     const auto k = static_cast<std::size_t>(ws.index[j]);
-    const double t = *times[k];
+    const double t = ws.time[j];
     const double L = x_at_time(series, "cell_height", t), gd = x_at_time(series, "shear_rate", t);
     if (!(L > 0) || !std::isfinite(gd) || gd == 0)
       throw AnalysisError(fmt::format("'{}': cell_height {} and shear_rate {} at t = {:.6g} give no shear profile",
@@ -284,14 +284,15 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
       sum[b] += vx;
       ++count[b];
     }
-    for (std::size_t b = 0; b < n; ++b)
+    std::vector<double> v(n);  // the layers' mean v_x
+    for (std::size_t b = 0; b < n; ++b) {
       if (count[b] == 0) throw AnalysisError(fmt::format("'{}': layer {} of {} holds no particle", files[k], b, n));
+      v[b] = sum[b] / static_cast<double>(count[b]);
+    }
     double most = -std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < n; ++i) {
-      const double vi = sum[i] / static_cast<double>(count[i]);
-      const double vnext = i + 1 < n ? sum[i + 1] / static_cast<double>(count[i + 1])
-                                     : sum[0] / static_cast<double>(count[0]) + gd * L;
-      const double s = (vnext - vi) / (gd * L / static_cast<double>(n));
+      const double vnext = i + 1 < n ? v[i + 1] : v[0] + gd * L;  // the last gap: across the boundary
+      const double s = (vnext - v[i]) / (gd * L / static_cast<double>(n));
       per[i].push_back(s);
       most = std::max(most, s);
     }
@@ -307,7 +308,7 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
 
 std::string rate_min_note(double v, double err) {
   if (!std::isfinite(v)) return ", rate_min n/a (no particle snapshots to profile)";
-  return fmt::format(", rate_min = {:.2f} +- {:.2f}{}", v, err, v < kBandedRateMin ? " BANDED" : "");
+  return fmt::format(", rate_min = {:.2f} +- {:.2f}{}", v, err, is_banded(v) ? " BANDED" : "");
 }
 
 Val window_rate_min(const std::string& run_dir, const Table& series, const std::string& x_column, const Window& w) {

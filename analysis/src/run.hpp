@@ -125,7 +125,8 @@ double x_at_time(const Table& series, const std::string& x_column, double t);
 struct WindowSnapshots {
   std::vector<int> index;
   std::vector<double> x;
-  std::size_t total = 0;  // contact snapshots of the run
+  std::vector<double> time;  // each one's .pvd time
+  std::size_t total = 0;     // snapshots of the run
   std::string problem;
 };
 // prefix: the snapshots' (contacts; particles_prefix for the bodies).
@@ -169,6 +170,7 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
 // cohesive or not, have rate_min 0.71-0.98; the eta = 10 runs at I = 0.03
 // and 0.1, 0.08 and 0.41 (a plug of one to two fifths of the cell).
 inline constexpr double kBandedRateMin = 0.5;
+inline bool is_banded(double rate_min) { return rate_min < kBandedRateMin; }  // false for nan
 // ", rate_min = v +- err" (+ " BANDED" below kBandedRateMin), or ",
 // rate_min n/a (...)" for nan: the note the fits print after each run.
 std::string rate_min_note(double v, double err);
