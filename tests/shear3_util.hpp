@@ -14,7 +14,7 @@ inline cd::Scene shear3_prep_scene(int n) {
   cd::Scene s;
   s.dimension = 3;
   s.gravity = {0, 0, 0};
-  s.shear_mode = "periodic";
+  s.shear_mode = cd::ShearMode::Periodic;
   s.n = n;
   s.d_mean = 1e-3;
   s.size_ratio = 1.5;

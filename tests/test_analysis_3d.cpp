@@ -350,7 +350,7 @@ TEST(Stress3, SnapshotMatchesTheSeriesOfARealRun) {
   cd::Scene sc;
   sc.dimension = 3;
   sc.gravity = {0, 0, 0};
-  sc.shear_mode = "periodic";
+  sc.shear_mode = cd::ShearMode::Periodic;
   sc.n = 64;
   sc.d_mean = 0.01;
   sc.size_ratio = 1.5;

@@ -206,7 +206,7 @@ Scene cell_scene(int n) {
   Scene s;
   s.dimension = 3;
   s.gravity = {0, 0, 0};
-  s.shear_mode = "periodic";
+  s.shear_mode = cd::ShearMode::Periodic;
   s.n = n;
   s.d_mean = 0.01;
   s.size_ratio = 1.5;
@@ -313,8 +313,8 @@ TEST(Cell3Scene, UnsupportedKeysAreRefusedByName) {
   { Scene t = s; t.cell_width = 0.1; refused(t, "shear.depth"); }
   { Scene t = s; t.cell_width = t.cell_height = 0.1; t.cell_depth = 0.025; refused(t, "shear.depth = 0.025"); }
   { Scene t = s; t.cell_width = t.cell_height = t.cell_depth = 0.04; refused(t, "particles.n = 100"); }
-  { Scene t = s; t.shear_mode = "walls"; refused(t, "shear.mode"); }
-  { Scene t = s; t.shear_mode = "none"; t.cell_depth = 0.1; refused(t, "depth"); }
+  { Scene t = s; t.shear_mode = cd::ShearMode::Walls; refused(t, "shear.mode"); }
+  { Scene t = s; t.shear_mode = cd::ShearMode::None; t.cell_depth = 0.1; refused(t, "depth"); }
 }
 
 // A cdsim-style run of a cell (run3 through the shared run loop) writes the
@@ -416,7 +416,7 @@ TEST(Cell3Checkpoint, ResumesTheLeesEdwardsOffset) {
   std::printf("le_offset after 80 steps: %.6g m (cell %.4g m)\n", a.params().le_offset, a.params().cell.x());
 
   Scene box = s;
-  box.shear_mode = "none";
+  box.shear_mode = cd::ShearMode::None;
   box.gravity = {0, 0, -9.81};
   World3 d = build_world3(box);
   try {

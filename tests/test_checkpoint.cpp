@@ -36,6 +36,7 @@
 #include <fmt/format.h>
 
 #include "checkpoint.hpp"
+#include "scene.hpp"
 #include "cli_util.hpp"
 #include "world_util.hpp"
 

@@ -121,7 +121,7 @@ TEST(Cohesion3Scene, AdhesionIsEtaPDSquaredWithTheRunsMeanDiameter) {
   {
     Scene t;
     t.gravity = {0, 0};
-    t.shear_mode = "periodic";
+    t.shear_mode = cd::ShearMode::Periodic;
     t.n = 20;
     t.d_mean = 1e-3;
     t.density = 2.6;
@@ -153,7 +153,7 @@ TEST(Cohesion3Scene, BadCombinationsAreRefusedNamingTheKey) {
   { Scene t = s; t.cohesion_number = 1e300; t.pressure = 1e300; refused(t, {"f_a", "contact.cohesion_number"}); }
   {
     Scene t = prep_scene(30);
-    t.shear_mode = "none";
+    t.shear_mode = cd::ShearMode::None;
     t.pressure = 0;
     t.isotropic = false;
     t.compaction_rate = 0;

@@ -89,7 +89,7 @@ Scene nondefault() {
   s.n = 3;
   s.d_mean = 2e-3;
   s.size_ratio = 1.5;
-  s.size_dist = "uniform";
+  s.size_dist = cd::SizeDist::Uniform;
   // read from tests/data/config/diameters.txt (the file wins over a list);
   // the path is made absolute when read
   s.diameters = {1e-3, 2.5e-3, 4e-3};
@@ -107,7 +107,7 @@ Scene nondefault() {
   s.checkpoint_strain = 0.1;
   s.checkpoint_wall = 300.5;
   s.quiet = true;
-  s.shear_mode = "walls";
+  s.shear_mode = cd::ShearMode::Walls;
   s.cell_width = 0.05;
   s.cell_height = 0.02;
   s.cell_depth = 0.03;
@@ -329,7 +329,7 @@ TEST(Overrides, AreAppliedAfterTheFile) {
   EXPECT_EQ(s.mu, 0.3);
   EXPECT_EQ(s.gravity, (std::vector<double>{0.0, -1.0}));
   EXPECT_EQ(s.name, "x y");
-  EXPECT_EQ(s.size_dist, "uniform");  // a bare word (the shell ate the quotes) is a string
+  EXPECT_EQ(s.size_dist, cd::SizeDist::Uniform);  // a bare word (the shell ate the quotes) is a name
   EXPECT_EQ(s.max_iter, 7);
   EXPECT_TRUE(s.quiet);
   EXPECT_EQ(s.dt, 2e-5);  // the last one wins

@@ -17,6 +17,7 @@
 
 #include "checkpoint.hpp"
 #include "config.hpp"
+#include "run_plan.hpp"
 #include "setup.hpp"
 #include "world.hpp"
 

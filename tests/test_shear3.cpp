@@ -331,7 +331,7 @@ TEST(Shear3Cell, StartRefusesOtherSamples) {
     Scene s2;
     s2.dimension = 2;
     s2.gravity = {0, 0};
-    s2.shear_mode = "periodic";
+    s2.shear_mode = cd::ShearMode::Periodic;
     s2.n = 20;
     s2.d_mean = 1e-3;
     s2.density = 2.6;
@@ -345,7 +345,7 @@ TEST(Shear3Cell, StartRefusesOtherSamples) {
   // A 3D pile's checkpoint: no cell.
   {
     Scene pile = prep_scene(20);
-    pile.shear_mode = "none";
+    pile.shear_mode = cd::ShearMode::None;
     pile.pressure = 0;
     pile.isotropic = false;
     pile.compaction_rate = 0;
@@ -386,7 +386,7 @@ TEST(Shear3Cell, KeysWithoutWhatTheyNeedAreRefusedByName) {
   { Scene t = s; t.overlap_projection = 0.5; refused(t, "contact.overlap_projection"); }
 }
 
-// output.checkpoint_strain in 3D: the plan (2D's plan_of, shared) puts a
+// output.checkpoint_strain in 3D: the plan (core/run_plan.hpp's, shared) puts a
 // checkpoint every 0.25 of strain on series rows, and a cdsim-style run
 // (run3) to strain 0.5 leaves a checkpoint whose cell is the run's last
 // (lengths, rate, offset, strain 0.5) and whose spheres are the world's.

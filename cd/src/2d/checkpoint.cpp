@@ -11,7 +11,6 @@
 
 #include <fmt/format.h>
 
-#include "config.hpp"
 #include "output.hpp"
 
 namespace cd {
@@ -76,20 +75,6 @@ std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* tota
   w.cell = cell[0];
   if (totals) *totals = tot;
   return h.key;
-}
-
-// ---------------------------------------------------------------------------
-// Restarting a run
-
-std::uint64_t scene_key(const Scene& scene) {
-  Scene s = scene;
-  s.source.clear();
-  s.threads = 0;
-  s.quiet = false;
-  s.checkpoint_interval = 0;
-  s.checkpoint_strain = 0;
-  s.checkpoint_wall = 0;
-  return fnv1a(resolved_toml(s));
 }
 
 }  // namespace cd

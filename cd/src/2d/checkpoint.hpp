@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "checkpoint_io.hpp"
-#include "scene.hpp"
 #include "world.hpp"
 
 namespace cd {
@@ -32,15 +31,5 @@ void save_checkpoint(const std::string& path, const World& w, std::uint64_t scen
 // shear.start) a version 3 file is read too: it differs only by having no
 // totals; to resume a run, it is refused.
 std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* totals = nullptr);
-
-// ---- restarting a run (run.cpp) ----
-
-// What a checkpoint must match: a hash of the resolved scene without the keys
-// that change neither the results nor the outputs, so that a restart may
-// change them: solver.threads (results are bit-identical for any thread
-// count), output.quiet, output.checkpoint_interval, output.checkpoint_strain,
-// output.checkpoint_wall, and the scene's file name.
-std::uint64_t scene_key(const Scene& s);
-
 
 }  // namespace cd

@@ -75,7 +75,7 @@ struct ShearInterval {
 class Engine2 final : public RunEngine {
  public:
   Engine2(World& w, const Scene& s, const RunOptions& opt)
-      : w_(w), s_(s), dir_(opt.out), dump_(opt.dump_steps), shear_(s.shear_mode != "none"),
+      : w_(w), s_(s), dir_(opt.out), dump_(opt.dump_steps), shear_(s.shear_mode != ShearMode::None),
         d_mean_(mean_diameter(s)) {
     // --dump-problem: the hook sees the problem of the step being taken
     // (w.steps + 1) just before its solve.
@@ -179,39 +179,6 @@ class Engine2 final : public RunEngine {
 };
 
 }  // namespace
-
-RunPlan plan_of(const Scene& s, double dt) {
-  RunPlan p;
-  p.dt = dt;
-  p.nsteps = std::llround(run_duration(s) / dt);
-  const std::int64_t nsteps = p.nsteps;
-  // An interval in steps, >= 1; one longer than the run is the run (no
-  // overflow for huge intervals).
-  const auto steps_of = [&](double interval) {
-    const double k = interval / dt;
-    return k >= double(nsteps) ? std::max<std::int64_t>(1, nsteps)
-                               : std::max<std::int64_t>(1, std::llround(k));
-  };
-  p.every_row = steps_of(s.series_interval);
-  p.every_snap = s.snapshot_interval > 0 ? steps_of(s.snapshot_interval) : 0;
-  // Checkpoints fall on series rows, so that no row's interval spans a
-  // restart: every so much simulated time, or shear strain, rounded up to
-  // whole rows; or at the first row after checkpoint_wall seconds of wall
-  // clock. Writing one only reads the state, so when they fall (even by the
-  // clock) changes no result.
-  const auto on_rows = [&](std::int64_t k) {
-    return p.every_row * std::max<std::int64_t>(1, (k + p.every_row - 1) / p.every_row);
-  };
-  p.every_ckpt = s.checkpoint_interval > 0 ? on_rows(steps_of(s.checkpoint_interval)) : 0;
-  const double rate = shear_rate(s);
-  p.every_ckpt_strain =
-      s.checkpoint_strain > 0 && rate > 0 ? on_rows(steps_of(s.checkpoint_strain / rate)) : 0;
-  p.ckpt_wall = s.checkpoint_wall;
-  p.checkpoint_interval = s.checkpoint_interval;
-  p.checkpoint_strain = s.checkpoint_strain;
-  p.key = scene_key(s);
-  return p;
-}
 
 RunSummary run(World& w, const Scene& s, const RunOptions& opt) {
   Engine2 e(w, s, opt);

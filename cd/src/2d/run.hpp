@@ -6,16 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "checkpoint.hpp"
 #include "run_loop.hpp"
 #include "scene.hpp"
 #include "world.hpp"
 
 namespace cd {
-
-// When the scene's series rows, snapshots and checkpoints fall, in steps
-// of dt, and the key its checkpoints carry (both dimensions).
-RunPlan plan_of(const Scene& s, double dt);
 
 // Runs the world for the scene's duration. The caller has validated the
 // scene and checked the output folder; this creates it and writes into it.

@@ -59,7 +59,7 @@ struct CellParams {
 };
 
 struct WorldParams {
-  double dt = 1e-4;
+  double dt = defaults::dt;
   Vec2 gravity{0.0, 0.0};
   double mu = 0.0, mu_wall = 0.0;
   double e_n = 0.0, e_t = 0.0;
@@ -82,7 +82,7 @@ struct WorldParams {
   // on every contact whose midpoint gap is <= debond (absolute); 0: none.
   double adhesion = 0.0, debond = 0.0;
   double d_ref = 1.0;     // length scale for overlaps (mean diameter)
-  bool rotation = true;   // bodies rotate (false: translations only, every W block without 1/I)
+  bool rotation = defaults::rotation;  // bodies rotate (false: translations only, every W block without 1/I)
   CellParams cell;
   SolverParams solver;
 };

@@ -5,11 +5,9 @@
 
 #include <fmt/format.h>
 
-#include "checkpoint.hpp"
 #include "checkpoint3.hpp"
+#include "derived.hpp"
 #include "output3.hpp"
-#include "run.hpp"
-#include "setup.hpp"
 
 namespace cd {
 

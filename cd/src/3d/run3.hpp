@@ -1,6 +1,7 @@
 // A 3D run: World3 in the shared run loop (core/run_loop.hpp), with its
 // checkpoints (checkpoint3.hpp), snapshots (output3.hpp) and watchdog. The
-// plan (series rows, snapshots, checkpoints, scene key) is 2D's plan_of.
+// plan (series rows, snapshots, checkpoints, scene key) is core/run_plan.hpp's,
+// as 2D's.
 #pragma once
 #include "run_loop.hpp"
 #include "scene.hpp"

@@ -128,13 +128,13 @@ void check_scene3(const Scene& s) {
   if (s.gravity.size() != 3) fail("gravity.g: a 3D scene needs [gx, gy, gz]");
   if (s.overlap_projection != 0)
     fail("contact.overlap_projection: the overlap projection is 2D only; leave it at 0");
-  if (s.shear_mode == "periodic") {
+  if (s.shear_mode == ShearMode::Periodic) {
     check_derived(s);
     return check_cell3(with_auto_cell3(s));
   }
-  if (s.shear_mode != "none")
+  if (s.shear_mode != ShearMode::None)
     fail(fmt::format("shear.mode = \"{}\": a 3D scene is \"none\" (the box) or \"periodic\" (a "
-                     "tri-periodic cell)", s.shear_mode));
+                     "tri-periodic cell)", name_of(s.shear_mode)));
   if (s.pressure != 0 || s.inertial_number != 0 || s.isotropic || s.strain != 0 || s.dt_tp != 0 ||
       !s.start.empty() || s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0 ||
       s.cohesion_number != 0 || s.checkpoint_strain != 0)
@@ -174,7 +174,7 @@ void check_scene3(const Scene& s) {
 
 WorldParams3 world_params3(const Scene& s0) {
   check_scene3(s0);
-  const Scene s = s0.shear_mode == "periodic" ? with_auto_cell3(s0) : s0;
+  const Scene s = s0.shear_mode == ShearMode::Periodic ? with_auto_cell3(s0) : s0;
   WorldParams3 p;
   p.dt = time_step(s);
   p.gravity = Vec3(s.gravity[0], s.gravity[1], s.gravity[2]);
@@ -197,7 +197,7 @@ WorldParams3 world_params3(const Scene& s0) {
   p.solver.tol = s.tol;
   p.solver.residual_tol = s.residual_tol;
   p.solver.max_iter = s.max_iter;
-  if (s.shear_mode == "periodic") {
+  if (s.shear_mode == ShearMode::Periodic) {
     p.cell = Vec3(s.cell_width, s.cell_height, s.cell_depth);
     p.periodic = {true, true, true};
     // At imposed pressure: L_y a dof (sigma_yy = p); isotropic, all three.
@@ -313,7 +313,7 @@ World3 build_cell3(const Scene& s0) {
 }
 
 World3 build_world3(const Scene& s0) {
-  if (s0.shear_mode == "periodic") return build_cell3(s0);
+  if (s0.shear_mode == ShearMode::Periodic) return build_cell3(s0);
   const Scene& s = s0;
   const WorldParams3 p = world_params3(s);
   const std::vector<double> d = generated_diameters(s);

@@ -4,8 +4,8 @@
 // protocols, [[disk]], [[wall]], polygons, regions, restitution, rotation
 // off) are refused by name rather than ignored.
 #pragma once
+#include "derived.hpp"
 #include "scene.hpp"
-#include "setup.hpp"
 #include "world3.hpp"
 
 namespace cd {
@@ -18,7 +18,7 @@ WorldParams3 world_params3(const Scene& s);
 
 // The world: a floor and four side walls, the generated spheres on the
 // lattice (particles.n, the size law or the explicit diameters).
-// shear.mode = "periodic": build_cell3.
+// shear.mode = periodic: build_cell3.
 World3 build_world3(const Scene& s);
 
 // A tri-periodic cell (shear.mode = "periodic"; docs/3d.md): L_x, L_y, L_z

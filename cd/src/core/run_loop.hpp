@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "checkpoint_io.hpp"
+#include "run_plan.hpp"
 #include "stages.hpp"
 
 namespace cd {
@@ -100,20 +101,6 @@ class RunEngine {
   virtual void after_step(std::int64_t /*k*/) {}
   // Protocol columns appended to a series row (and their interval reset).
   virtual void add_columns(Columns& /*cols*/) {}
-};
-
-// When things happen, in steps, from the scene (2d/run.cpp: plan_of).
-struct RunPlan {
-  std::int64_t nsteps = 0;
-  double dt = 0;
-  std::int64_t every_row = 1;
-  std::int64_t every_snap = 0;         // 0: no snapshots
-  std::int64_t every_ckpt = 0;         // 0: none by simulated time
-  std::int64_t every_ckpt_strain = 0;  // 0: none by strain
-  double ckpt_wall = 0;                // s of wall clock; 0: none
-  double checkpoint_interval = 0, checkpoint_strain = 0;  // as given (for messages)
-  std::uint64_t key = 0;               // scene key a checkpoint must match
-  bool checkpoints() const { return every_ckpt || every_ckpt_strain || ckpt_wall > 0; }
 };
 
 // Runs the engine to plan.nsteps. The caller has validated the scene and

@@ -6,13 +6,14 @@
 #include <functional>
 #include <vector>
 
+#include "defaults.hpp"
 #include "parallel.hpp"
 
 namespace cd {
 
 struct SolverParams {
-  double tol = 1e-4;       // eps_f on rms |dp| / mean |p| over a sweep (LMGC90's "Quad" norm)
-  int max_iter = 2000;     // iteration cap
+  double tol = defaults::tol;  // eps_f on rms |dp| / mean |p| over a sweep (LMGC90's "Quad" norm)
+  int max_iter = defaults::max_iter;  // iteration cap
   // Below this many rows the sweep runs on one thread: a colour of a few
   // dozen rows costs less than the barrier that ends it (measured: a
   // 600-row pile ran 3x slower on 2 threads than on 1). Loops over bodies
@@ -23,7 +24,7 @@ struct SolverParams {
   // criterion on what the contact laws miss rather than on how much the
   // impulses still move (which, in dense shear, can stay above tol long
   // after the laws are met). 0: off, the rms |dp| test alone.
-  double residual_tol = 0.0;
+  double residual_tol = defaults::residual_tol;
 };
 
 struct SolveStats {

@@ -54,10 +54,20 @@ Rule vector_of(std::size_t a, std::size_t b) {
 Rule non_empty() {
   return {"non-empty", [](const Val& v) { return !std::get<std::string>(v).empty(); }};
 }
-Rule size_dist() {
-  return {"\"uniform\" or \"uniform_area\"", [](const Val& v) {
-            return std::get<std::string>(v) == "uniform" || std::get<std::string>(v) == "uniform_area";
-          }};
+// An enum key (scene.hpp): one of its names. The value is checked when it is
+// read (get below, with this text); the rule carries the text for the
+// parameter table.
+template <class E>
+std::string names_text() {
+  const auto& names = enum_names(E{});
+  std::string t;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    t += fmt::format("{}\"{}\"", i == 0 ? "" : i + 1 == names.size() ? " or " : ", ", names[i]);
+  return t;
+}
+template <class E>
+Rule one_of() {
+  return {names_text<E>(), {}};
 }
 Rule region() {
   return {"[] or [xmin, ymin, xmax, ymax] with xmin < xmax, ymin < ymax", [](const Val& v) {
@@ -81,12 +91,6 @@ Rule positive_list() {
             return std::all_of(r.begin(), r.end(), [](double x) { return x > 0; });
           }};
 }
-Rule shear_mode() {
-  return {"\"none\", \"periodic\" or \"walls\"", [](const Val& v) {
-            const auto& m = std::get<std::string>(v);
-            return m == "none" || m == "periodic" || m == "walls";
-          }};
-}
 Rule disk_density() {
   return {"> 0, or -1 (particles.density)", [](const Val& v) { return num(v) > 0 || num(v) == -1; }};
 }
@@ -94,7 +98,8 @@ Rule disk_density() {
 // ---- the parameter table -----------------------------------------------------
 template <class T>
 using Field = std::variant<double T::*, int T::*, unsigned T::*, bool T::*, std::string T::*,
-                           std::array<double, 2> T::*, std::vector<double> T::*>;
+                           std::array<double, 2> T::*, std::vector<double> T::*, ShearMode T::*,
+                           SizeDist T::*>;
 
 template <class T>
 struct Param {
@@ -134,7 +139,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
       {"particles", "size_ratio", &Scene::size_ratio, "", ge(1), "d_max / d_min"},
-      {"particles", "size_dist", &Scene::size_dist, "", size_dist(), "diameter distribution: uniform in d, or uniform_area (equal area per size class)"},
+      {"particles", "size_dist", &Scene::size_dist, "", one_of<SizeDist>(), "diameter distribution: uniform in d, or uniform_area (equal area per size class)"},
       {"particles", "diameters", &Scene::diameters, "m", positive_list(), "explicit diameters of the generated particles, placed in an order shuffled by particles.seed; particles.n is then their count (0 or that count), and d_mean, size_ratio, size_dist are not used; []: draw them from the size law"},
       {"particles", "diameters_file", &Scene::diameters_file, "", any(), "a text file of diameters (m; whitespace-separated, # comments; relative to the scene file's folder) read into particles.diameters; \"\": none"},
       {"particles", "density", &Scene::density, "kg/m^2 (2D), kg/m^3 (3D)", gt(0), "2D: mass per unit area (2600 kg/m^3 x 1 mm = 2.6); 3D: mass per unit volume (2600 for glass)"},
@@ -150,7 +155,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"output", "checkpoint_strain", &Scene::checkpoint_strain, "", ge(0), "shear strain between checkpoints (needs shear.inertial_number > 0), rounded up to whole series intervals; 0: none"},
       {"output", "checkpoint_wall", &Scene::checkpoint_wall, "s (wall clock)", ge(0), "a checkpoint at the first series row after this much wall-clock time since the last one (so at most this plus one series interval's wall time between checkpoints); changes no result; 0: none"},
       {"output", "quiet", &Scene::quiet, "", any(), "no progress output"},
-      {"shear", "mode", &Scene::shear_mode, "", shear_mode(), "boundary protocol: none; periodic (bi-periodic Lees-Edwards cell, height a dof at imposed pressure); walls (rough walls of glued grains, periodic in x, top wall at imposed velocity and pressure)"},
+      {"shear", "mode", &Scene::shear_mode, "", one_of<ShearMode>(), "boundary protocol: none; periodic (bi-periodic Lees-Edwards cell, height a dof at imposed pressure); walls (rough walls of glued grains, periodic in x, top wall at imposed velocity and pressure)"},
       {"shear", "width", &Scene::cell_width, "m", ge(0), "cell width (period in x)"},
       {"shear", "height", &Scene::cell_height, "m", ge(0), "initial cell height (periodic) or gap between the wall grains' centres (walls)"},
       {"shear", "depth", &Scene::cell_depth, "m", ge(0), "3D only: the periodic cell's length along z (vorticity direction; width along x is the shear direction, height along y the gradient); width, height and depth all 0: the cube that holds the generated spheres on a loose lattice"},
@@ -262,6 +267,20 @@ std::string get(const toml::value& v, std::string& x) {
   return "";
 }
 
+std::string text(const std::string& x, bool);
+
+template <class E>
+  requires std::is_enum_v<E>
+std::string get(const toml::value& v, E& x) {
+  std::string name;
+  if (std::string e = get(v, name); !e.empty()) return e;
+  const auto& names = enum_names(E{});
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) return fmt::format(" = {}: must be {}", text(name, false), names_text<E>());
+  x = static_cast<E>(it - names.begin());
+  return "";
+}
+
 std::string get(const toml::value& v, std::vector<double>& x) {
   if (!v.is_array()) return ": expected an array of numbers, got " + type_name(v);
   std::vector<double> out(v.as_array().size());
@@ -307,6 +326,11 @@ std::string text(const std::vector<double>& x, bool toml) {
   for (std::size_t i = 0; i < x.size(); ++i) out += (i ? ", " : "") + text(x[i], toml);
   return out + "]";
 }
+template <class E>
+  requires std::is_enum_v<E>
+std::string text(E x, bool toml) {
+  return text(std::string(name_of(x)), toml);
+}
 template <std::size_t N>
 std::string text(const std::array<double, N>& x, bool toml) {
   return text(std::vector<double>(x.begin(), x.end()), toml);
@@ -315,6 +339,7 @@ std::string text(const std::array<double, N>& x, bool toml) {
 template <class X>
 Val to_val(const X& x) {
   if constexpr (std::is_same_v<X, bool> || std::is_same_v<X, std::string>) return x;
+  else if constexpr (std::is_enum_v<X>) return std::string(name_of(x));
   else if constexpr (std::is_arithmetic_v<X>) return static_cast<double>(x);
   else return std::vector<double>(x.begin(), x.end());
 }
@@ -557,7 +582,11 @@ void apply_override(toml::value& root, const std::string& set) {
   try {
     v = parse(value);
   } catch (const std::exception&) {
-    if (!std::holds_alternative<std::string Scene::*>(p->field))
+    // A string key, or an enum key (a name), takes a bare word.
+    const bool word = std::holds_alternative<std::string Scene::*>(p->field) ||
+                      std::holds_alternative<ShearMode Scene::*>(p->field) ||
+                      std::holds_alternative<SizeDist Scene::*>(p->field);
+    if (!word)
       throw ConfigError(fmt::format("{}: '{}' is not a TOML value (a number, true, false, "
                                     "\"string\" or [array])", src, value));
     v = parse(text(value, true));

@@ -1,15 +1,35 @@
-// Scene: every parameter of a run, as plain data. The defaults written here are
-// the only defaults (config.cpp binds each field to its TOML key, documents it
-// and validates it; the resolved scene.toml written with every run is printed
-// from the same table).
+// Scene: every parameter of a run, as plain data, the same struct for 2D and
+// 3D (the bottom layer: it includes nothing of the engines). The defaults
+// written here are the only defaults (config.cpp binds each field to its
+// TOML key, documents it and validates it; the resolved scene.toml written
+// with every run is printed from the same table); the engines' parameter
+// structs take the few they share from defaults.hpp.
 #pragma once
 #include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
-#include "world.hpp"
+#include "defaults.hpp"
 
 namespace cd {
+
+// shear.mode: the boundary protocol (method.md section 9), chosen once per
+// scene. The names are the scene file's, in enum order.
+enum class ShearMode { None, Periodic, Walls };
+inline constexpr std::array<std::string_view, 3> kShearModeNames = {"none", "periodic", "walls"};
+
+// particles.size_dist: the size law of the generated particles.
+enum class SizeDist { Uniform, UniformArea };
+inline constexpr std::array<std::string_view, 2> kSizeDistNames = {"uniform", "uniform_area"};
+
+// The names of an enum's values (config.cpp reads and writes them through
+// this overload, so that a new enum key needs only its names here), and the
+// name of one value, for messages.
+constexpr const auto& enum_names(ShearMode) { return kShearModeNames; }
+constexpr const auto& enum_names(SizeDist) { return kSizeDistNames; }
+template <class E>
+constexpr std::string_view name_of(E e) { return enum_names(e)[static_cast<std::size_t>(e)]; }
 
 struct DiskSpec {            // [[disk]]: one explicit disk
   std::array<double, 2> pos{0.0, 0.0};
@@ -32,10 +52,10 @@ struct WallSpec {            // [[wall]]: a rigid segment with imposed velocity
 struct Scene {
   std::string name = "default";
   std::string source;        // file the scene came from (for messages)
-  int dimension = 2;         // 2: disks and polygons (this file); 3: spheres (3d/setup3.hpp)
+  int dimension = 2;         // 2: disks and polygons (2d/setup.hpp); 3: spheres (3d/setup3.hpp)
 
   // [time]
-  double dt = WorldParams{}.dt;  // time step (s)
+  double dt = defaults::dt;  // time step (s)
   double duration = 0.5;     // simulated time (s)
 
   // [gravity]: [gx, gy] in 2D, [gx, gy, gz] in 3D
@@ -52,24 +72,24 @@ struct Scene {
   double e_n = 0.0;          // normal restitution
   double e_t = 0.0;          // tangential restitution
   double alert = 0.1;        // alert distance, in mean diameters
-  bool rotation = WorldParams{}.rotation;  // integrate rotations
+  bool rotation = defaults::rotation;  // integrate rotations
   double overlap_correction = 0.0;  // beta: overlaps separate at beta |gap|/dt (0: none)
   double overlap_projection = 0.0;  // beta_p: centres moved apart by beta_p |gap| a step (0: none)
   double adhesion = 0.0;     // pull-off force f_a (N); 0: no cohesion
   double debond = 0.01;      // debonding distance delta_a, in mean diameters
 
   // [solver]
-  // The solver's defaults are SolverParams' (nlgs.hpp): one source.
-  double tol = SolverParams{}.tol;           // NLGS tolerance eps_f (relative)
-  int max_iter = SolverParams{}.max_iter;    // iteration cap per step
-  double residual_tol = SolverParams{}.residual_tol;  // > 0: also stop on the law residual
+  // SolverParams (core/solver.hpp) takes the same defaults.hpp values: one source.
+  double tol = defaults::tol;                // NLGS tolerance eps_f (relative)
+  int max_iter = defaults::max_iter;         // iteration cap per step
+  double residual_tol = defaults::residual_tol;  // > 0: also stop on the law residual
   int threads = 0;           // 0: OpenMP default
 
   // [particles]: random generation (n = 0 for none)
   int n = 0;
   double d_mean = 1e-3;      // mean diameter (m)
   double size_ratio = 2.0;   // d_max / d_min
-  std::string size_dist = "uniform_area";  // "uniform" | "uniform_area"
+  SizeDist size_dist = SizeDist::UniformArea;
   // explicit diameters of the generated particles (then n = their count, and
   // d_mean, size_ratio, size_dist are not used); read from diameters_file
   // (one per line or whitespace-separated, '#' comments) when that is given
@@ -100,7 +120,7 @@ struct Scene {
   bool quiet = false;
 
   // [shear]: boundary protocols (method.md section 9)
-  std::string shear_mode = "none";  // "none" | "periodic" (Lees-Edwards) | "walls"
+  ShearMode shear_mode = ShearMode::None;  // periodic: Lees-Edwards cell; walls: rough walls
   double cell_width = 0.0;          // cell width (m)
   double cell_height = 0.0;         // initial cell height / wall gap (m)
   double cell_depth = 0.0;          // 3D periodic cell: its length along z (m)

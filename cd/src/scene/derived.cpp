@@ -1,0 +1,137 @@
+#include "derived.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+namespace cd {
+
+namespace {
+
+// Diameter range [a, b] with b = ratio a whose number mean is d_mean.
+//   uniform:       d uniform,           mean = a (1 + r) / 2
+//   uniform_area:  pdf(d) ~ 1/d^2, i.e. each size class holds the same area
+//                  fraction (2D), mean = a r ln r / (r - 1)
+void diameter_range(const Scene& s, double& a, double& b) {
+  const double r = s.size_ratio;
+  if (r == 1.0) {
+    a = b = s.d_mean;
+  } else if (s.size_dist == SizeDist::Uniform) {
+    a = 2.0 * s.d_mean / (1.0 + r);
+  } else {
+    a = s.d_mean * (r - 1.0) / (r * std::log(r));
+  }
+  b = a * r;
+}
+
+// Quantities derived from several keys, checked before anything is built or
+// written: each must be finite, and the run must take at least one step and
+// no more than kMaxSteps.
+constexpr double kMaxSteps = 1e9;
+
+}  // namespace
+
+std::vector<double> generated_diameters(const Scene& s) {
+  if (!s.diameters.empty()) {
+    // The given diameters, in an order shuffled by the seed (Fisher-Yates
+    // with the platform-independent uniform01), so that a sorted list does
+    // not place the large grains in the bottom rows.
+    std::vector<double> d = s.diameters;
+    std::mt19937_64 g(s.seed);
+    for (std::size_t i = d.size(); i > 1; --i)
+      std::swap(d[i - 1], d[static_cast<std::size_t>(uniform01(g) * i)]);
+    return d;
+  }
+  double a, b;
+  diameter_range(s, a, b);
+  std::mt19937_64 g(s.seed);
+  std::vector<double> d(s.n);
+  for (double& x : d) {
+    const double u = uniform01(g);
+    x = s.size_dist == SizeDist::Uniform ? a + u * (b - a) : 1.0 / (1.0 / a - u * (1.0 / a - 1.0 / b));
+  }
+  return d;
+}
+
+std::pair<double, double> diameter_bounds(const Scene& s) {
+  if (!s.diameters.empty())
+    return {*std::min_element(s.diameters.begin(), s.diameters.end()),
+            *std::max_element(s.diameters.begin(), s.diameters.end())};
+  double a, b;
+  diameter_range(s, a, b);
+  return {a, b};
+}
+
+double mean_diameter(const Scene& s) {
+  double sum = 0;
+  int n = 0;
+  for (const DiskSpec& d : s.disks) {
+    sum += 2 * d.radius;
+    ++n;
+  }
+  if (!s.diameters.empty()) {
+    for (const double d : s.diameters) sum += d;
+    n += static_cast<int>(s.diameters.size());
+  } else if (s.n > 0) {
+    sum += s.n * s.d_mean;
+    n += s.n;
+  }
+  return n > 0 ? sum / n : s.d_mean;
+}
+
+double pressure_time(const Scene& s) {
+  return s.pressure > 0 ? mean_diameter(s) * std::sqrt(s.density / s.pressure) : 0.0;
+}
+
+double shear_rate(const Scene& s) {
+  const double tp = pressure_time(s);
+  return tp > 0 ? s.inertial_number / tp : 0.0;
+}
+
+double pull_off_force(const Scene& s) {
+  if (!(s.cohesion_number > 0)) return s.adhesion;
+  const double d = mean_diameter(s);
+  return s.cohesion_number * s.pressure * (s.dimension == 3 ? d * d : d);
+}
+
+double time_step(const Scene& s) { return s.dt_tp > 0 ? s.dt_tp * pressure_time(s) : s.dt; }
+
+double run_duration(const Scene& s) {
+  return s.strain > 0 && shear_rate(s) > 0 ? s.strain / shear_rate(s) : s.duration;
+}
+
+void check_derived(const Scene& s) {
+  auto fail = [](const std::string& m) { throw SceneError(m); };
+  const double dt = time_step(s);
+  const char* dt_from = s.dt_tp > 0 ? "shear.dt_tp x t_p" : "time.dt";
+  if (!std::isfinite(dt) || dt <= 0) fail(fmt::format("the time step ({}) is {}: must be finite and > 0", dt_from, dt));
+  if (s.shear_mode != ShearMode::None && s.pressure > 0) {
+    const double tp = pressure_time(s), gd = shear_rate(s);
+    if (!std::isfinite(tp) || !std::isfinite(gd))
+      fail(fmt::format("t_p = d sqrt(rho/p) = {} s and the shear rate {} 1/s must be finite "
+                       "(particles.d_mean, particles.density, shear.pressure, shear.inertial_number)",
+                       tp, gd));
+  }
+  if (s.adhesion > 0 || s.cohesion_number > 0) {
+    const double fa = pull_off_force(s);
+    if (!std::isfinite(fa))
+      fail(fmt::format("the pull-off force f_a = {} N must be finite ({})", fa,
+                       s.cohesion_number > 0 ? (s.dimension == 3 ? "contact.cohesion_number x shear.pressure x d^2"
+                                                                 : "contact.cohesion_number x shear.pressure x d")
+                                             : "contact.adhesion"));
+  }
+  const double T = run_duration(s);
+  const char* T_from = s.strain > 0 ? "shear.strain / shear rate" : "time.duration";
+  const double steps = T / dt;
+  if (!std::isfinite(T) || !(steps < kMaxSteps))
+    fail(fmt::format("the run would take {:.3g} steps ({} = {:.4g} s, time step {:.4g} s), more "
+                     "than the limit of {:.0e}: shorten the run or lengthen the step",
+                     steps, T_from, T, dt, kMaxSteps));
+  if (!(steps >= 1 - 1e-9))
+    fail(fmt::format("the run would take less than one step: its duration ({} = {:.4g} s) is "
+                     "shorter than the time step ({} = {:.4g} s)", T_from, T, dt_from, dt));
+}
+
+}  // namespace cd
