@@ -1,0 +1,2 @@
+// The 2D engine on core: allowed.
+#include "c.hpp"

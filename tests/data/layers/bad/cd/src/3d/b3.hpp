@@ -1,0 +1,2 @@
+// The 3D engine on core: allowed.
+#include "c.hpp"

@@ -1,0 +1,2 @@
+// Core on the scene: allowed.
+#include "s.hpp"

@@ -1,0 +1,2 @@
+// A scene header reaching up into core: refused.
+#include "c.hpp"
