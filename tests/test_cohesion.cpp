@@ -135,9 +135,15 @@ TEST(Cohesion, ZeroAdhesionThroughTheCohesiveSweepIsBitIdentical) {
 TEST(CohesionHardCase, StronglyCohesivePileStaysBounded) {
   // 120 disks poured into a box with f_a = 100 m g (the pressure at the base
   // of this pile is ~10 m g / d, so eta = f_a / (p d) ~ 10 there and ~100 in
-  // the upper layers). Adhesion only pulls while the contact opens
-  // (f_n = -f_a with u_n > 0: negative power), so the energy may only fall;
-  // no NaN, overlap bounded as for the cohesionless pile (1e-2 d).
+  // the upper layers). Adhesion pulls on every contact within the debonding
+  // distance, also while a pair approaches (f_n = -f_a with u_n < 0:
+  // positive power): the bonds store energy, f_a per unit of approach up to
+  // debond, so E = KE + PE may rise. run_watched checks every step: the
+  // change of E is the contacts' work, whose law part (the adhesion's work
+  // f_a du_n counted apart) dissipates to the solver's bound. Over the run E
+  // may gain at most what the bonds hold: f_a debond each, at most 3 a disk
+  // (walls included). No NaN, overlap bounded as for the cohesionless pile
+  // (1e-2 d).
   auto p = cohesive(2e-3, 9.81, 0.4, 0.0, 0.02);
   p.solver.tol = 1e-4;
   p.solver.max_iter = 1000;

@@ -86,11 +86,7 @@ TEST(Pile, SettlesToRestWithBoundedOverlapAndConvergedLaw) {
   for (int chunk = 0; chunk < 22; ++chunk) {
     const Watch c = run_watched(w, 100);
     ke_peak = std::max(ke_peak, w.kinetic_energy());
-    r.max_overlap = std::max(r.max_overlap, c.max_overlap);
-    r.max_energy_gain = std::max(r.max_energy_gain, c.max_energy_gain);
-    r.mean_iter += c.mean_iter / 22;
-    r.max_iter = std::max(r.max_iter, c.max_iter);
-    r.cap_hits += c.cap_hits;
+    r.merge(c, 22);
   }
   report("settling pile", r);
   ASSERT_GT(ke_peak, 1e-2 * mgd);  // it did fall
