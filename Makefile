@@ -77,8 +77,11 @@ run: build
 	@echo "(resolved scene), shapes.pvd, particles.pvd, contacts.pvd, walls.pvd (VTK collections)."
 	@echo "Open in ParaView:  paraview $(OUT)/shapes.pvd   (grains as drawn; colour by velocity)"
 
+# After the suite, the tree is checked again (tests/check_tree.cmake): no
+# test may leave a file in the sources (they write into the build folder).
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 900
+	cmake -DROOT=$(CURDIR) -P tests/check_tree.cmake
 
 # docs/scene-parameters.md is generated: a fixed header, then exactly what
 # `cdsim --help-scene` prints (tests/test_help_scene.cpp fails when they differ).

@@ -329,14 +329,14 @@ TEST(CdsimRestart, KilledRunResumesBitIdentical) {
   expect_same_outputs(d / "A", B);
 
   // The final checkpoints hold the same state; B's stage timers went on
-  // across the restart, and its series rows add up to them.
+  // across the restart, and its timings.csv rows add up to them.
   cd::World wa{cd::WorldParams{}}, wb{cd::WorldParams{}};
   EXPECT_EQ(cd::load_checkpoint((d / "A" / "checkpoint.bin").string(), wa),
             cd::load_checkpoint((B / "checkpoint.bin").string(), wb));
   EXPECT_EQ(cdtest::state_hash(wa), cdtest::state_hash(wb));
   EXPECT_EQ(wa.warm_start().p, wb.warm_start().p);
   std::array<double, cd::kStages> sum{};
-  for (const auto& row : series_cells(B / "series.csv"))
+  for (const auto& row : series_cells(B / "timings.csv"))
     for (int s = 0; s < cd::kStages; ++s)
       sum[s] += std::stod(row.at(std::string("t_") + cd::kStageNames[s]));
   // Every stage of the step (output is also timed after the last row: the

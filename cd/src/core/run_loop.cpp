@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -51,7 +52,7 @@ void clear_previous(const std::filesystem::path& dir) {
   if (!fs::is_directory(dir)) return;
   for (const auto& e : fs::directory_iterator(dir)) {
     const std::string f = e.path().filename().string();
-    const bool ours = f == "series.csv" || f == "scene.toml" || e.path().extension() == ".pvd" ||
+    const bool ours = f == "series.csv" || f == "timings.csv" || f == "scene.toml" || e.path().extension() == ".pvd" ||
                       f.starts_with("checkpoint.bin") || f.starts_with("problem_") ||
                     f.starts_with("summary.toml") ||
                       (e.path().extension() == ".vtp" &&
@@ -132,6 +133,9 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const fs::path dir(opt.out);
   const std::string ckpt = (dir / "checkpoint.bin").string();
   const std::string series_path = (dir / "series.csv").string();
+  // The stage timings, wall-clock seconds, apart from the physics so that
+  // identical runs give byte-identical series (timings.csv: same rows).
+  const std::string timings_path = (dir / "timings.csv").string();
   const double dt = plan.dt;
   const std::int64_t nsteps = plan.nsteps;
   const std::int64_t every_row = plan.every_row, every_snap = plan.every_snap;
@@ -144,6 +148,8 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const std::uint64_t key = plan.key;
   const bool resume = !opt.fresh && fs::exists(ckpt);
   std::vector<std::string> columns;  // of series.csv, cut back to the checkpoint
+  std::vector<std::string> timing_columns;  // of timings.csv, likewise
+  bool legacy = false;                      // timings in series.csv (a run begun before timings.csv)
   RunTotals tot;                     // the run's cost so far (summary.toml)
   if (resume) {
     try {
@@ -151,6 +157,11 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
         throw CheckpointError(fmt::format("checkpoint '{}' was written by a different scene "
                                           "(compare with {})", ckpt, (dir / "scene.toml").string()));
       columns = truncate_series(series_path, w.steps());
+      // A run begun before timings.csv existed has the timings in its
+      // series: it goes on so, to its end.
+      legacy = !fs::exists(timings_path) &&
+               std::any_of(columns.begin(), columns.end(), [](const std::string& c) { return c.starts_with("t_"); });
+      if (!legacy) timing_columns = truncate_series(timings_path, w.steps());
     } catch (const CheckpointError& e) {
       throw CheckpointError(std::string(e.what()) +
                             "; run with --fresh to discard the checkpoint and start over");
@@ -180,6 +191,8 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   for (std::int64_t j = 0; resume && every_snap && j * every_snap <= k0; ++j)
     frames.emplace_back(static_cast<double>(j * every_snap) * dt, fmt::format("{:05d}", j));
   Series series = resume ? Series(series_path, std::move(columns)) : Series(series_path);
+  std::optional<Series> timings;
+  if (!legacy) timings.emplace(resume ? Series(timings_path, std::move(timing_columns)) : Series(timings_path));
   if (every_snap) w.open_snapshots(opt.out, std::move(frames));
 
   RunSummary sum;
@@ -276,8 +289,10 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
                     {"kinetic_energy", w.kinetic_energy()},
                     {"correction_work", iv.corr_work},
                     {"projection_work", iv.proj_work}};
+        Columns tcols = {{"step", double(k)}, {"time", w.time()}};
         for (int s = 0; s < kStages; ++s)
-          cols.emplace_back(std::string("t_") + kStageNames[s], t.t[s] - iv.t0.t[s]);
+          tcols.emplace_back(std::string("t_") + kStageNames[s], t.t[s] - iv.t0.t[s]);
+        if (legacy) cols.insert(cols.end(), tcols.begin() + 2, tcols.end());
         w.add_columns(cols);
         for (const auto& [name, x] : cols)
           if (!std::isfinite(x))
@@ -285,6 +300,10 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
                                           "series.csv holds the rows before it", k, w.time(), name, x));
         series.row(cols);
         series.flush();
+        if (timings) {
+          timings->row(tcols);
+          timings->flush();
+        }
       });
       iv = Interval{};
       iv.t0 = w.times();
