@@ -198,9 +198,14 @@ CDSIM = OMP_NUM_THREADS=$(run_threads) $(BUILD)/cd/cdsim
 # actual size law (shear.width = shear.height = 0), so any ratio works as is.
 SIZE_RATIO ?= 2
 SIZE_DIST  ?= uniform_area
-# The time step in t_p = d sqrt(rho/p): at most 0.05 t_p, and at most
-# 0.005 d of relative sliding per step (dt <= 0.005 t_p / I).
-dt_tp = $(shell awk 'BEGIN { x = 0.005 / $(1); printf "%.4g", x < 0.05 ? x : 0.05 }')
+# The settings that depend on I (solver.tol and residual_tol, shear.dt_tp,
+# shear.cell_mass) are not decided here: the shear scenes give them as
+# "auto", and cdsim sets them from shear.inertial_number by one policy for
+# single runs and campaigns alike (cd/src/scene/shear_policy.hpp; the
+# measurements behind it: docs/shear.md, "Settings by I"). What a run at I
+# will use, as its scene.toml will say: $(1) I, $(2) the key (e.g. dt_tp).
+resolved = $(shell $(BUILD)/cd/cdsim $(SHEAR_SCENE) --set shear.inertial_number=$(1) --print-scene \
+  | awk '$$1 == "$(2)" { print $$3; exit }')
 # 100 series rows per unit strain: 0.01 / shear rate = 0.01 t_p / I.
 # (A second argument, when given, is the pressure instead of P.)
 series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt($(RHO) / $(or $(2),$(P))) / $(1) }')
@@ -245,28 +250,15 @@ $(CAMPAIGNS)/prep/ns_%/.done: | build
 	  --set shear.width=0 --set shear.height=0 $(PREP_SET)
 	touch $@
 
-# The shear runs' solver settings (docs/accuracy.md, "Accuracy against cost
-# in steady shear"): at I >= 0.01, tol 1e-3 keeps mu*, phi and z within ~2
-# sigma of tol 1e-5 at 11-35 % of its cost, while 1e-4 costs 2-4x more and
-# is not measurably closer. At I = 1e-3, tol 1e-3 stops too early (mu* 5 %,
-# 2.6 sigma, above 1e-4; overlaps 0.012 d) and 1e-4 hits the sweep cap on
-# 43 % of its steps; 1e-4 with solver.residual_tol = 3e-3 agrees with it
-# within 0.7 sigma at a third of its cost with no cap hits: the setting below
-# I = 0.01. SHEAR_TOL=x sets solver.tol = x alone for every run.
+# SHEAR_TOL=x sets solver.tol = x alone (no law-residual stop) for every
+# shear run, instead of the policy's tolerance.
 SHEAR_TOL ?=
-shear_solver = $(if $(SHEAR_TOL),--set solver.tol=$(SHEAR_TOL),$(shell awk 'BEGIN { print ($(1) >= 0.01) ? \
-  "--set solver.tol=1e-3" : "--set solver.tol=1e-4 --set solver.residual_tol=3e-3" }'))
-# Above I = 0.4 the cell height of the default mass (shear.cell_mass 0.1)
-# oscillates for several units of strain after the start (docs/shear.md, "The
-# pressure control at high I"); a light cell (0.01) holds sigma_yy + K_yy = p
-# there (2D at I = 0.6, 3D at I = 1: tests/test_cell_control.cpp). Points at
-# I >= 0.5 get it.
-shear_cell = $(shell awk 'BEGIN { if ($(1) >= 0.5) print "--set shear.cell_mass=0.01" }')
+shear_solver = $(if $(SHEAR_TOL),--set solver.tol=$(SHEAR_TOL) --set solver.residual_tol=0)
 # One shear run of every campaign (fresh, ladder, pressure series): $(1) I,
 # $(2) the run folder it starts from, $(3) p, $(4) strain.
-shear_cmd = $(CDSIM) $(SHEAR_SCENE) --out $(@D) $(CAMPAIGN_SET) $(call shear_solver,$(1)) $(call shear_cell,$(1)) \
+shear_cmd = $(CDSIM) $(SHEAR_SCENE) --out $(@D) $(CAMPAIGN_SET) $(shear_solver) \
 	  --set shear.start='"$(2)/checkpoint.bin"' --set shear.pressure=$(3) \
-	  --set shear.inertial_number=$(1) --set shear.strain=$(4) --set shear.dt_tp=$(call dt_tp,$(1)) \
+	  --set shear.inertial_number=$(1) --set shear.strain=$(4) \
 	  --set output.series_interval=$(call series_dt,$(1),$(3)) --set output.snapshot_interval=$(call snapshot_dt,$(1),$(3))
 # A fresh run: $(1) I, $(2) the shape (its compacted sample).
 shear_run = $(call shear_cmd,$(1),$(CAMPAIGNS)/prep/ns_$(2),$(P),$(STRAIN)) --set particles.nsides=[$(2)]
@@ -346,8 +338,9 @@ $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done
 # investigated here.) The steps dumped are
 # the last one and the one FS_GAP steps before. N = 1000 is committed
 # (tests/data/frozen-shear); make frozen-shear FS_N=10000 regenerates larger
-# ones into $(FROZEN)/N_10000 (hours). The shear runs keep the campaign's
-# solver settings (tol 1e-4, cap 2000): the dumped problems are theirs.
+# ones into $(FROZEN)/N_10000 (hours). The shear runs solve at tol 1e-4
+# alone, cap 2000 (the settings the committed problems were dumped with, not
+# the policy's), at the policy's time step: the dumped problems are theirs.
 FROZEN ?= outputs/frozen-shear
 FS_N ?= 1000
 FS_SHAPES ?= 0 6
@@ -364,10 +357,10 @@ frozen-shear: build
 	@ls -l $(FROZEN)/N_$(FS_N)/frozen/*/*/problem_*.cdp
 frozen-shear-runs: $(foreach s,$(FS_SHAPES),$(CAMPAIGNS)/frozen/ns_$(s)/I_0.001/.done)
 # steps of a strain at I with the campaign's dt: strain / (I dt_tp)
-fs_steps = $(shell awk 'BEGIN { printf "%d", $(2) / ($(1) * $(call dt_tp,$(1))) + 0.5 }')
+fs_steps = $(shell awk 'BEGIN { printf "%d", $(2) / ($(1) * $(call resolved,$(1),dt_tp)) + 0.5 }')
 frozen_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --fresh \
 	  --set shear.start='"$(3)"' --set shear.pressure=$(P) \
-	  --set shear.inertial_number=$(1) --set shear.strain=$(2) --set shear.dt_tp=$(call dt_tp,$(1)) \
+	  --set shear.inertial_number=$(1) --set shear.strain=$(2) --set solver.tol=1e-4 --set solver.residual_tol=0 \
 	  --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=0 \
 	  --dump-problem $(shell echo $$(( $(call fs_steps,$(1),$(2)) - $(FS_GAP) ))) \
 	  --dump-problem $(call fs_steps,$(1),$(2))
@@ -413,7 +406,7 @@ acc_solver = $(strip --set solver.residual_tol=0 \
   $(if $(filter rt_%,$(2)),--set solver.tol=1e-4 --set solver.residual_tol=$(patsubst rt_%,%,$(2))) \
   $(if $(filter cap_%,$(2)),--set solver.tol=1e-4 --set solver.max_iter=$(patsubst cap_%,%,$(2))) \
   $(if $(filter dtx_%,$(2)),--set solver.tol=1e-4 \
-    --set shear.dt_tp=$(shell awk 'BEGIN { printf "%.4g", $(patsubst dtx_%,%,$(2)) * $(call dt_tp,$(1)) }')))
+    --set shear.dt_tp=$(shell awk 'BEGIN { printf "%.4g", $(patsubst dtx_%,%,$(2)) * $(call resolved,$(1),dt_tp) }')))
 .PHONY: accuracy-shear accuracy-shear-runs
 accuracy-shear: build
 	$(MAKE) --no-print-directory CAMPAIGNS=$(ACC) N=$(ACC_N) accuracy-shear-runs

@@ -161,7 +161,7 @@ TEST(PrepHardCases, Ratio4ShearFromTheSampleKeepsOverlapsBounded) {
   }
   const cd::Scene s = cd::load_scene(kSrc + "/configs/shear-inertial.toml",
                                      {"shear.start=\"" + ckpt + "\"", "shear.strain=0.3",
-                                      "output.quiet=true"});
+                                      "output.quiet=true", "solver.tol=1e-4"});  // as before "auto"
   cd::World w = cd::build_world(s);
   const long n = std::lround(cd::run_duration(s) / w.params().dt);
   const auto t0 = std::chrono::steady_clock::now();

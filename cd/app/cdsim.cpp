@@ -1,6 +1,6 @@
 // cdsim: runs a scene, 2D (disks, polygons) or 3D (spheres; `dimension = 3`).
 //   cdsim SCENE.toml [--set section.key=value]... [--out DIR] [--threads N] [--quiet] [--fresh]
-//         [--dump-problem STEP]...
+//         [--dump-problem STEP]... [--print-scene]
 // Everything is checked (scene, particles, output folder) before anything is
 // written; any error is one message naming the problem, and exit code 2.
 // Exit codes: 0 done; 2 bad input (usage, scene, start sample, checkpoint,
@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   std::string scene_path, out;
   std::vector<std::string> sets;
   int threads = -1;
-  bool quiet = false, help_scene = false, fresh = false;
+  bool quiet = false, help_scene = false, fresh = false, print_scene = false;
   app.add_option("scene", scene_path, "scene file (TOML)");
   app.add_option("--set", sets, "override a parameter: section.key=value (repeatable)");
   app.add_option("--out", out, "output folder (default: outputs/<scene name>)");
@@ -38,6 +38,8 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet,-q", quiet, "no progress line on stderr");
   app.add_flag("--fresh", fresh, "start over, discarding a checkpoint in the output folder");
   app.add_flag("--help-scene", help_scene, "print every scene parameter with its default");
+  app.add_flag("--print-scene", print_scene,
+               "print the resolved scene (the scene.toml the run would write, \"auto\" keys set) and exit");
   std::vector<std::int64_t> dump_steps;
   app.add_option("--dump-problem", dump_steps,
                  "write step STEP's contact problem into the output folder (repeatable): "
@@ -69,6 +71,10 @@ int main(int argc, char** argv) {
     cd::Scene scene = cd::load_scene(scene_path, sets);
     if (quiet) scene.quiet = true;
     if (threads >= 0) scene.threads = threads;
+    if (print_scene) {
+      std::cout << cd::resolved_toml(scene);
+      return 0;
+    }
     if (out.empty()) out = "outputs/" + scene.name;
     const bool three = scene.dimension == 3;
     if (three && !dump_steps.empty())

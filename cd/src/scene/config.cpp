@@ -20,6 +20,8 @@
 #include <fmt/format.h>
 #include <toml.hpp>
 
+#include "shear_policy.hpp"
+
 namespace cd {
 namespace {
 
@@ -132,9 +134,9 @@ const std::vector<Param<Scene>>& scene_params() {
       {"contact", "cohesion_number", &Scene::cohesion_number, "", ge(0), "cohesion number eta, the pull-off force f_a in units of the imposed shear.pressure p (needs p > 0; instead of contact.adhesion): 2D f_a = eta p d (p in N/m), 3D f_a = eta p d^2 (p in N/m^2), d = particles.d_mean (with shear.start: the scene's particles.d_mean, within 10 % of the sample's; particles.diameters: their mean), the d of t_p and I; 0: use contact.adhesion"},
       {"contact", "overlap_correction", &Scene::overlap_correction, "", in(0, 1), "beta: an overlapping contact must separate at beta |gap|/dt; injects energy (bounded by the series column correction_work); 0: pure CD, overlaps never pushed apart"},
       {"contact", "overlap_projection", &Scene::overlap_projection, "", in(0, 1), "beta_p: on a step where some overlap reaches 1e-3 of its pair's smaller diameter, the positions (and the periodic cell's lengths) move by the smallest mass-weighted displacement that opens every overlap by beta_p times itself and closes no gap (a frictionless pseudo-velocity solve, at most 100 sweeps); velocities untouched, so no energy put in; the contact forces' work on those moves is the series column projection_work; 0: off"},
-      {"solver", "tol", &Scene::tol, "", in_open_closed(0, 1), "NLGS convergence tolerance (relative)"},
+      {"solver", "tol", &Scene::tol, "", in_open_closed(0, 1), "NLGS convergence tolerance (relative); \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "max_iter", &Scene::max_iter, "", in(1, 1e8), "NLGS iteration cap per time step"},
-      {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone"},
+      {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "threads", &Scene::threads, "", in(0, 1024), "OpenMP threads; 0: OpenMP default"},
       {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
@@ -161,11 +163,11 @@ const std::vector<Param<Scene>>& scene_params() {
       {"shear", "depth", &Scene::cell_depth, "m", ge(0), "3D only: the periodic cell's length along z (vorticity direction; width along x is the shear direction, height along y the gradient); width, height and depth all 0: the cube that holds the generated spheres on a loose lattice"},
       {"shear", "pressure", &Scene::pressure, "N/m", ge(0), "imposed normal stress sigma_yy (2D: force per length, N/m; 3D: force per area, N/m^2)"},
       {"shear", "inertial_number", &Scene::inertial_number, "", ge(0), "imposed inertial number I: shear rate = I sqrt(p/rho)/d (walls: top wall speed = shear rate x current gap); 0: no shear"},
-      {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width; 3D: and depth) degree of freedom, in units of the particles' total mass"},
+      {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width; 3D: and depth) degree of freedom, in units of the particles' total mass; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"shear", "isotropic", &Scene::isotropic, "", any(), "compaction: the width (3D: and the depth) is a degree of freedom too, at sigma_xx (= sigma_zz) = pressure (periodic, inertial_number = 0)"},
       {"shear", "compaction_rate", &Scene::compaction_rate, "1/t_p", in(0, 1), "periodic cell at imposed pressure: its height (and, isotropic, width) shrinks at most at this strain rate, -(dL/dt)/L <= compaction_rate / t_p, and by at most a quarter of the alert distance a step (a brake on the pressure-driven collapse; the inertial number of the compaction); 0: no bound"},
       {"shear", "strain", &Scene::strain, "", ge(0), "run until this shear strain (overrides time.duration); 0: use time.duration"},
-      {"shear", "dt_tp", &Scene::dt_tp, "t_p", ge(0), "time step in units of t_p = d sqrt(rho/p) (overrides time.dt); 0: use time.dt"},
+      {"shear", "dt_tp", &Scene::dt_tp, "t_p", ge(0), "time step in units of t_p = d sqrt(rho/p) (overrides time.dt); 0: use time.dt; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"shear", "start", &Scene::start, "", any(), "checkpoint.bin to start from (same particles): of a preparation run (the cell it reached, from rest) or of a shear run (continued: its Lees-Edwards offset and cell rates kept, its mean flow replaced by this run's rate; strain counted from 0); \"\": generate particles"},
   };
   return t;
@@ -193,6 +195,23 @@ const std::vector<Param<WallSpec>>& wall_params() {
       {"wall", "omega", &WallSpec::omega, "rad/s", any(), "imposed angular velocity about the midpoint"},
   };
   return t;
+}
+
+// The keys that may be "auto": their value is the shear policy's for the
+// scene's inertial number (shear_policy.hpp), put in once every key is read.
+struct AutoKey {
+  std::string_view key;
+  double Scene::*member;
+  double ShearSettings::*value;
+};
+constexpr std::array<AutoKey, 4> kAutoKeys = {{{"solver.tol", &Scene::tol, &ShearSettings::tol},
+                                               {"solver.residual_tol", &Scene::residual_tol, &ShearSettings::residual_tol},
+                                               {"shear.dt_tp", &Scene::dt_tp, &ShearSettings::dt_tp},
+                                               {"shear.cell_mass", &Scene::cell_mass, &ShearSettings::cell_mass}}};
+const AutoKey* auto_key(std::string_view name) {
+  for (const AutoKey& a : kAutoKeys)
+    if (a.key == name) return &a;
+  return nullptr;
 }
 
 // "contact.mu", "name", or "disk[3].radius" for an entry of an array of tables.
@@ -352,6 +371,7 @@ Val to_val(const X& x) {
 struct Problems {
   const std::string& path;
   std::vector<std::tuple<int, unsigned, std::size_t, std::string>> list;  // rank, line, col, text
+  std::vector<std::pair<const AutoKey*, toml::value>> autos;  // keys given as "auto", and where
 
   void add(const toml::value& at, std::string_view key, const std::string& msg) {
     const toml::source_location loc = at.location();
@@ -429,6 +449,11 @@ void read_key(const std::vector<Param<T>>& params, std::string_view section, con
   if (!p && section.empty() && table)
     return out.add(v, key, fmt::format("unknown section '{}'{}", key, did_you_mean(key, section_names())));
   if (!p) return out.add(v, key, fmt::format("unknown key '{}'{}", name, did_you_mean(name, labels(params, index))));
+  if (const AutoKey* a = auto_key(name); a && v.is_string() && v.as_string().str == "auto")
+  {
+    out.autos.emplace_back(a, v);
+    return;
+  }
   std::visit([&](auto member) {
     auto x = obj.*member;
     if (const std::string e = get(v, x); !e.empty()) return out.add(v, key, name + e);
@@ -464,7 +489,7 @@ const toml::value& child(const toml::value& t, const std::string& key) {
 }
 
 Scene read_scene(const toml::value& root, const std::string& path) {
-  Problems out{path, {}};
+  Problems out{path, {}, {}};
   Scene s;
   s.source = path;
   for (const auto& [name, v] : root.as_table()) {
@@ -473,6 +498,20 @@ Scene read_scene(const toml::value& root, const std::string& path) {
     else if (!is_section(name)) read_key(scene_params(), "", name, v, "", s, out);
     else if (v.is_table()) read_table(v, scene_params(), name, "", s, out);
     else out.add(v, name, fmt::format("{}: expected a [{}] table, got {}", name, name, type_name(v)));
+  }
+  out.throw_if_any();
+
+  // "auto": the shear settings at the scene's I (after every key and
+  // override is read, so that --set shear.inertial_number counts).
+  for (const auto& [a, at] : out.autos) {
+    if (!(s.inertial_number > 0)) {
+      out.add(at, a->key.substr(a->key.find('.') + 1),
+              fmt::format("{} = \"auto\" is set by shear.inertial_number (docs/shear.md, \"Settings "
+                          "by I\"), which is {}: give shear.inertial_number > 0 or a number",
+                          a->key, text(s.inertial_number, false)));
+      continue;
+    }
+    s.*(a->member) = shear_settings(s.inertial_number).*(a->value);
   }
   out.throw_if_any();
 
@@ -582,10 +621,12 @@ void apply_override(toml::value& root, const std::string& set) {
   try {
     v = parse(value);
   } catch (const std::exception&) {
-    // A string key, or an enum key (a name), takes a bare word.
+    // A string key, or an enum key (a name), takes a bare word; so does an
+    // "auto" key, the word auto.
     const bool word = std::holds_alternative<std::string Scene::*>(p->field) ||
                       std::holds_alternative<ShearMode Scene::*>(p->field) ||
-                      std::holds_alternative<SizeDist Scene::*>(p->field);
+                      std::holds_alternative<SizeDist Scene::*>(p->field) ||
+                      (value == "auto" && auto_key(key));
     if (!word)
       throw ConfigError(fmt::format("{}: '{}' is not a TOML value (a number, true, false, "
                                     "\"string\" or [array])", src, value));

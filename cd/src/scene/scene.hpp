@@ -23,9 +23,9 @@ inline constexpr std::array<std::string_view, 3> kShearModeNames = {"none", "per
 enum class SizeDist { Uniform, UniformArea };
 inline constexpr std::array<std::string_view, 2> kSizeDistNames = {"uniform", "uniform_area"};
 
-// The names of an enum's values (config.cpp reads and writes them through
-// this overload, so that a new enum key needs only its names here), and the
-// name of one value, for messages.
+// The names of an enum's values (config.cpp reads and writes every enum key
+// through this overload; a new enum adds its names here and its member type
+// to config.cpp's Field), and the name of one value, for messages.
 constexpr const auto& enum_names(ShearMode) { return kShearModeNames; }
 constexpr const auto& enum_names(SizeDist) { return kSizeDistNames; }
 template <class E>

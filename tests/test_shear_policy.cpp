@@ -1,0 +1,162 @@
+// The shear settings by I (cd/src/scene/shear_policy.hpp, docs/shear.md
+// "Settings by I"): the documented table at its breakpoints, "auto" in a
+// scene resolved to it (and refused where there is no I), and a campaign
+// point and a single run at the same I resolving to the same settings: the
+// command `make -n` shows for a campaign run and the single run of the same
+// scene, both printed by cdsim --print-scene.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "cli_util.hpp"
+#include "config.hpp"
+#include "shear_policy.hpp"
+
+namespace {
+
+struct Expected {
+  double I, tol, residual_tol, dt_tp, cell_mass;
+};
+
+// docs/shear.md's table, read at and around each breakpoint (I = 0.01 for
+// the tolerance, 0.1 for the time step's cap, 0.5 for the cell mass).
+const Expected kTable[] = {
+    {0.001, 1e-4, 3e-3, 0.05, 0.1},   {0.00999, 1e-4, 3e-3, 0.05, 0.1}, {0.01, 1e-3, 0.0, 0.05, 0.1},
+    {0.05, 1e-3, 0.0, 0.05, 0.1},     {0.1, 1e-3, 0.0, 0.05, 0.1},      {0.2, 1e-3, 0.0, 0.025, 0.1},
+    {0.3, 1e-3, 0.0, 0.01667, 0.1},   {0.49, 1e-3, 0.0, 0.0102, 0.1},   {0.5, 1e-3, 0.0, 0.01, 0.01},
+    {1.0, 1e-3, 0.0, 0.005, 0.01},
+};
+
+TEST(ShearPolicy, TheTableAtItsBreakpoints) {
+  for (const Expected& e : kTable) {
+    const cd::ShearSettings s = cd::shear_settings(e.I);
+    EXPECT_EQ(s.tol, e.tol) << "I = " << e.I;
+    EXPECT_EQ(s.residual_tol, e.residual_tol) << "I = " << e.I;
+    EXPECT_EQ(s.dt_tp, e.dt_tp) << "I = " << e.I;
+    EXPECT_EQ(s.cell_mass, e.cell_mass) << "I = " << e.I;
+    // dt <= 0.005 t_p / I (to the 4 digits it is written with), <= 0.05 t_p.
+    EXPECT_LE(s.dt_tp, 0.005 / e.I * (1 + 5e-4)) << "I = " << e.I;
+    EXPECT_LE(s.dt_tp, 0.05) << "I = " << e.I;
+  }
+}
+
+const char* kAutoScene =
+    "[solver]\ntol = \"auto\"\nresidual_tol = \"auto\"\n"
+    "[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.3\ndt_tp = \"auto\"\ncell_mass = \"auto\"\n";
+
+TEST(ShearPolicy, AutoKeysTakeThePolicysValueForTheScenesI) {
+  for (const Expected& e : kTable) {
+    std::ostringstream I;
+    I << e.I;
+    const cd::Scene s = cd::parse_scene(kAutoScene, "a.toml", {"shear.inertial_number=" + I.str()});
+    EXPECT_EQ(s.tol, e.tol) << "I = " << e.I;
+    EXPECT_EQ(s.residual_tol, e.residual_tol) << "I = " << e.I;
+    EXPECT_EQ(s.dt_tp, e.dt_tp) << "I = " << e.I;
+    EXPECT_EQ(s.cell_mass, e.cell_mass) << "I = " << e.I;
+    // The resolved scene holds the numbers, and reads back to them.
+    const std::string r = cd::resolved_toml(s);
+    EXPECT_EQ(r.find("= \"auto\""), std::string::npos) << r;
+    const cd::Scene back = cd::parse_scene(r, "scene.toml");
+    EXPECT_EQ(back.tol, s.tol);
+    EXPECT_EQ(back.residual_tol, s.residual_tol);
+    EXPECT_EQ(back.dt_tp, s.dt_tp);
+    EXPECT_EQ(back.cell_mass, s.cell_mass);
+  }
+  // A number overrides the policy for its key only; a bare word works as an override.
+  const cd::Scene o = cd::parse_scene(kAutoScene, "a.toml", {"solver.tol=1e-5", "shear.inertial_number=0.001"});
+  EXPECT_EQ(o.tol, 1e-5);
+  EXPECT_EQ(o.residual_tol, 3e-3);
+  const cd::Scene w = cd::parse_scene("[shear]\ninertial_number = 0.6\n", "a.toml", {"shear.cell_mass=auto"});
+  EXPECT_EQ(w.cell_mass, 0.01);
+}
+
+TEST(ShearPolicy, AutoWithoutAnInertialNumberOrOnAnotherKeyIsRefused) {
+  try {
+    cd::parse_scene("[solver]\ntol = \"auto\"\n", "a.toml");
+    FAIL() << "no I";
+  } catch (const cd::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("a.toml:2:1: solver.tol = \"auto\" is set by shear.inertial_number"),
+              std::string::npos)
+        << e.what();
+  }
+  try {
+    cd::parse_scene("[contact]\nmu = \"auto\"\n[shear]\ninertial_number = 0.1\n", "a.toml");
+    FAIL() << "contact.mu has no policy";
+  } catch (const cd::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("contact.mu: expected a number, got a string"), std::string::npos)
+        << e.what();
+  }
+}
+
+// The four keys of a resolved scene printed by cdsim --print-scene.
+std::map<std::string, std::string> settings_of(const std::string& printed) {
+  std::map<std::string, std::string> out;
+  std::istringstream in(printed);
+  std::string section;
+  for (std::string line; std::getline(in, line);) {
+    if (line.starts_with("[")) section = line.substr(1, line.find(']') - 1);
+    std::istringstream ls(line);
+    std::string key, eq, value;
+    ls >> key >> eq >> value;
+    const std::string name = section + "." + key;
+    if (eq == "=" && (name == "solver.tol" || name == "solver.residual_tol" || name == "shear.dt_tp" ||
+                      name == "shear.cell_mass" || name == "shear.inertial_number"))
+      out[name] = value;
+  }
+  return out;
+}
+
+// The shear command `make -n` gives for a campaign point, run with
+// --print-scene (it reads the scene only: no sample needed).
+std::map<std::string, std::string> campaign_settings(const std::string& I, const std::string& dim) {
+  const std::string camp = (cdtest::scratch_dir("test_shear_policy", "campaigns" + dim)).string();
+  const auto made = cdtest::run_command(std::string("make --no-print-directory -n -C ") + CDLAB_SOURCE_DIR +
+                                        " BUILD=" + CDLAB_BINARY_DIR + " DIM=" + dim + " CAMPAIGNS=" + camp +
+                                        " " + camp + "/inertial/I_" + I + "/.done");
+  EXPECT_EQ(made.code, 0) << made.out;
+  // Each command, its continued lines (ending in a backslash) joined.
+  std::istringstream in(made.out);
+  std::string cmd, joined;
+  for (std::string line; std::getline(in, line);) {
+    if (line.ends_with("\\")) {
+      joined += line.substr(0, line.size() - 1);
+      continue;
+    }
+    joined += line;
+    if (joined.find("--set shear.inertial_number=" + I + " ") != std::string::npos) cmd = joined;
+    joined.clear();
+  }
+  EXPECT_FALSE(cmd.empty()) << made.out;
+  EXPECT_EQ(cmd.find("solver.tol"), std::string::npos) << "the Makefile decides no setting: " << cmd;
+  const auto r = cdtest::run_command(std::string("cd ") + CDLAB_SOURCE_DIR + " && " + cmd + " --print-scene");
+  EXPECT_EQ(r.code, 0) << cmd << "\n" << r.out;
+  return settings_of(r.out);
+}
+
+std::map<std::string, std::string> single_run_settings(const std::string& scene, const std::string& I) {
+  const auto r = cdtest::run_command(std::string(CDLAB_BINARY_DIR) + "/cd/cdsim " + CDLAB_SOURCE_DIR +
+                                     "/configs/" + scene + " --set shear.inertial_number=" + I + " --print-scene");
+  EXPECT_EQ(r.code, 0) << r.out;
+  return settings_of(r.out);
+}
+
+TEST(ShearPolicy, ACampaignPointAndASingleRunAtTheSameIRunTheSameSettings) {
+  for (const char* I : {"0.003", "0.01", "0.3", "0.5"}) {
+    const auto c = campaign_settings(I, "2"), s = single_run_settings("shear-inertial.toml", I);
+    EXPECT_EQ(c.size(), 5u) << I;
+    EXPECT_EQ(c, s) << "I = " << I;
+    const cd::ShearSettings p = cd::shear_settings(std::stod(I));
+    EXPECT_EQ(std::stod(s.at("solver.tol")), p.tol) << I;
+    EXPECT_EQ(std::stod(s.at("solver.residual_tol")), p.residual_tol) << I;
+    EXPECT_EQ(std::stod(s.at("shear.dt_tp")), p.dt_tp) << I;
+    EXPECT_EQ(std::stod(s.at("shear.cell_mass")), p.cell_mass) << I;
+  }
+  const auto c3 = campaign_settings("0.001", "3"), s3 = single_run_settings("shear3-inertial.toml", "0.001");
+  EXPECT_EQ(c3.size(), 5u);
+  EXPECT_EQ(c3, s3);
+  EXPECT_EQ(std::stod(s3.at("solver.residual_tol")), 3e-3);
+}
+
+}  // namespace
