@@ -1,0 +1,109 @@
+// State hashes of the 3D scenes that the optional physics reaches (issue 27:
+// the ContactProblem3 seam, the law types and the boundary variant are pure
+// refactors). tests/world3_hash.hpp's four piles cover the default path;
+// these cover the rest: restitution, orthotropic cones on spheres and walls,
+// the tri-periodic cell compacted at imposed pressure, Lees-Edwards shear
+// with the height at imposed stress, with and without adhesion. The expected
+// values were recorded on main before the refactor (commit 6d4d12b, this
+// build's Release flags); a change that alters any of these paths by a bit
+// shows here. A stated bug fix changes the hashes of the scenes it touches,
+// and the comment beside the value says which fix.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include <omp.h>
+
+#include "setup3.hpp"
+#include "shear3_util.hpp"
+#include "world3_hash.hpp"
+
+namespace {
+
+cd::World3 pile(int n) {
+  cd::Pile3dParams q;
+  q.n_spheres = n;
+  q.mu = 0.4;
+  q.solver.tol = 1e-6;
+  q.solver.max_iter = 200;
+  return cd::make_pile3d(q);
+}
+
+std::uint64_t run(cd::World3& w, int steps) {
+  for (int s = 0; s < steps; ++s) w.step();
+  return cdtest::world3_hash(w);
+}
+
+// A pile of 200 with the given parameters changed, 100 steps.
+template <class F>
+std::uint64_t pile_hash(F&& change) {
+  cd::World3 w = pile(200);
+  cd::WorldParams3 p = w.params();
+  change(p);
+  w.set_params(p);
+  return run(w, 100);
+}
+
+// 100 spheres compacted isotropically in a tri-periodic cell (200 steps),
+// then sheared with the height at imposed stress (150 steps), with the
+// given changes to the shear's parameters.
+template <class F>
+std::uint64_t shear_hash(F&& change) {
+  cd::World3 w = cd::build_world3(cdtest::shear3_prep_scene(100));
+  run(w, 200);
+  cd::WorldParams3 p = w.params();
+  p.cell_dof = {false, true, false};
+  p.max_strain_rate = 0.0;
+  p.shear_rate = 0.1 / (1e-3 * std::sqrt(2600.0 / 1e5));  // I = 0.1
+  change(p);
+  w.set_params(p);
+  return run(w, 150);
+}
+
+struct Case {
+  const char* name;
+  std::uint64_t expect;
+};
+
+}  // namespace
+
+TEST(World3Hashes, OptionalPhysicsBitIdentical) {
+  omp_set_num_threads(1);
+  const std::uint64_t got[] = {
+      pile_hash([](cd::WorldParams3& p) {
+        p.e_n = 0.5;
+        p.e_t = 0.2;
+      }),
+      pile_hash([](cd::WorldParams3& p) {
+        p.orthotropic = true;
+        p.axis_a = cd::Vec3(1.0, 1.0, 0.2);
+        p.mu_b = 0.2;
+        p.mu_wall = 0.3;
+        p.mu_wall_b = 0.6;
+      }),
+      pile_hash([](cd::WorldParams3& p) {
+        p.orthotropic = true;
+        p.mu = 0.0;
+        p.mu_b = 0.3;
+        p.mu_wall = 0.0;
+        p.mu_wall_b = 0.3;
+      }),
+      [] {
+        cd::World3 w = cd::build_world3(cdtest::shear3_prep_scene(100));
+        return run(w, 200);
+      }(),
+      shear_hash([](cd::WorldParams3&) {}),
+      shear_hash([](cd::WorldParams3& p) {
+        p.adhesion = 1.0 * 1e5 * 1e-6;  // eta = 1: f_a = eta p d^2
+        p.debond = 0.05e-3;
+      }),
+  };
+  const Case expect[] = {
+      {"restitution pile", 0x28a4504330a780d8ull},  {"orthotropic pile", 0x565a602263430743ull}, {"orthotropic mu = 0", 0x05e69d0165f636ffull},
+      {"compaction", 0xb01270695a1cd9b4ull},        {"shear", 0xe5c9f72700140155ull},            {"cohesive shear", 0x91302f7e2690f82cull},
+  };
+  for (std::size_t k = 0; k < std::size(got); ++k) {
+    std::printf("[ state hash ] %-20s 0x%016llxull\n", expect[k].name, static_cast<unsigned long long>(got[k]));
+    EXPECT_EQ(got[k], expect[k].expect) << expect[k].name;
+  }
+}
