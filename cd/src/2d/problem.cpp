@@ -21,6 +21,8 @@
 
 #include "law.hpp"
 #include "nlgs.hpp"
+#include "problem_file.hpp"
+#include "text_reader.hpp"
 #include "block_rows.hpp"
 #include "coupling.hpp"
 #include "colour_blocks.hpp"
@@ -29,105 +31,12 @@ namespace cd {
 
 namespace {
 
-// Whitespace-token reader over the whole file, keeping line numbers for the
-// error messages. The CSparse listing mixes free text (two header lines) with
-// numbers, so the reader can also hand out whole lines.
-class Reader {
- public:
-  Reader(std::istream& in, std::string name) : name_(std::move(name)) {
-    for (std::string l; std::getline(in, l);) lines_.push_back(std::move(l));
-  }
-
-  [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(fmt::format("{}:{}: {}", name_, last_ + 1, what));
-  }
-
-  // Next token, empty at end of file.
-  std::string_view token() {
-    while (li_ < lines_.size()) {
-      const std::string& l = lines_[li_];
-      while (col_ < l.size() && std::isspace(static_cast<unsigned char>(l[col_]))) ++col_;
-      if (col_ < l.size()) {
-        const std::size_t b = col_;
-        while (col_ < l.size() && !std::isspace(static_cast<unsigned char>(l[col_]))) ++col_;
-        last_ = li_;
-        return std::string_view(l).substr(b, col_ - b);
-      }
-      ++li_;
-      col_ = 0;
-    }
-    last_ = lines_.empty() ? 0 : lines_.size() - 1;
-    return {};
-  }
-
-  // The next token without taking it (empty at end of file).
-  std::string_view peek() {
-    const std::size_t li = li_, col = col_, last = last_;
-    const std::string_view t = token();
-    li_ = li, col_ = col, last_ = last;
-    return t;
-  }
-
-  // The line after the one the cursor is on (the rest of that one is dropped).
-  const std::string& next_line(const char* what) {
-    if (col_ > 0) {
-      ++li_;
-      col_ = 0;
-    }
-    if (li_ >= lines_.size()) fail(fmt::format("unexpected end of file, expected {}", what));
-    last_ = li_;
-    return lines_[li_++];
-  }
-
-  std::string_view need(const std::string& what) {
-    const std::string_view t = token();
-    if (t.empty()) fail(fmt::format("unexpected end of file, expected {}", what));
-    for (char c : t)
-      if (!std::isprint(static_cast<unsigned char>(c)))
-        fail(
-            fmt::format("binary data where {} was expected: not a .dat text file "
-                        "(FCLib .hdf5 problems are not read)",
-                        what));
-    return t;
-  }
-
-  void expect(std::string_view word, const std::string& where) {
-    const std::string_view t = need(fmt::format("'{}' {}", word, where));
-    if (t != word) fail(fmt::format("expected '{}' {}, got '{}'", word, where, t));
-  }
-
-  long long integer(const std::string& what, long long lo, long long hi) {
-    const std::string t(need(what));
-    char* end = nullptr;
-    errno = 0;
-    const long long v = std::strtoll(t.c_str(), &end, 10);
-    if (*end != '\0' || errno != 0)
-      fail(fmt::format("expected {} (an integer), got '{}'", what, t));
-    if (v < lo || v > hi) fail(fmt::format("{} is {}, expected {} to {}", what, v, lo, hi));
-    return v;
-  }
-
-  double number(const std::string& what) {
-    const std::string t(need(what));
-    char* end = nullptr;
-    const double v = std::strtod(t.c_str(), &end);
-    if (*end != '\0') fail(fmt::format("expected {} (a number), got '{}'", what, t));
-    if (!std::isfinite(v)) fail(fmt::format("{} is '{}', not a finite number", what, t));
-    return v;
-  }
-
- private:
-  std::string name_;
-  std::vector<std::string> lines_;
-  std::size_t li_ = 0, col_ = 0, last_ = 0;
-};
-
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
 // Storage 0: "rows<TAB>cols" again, then the column-major array (Siconos
 // writes matrix0 in its own order, size1 values a line: a text line is a
 // column of W).
-void read_dense(Reader& rd, long long n, Triplets& t) {
+void read_dense(TextReader& rd, long long n, Triplets& t) {
   const long long r2 = rd.integer("the dense row count", 0, LLONG_MAX);
   const long long c2 = rd.integer("the dense column count", 0, LLONG_MAX);
   if (r2 != n || c2 != n)
@@ -144,7 +53,7 @@ void read_dense(Reader& rd, long long n, Triplets& t) {
 // "col j : locations a to b" and b - a + 1 lines "row : value"; or, for a
 // triplet matrix, "triplet: M-by-N, nzmax: K nnz: K" and K lines
 // "row col : value".
-void read_sparse(Reader& rd, long long n, Triplets& t) {
+void read_sparse(TextReader& rd, long long n, Triplets& t) {
   rd.integer("the sparse origin", 0, 3);
   rd.next_line("the CSparse version line");
   const std::string& h = rd.next_line("the CSparse size line");
@@ -236,7 +145,7 @@ Eigen::VectorXd checked_diagonal(const Problem& p) {
 }  // namespace
 
 Problem read_problem(std::istream& in, const std::string& name) {
-  Reader rd(in, name);
+  TextReader rd(in, name);
   Problem p;
   p.dim = static_cast<int>(rd.integer("the dimension", 1, 3));
   if (p.dim != 2)
@@ -332,18 +241,12 @@ void write_contact_problem(const ContactProblem& p, const SolverParams& prm, std
   auto x = [](double v) { return fmt::format("{:a}", v); };
   out << "cdlab-contact-problem 1\n";
   out << "law " << law_name(p.law) << "\nrotation " << (p.rotation ? 1 : 0) << "\n";
-  out << "tol " << x(prm.tol) << "\nmax_iter " << prm.max_iter << "\nmin_parallel "
-      << prm.min_parallel << "\n";
-  if (prm.residual_tol > 0) out << "residual_tol " << x(prm.residual_tol) << "\n";
+  problem_file::write_solver(out, prm);
   out << "bodies " << p.vel.size() << "\n";
   for (const BodyVel& v : p.vel)
     out << fmt::format("{} {} {} {} {}\n", x(v.vx), x(v.vy), x(v.w), x(v.inv_m), x(v.inv_I));
-  const Colouring& c = p.colouring;
-  out << "colours " << c.split.size() << " overflow " << (c.overflow ? 1 : 0) << "\nstart";
-  for (const auto v : c.start) out << ' ' << v;
-  out << "\nsplit";
-  for (const auto v : c.split) out << ' ' << v;
-  out << "\nrows " << p.rows.size() << "\n";
+  problem_file::write_colouring(out, p.colouring);
+  out << "rows " << p.rows.size() << "\n";
   for (const ContactRow& r : p.rows)
     out << fmt::format("{} {} {} {} {} {} {} {} {} {} {} {} {} {} {} {} {}\n", r.b1, r.b2,
                        x(r.nx), x(r.ny), x(r.c1n), x(r.c1t), x(r.c2n), x(r.c2t), x(r.wnn),
@@ -351,8 +254,7 @@ void write_contact_problem(const ContactProblem& p, const SolverParams& prm, std
                        x(r.adh));
   out << "dofs " << p.dofs.size() << "\n";
   for (const BoundaryDof& d : p.dofs) {
-    out << fmt::format("{} {} {} {} {}\n", x(d.v0), x(d.v), x(d.inv_mass), x(d.scale),
-                       d.rows.size());
+    out << problem_file::dof_scalars(d) << ' ' << d.rows.size() << '\n';
     for (std::size_t m = 0; m < d.rows.size(); ++m)
       out << fmt::format("{} {} {}\n", d.rows[m], x(d.an[m]), x(d.at[m]));
   }
@@ -367,32 +269,14 @@ void write_contact_problem(const ContactProblem& p, const SolverParams& prm,
 }
 
 ContactProblem read_contact_problem(std::istream& in, const std::string& name, SolverParams& prm) {
-  Reader rd(in, name);
+  TextReader rd(in, name);
   rd.expect("cdlab-contact-problem", "at the start (not a cdlab problem file)");
   if (rd.integer("the format version", 1, 1) != 1) rd.fail("unknown format version");
   ContactProblem p;
-  rd.expect("law", "after the header");
-  const std::string law(rd.need("the law's name"));
-  bool found = false;
-  for (const LocalLaw& l : {LocalLaw{Frictionless{}}, LocalLaw{Coulomb{}},
-                            LocalLaw{CohesiveFrictionless{}}, LocalLaw{CohesiveCoulomb{}}})
-    if (law_name(l) == law) {
-      p.law = l;
-      found = true;
-    }
-  if (!found) rd.fail(fmt::format("unknown law '{}'", law));
+  p.law = problem_file::read_law<LocalLaw>(rd, [](const LocalLaw& l) { return law_name(l); });
   rd.expect("rotation", "after the law");
   p.rotation = rd.integer("rotation (0 or 1)", 0, 1) == 1;
-  rd.expect("tol", "after rotation");
-  prm.tol = rd.number("the tolerance");
-  rd.expect("max_iter", "after tol");
-  prm.max_iter = static_cast<int>(rd.integer("the sweep cap", 1, INT_MAX));
-  rd.expect("min_parallel", "after max_iter");
-  prm.min_parallel = static_cast<int>(rd.integer("the parallel threshold", 0, INT_MAX));
-  if (rd.peek() == "residual_tol") {  // optional: written when > 0
-    rd.token();
-    prm.residual_tol = rd.number("the residual tolerance");
-  }
+  problem_file::read_solver(rd, prm, "after rotation");
   rd.expect("bodies", "after the solver's parameters");
   const long long nb = rd.integer("the number of bodies", 0, INT_MAX);
   p.vel.resize(nb);
@@ -405,31 +289,13 @@ ContactProblem read_contact_problem(std::istream& in, const std::string& name, S
     v.inv_m = rd.number("inv_m" + w);
     v.inv_I = rd.number("inv_I" + w);
   }
-  rd.expect("colours", "after the bodies");
-  const long long nc = rd.integer("the number of colours", 0, 64);
-  rd.expect("overflow", "after the number of colours");
-  p.colouring.overflow = rd.integer("overflow (0 or 1)", 0, 1) == 1;
-  rd.expect("start", "after the colour count");
-  p.colouring.start.resize(nc + 1);
-  for (auto& v : p.colouring.start)
-    v = static_cast<std::int32_t>(rd.integer("a colour start", 0, INT_MAX));
-  rd.expect("split", "after the colour starts");
-  p.colouring.split.resize(nc);
-  for (long long c = 0; c < nc; ++c) {
-    p.colouring.split[c] = static_cast<std::int32_t>(rd.integer(
-        "a colour split", p.colouring.start[c], p.colouring.start[c + 1]));
-  }
-  rd.expect("rows", "after the colouring");
-  const long long nr = rd.integer("the number of rows", 0, INT_MAX);
-  if (p.colouring.start.front() != 0 || p.colouring.start.back() != nr)
-    rd.fail(fmt::format("the colours cover rows {} to {}, the problem has {}",
-                        p.colouring.start.front(), p.colouring.start.back(), nr));
+  p.colouring = problem_file::read_colouring(rd, 64, "after the bodies");
+  const long long nr = problem_file::read_row_count(rd, p.colouring);
   p.rows.resize(nr);
   for (long long k = 0; k < nr; ++k) {
     ContactRow& r = p.rows[k];
     const std::string w = fmt::format(" of row {}", k);
-    r.b1 = static_cast<std::int32_t>(rd.integer("body 1" + w, 0, nb - 1));
-    r.b2 = static_cast<std::int32_t>(rd.integer("body 2" + w, 0, nb - 1));
+    problem_file::read_row_bodies(rd, r, nb, w);
     for (double* f : {&r.nx, &r.ny, &r.c1n, &r.c1t, &r.c2n, &r.c2t, &r.wnn, &r.wnt, &r.wtt,
                       &r.bn, &r.bt, &r.pn, &r.pt, &r.mu, &r.adh})
       *f = rd.number("a number" + w);
@@ -441,10 +307,7 @@ ContactProblem read_contact_problem(std::istream& in, const std::string& name, S
   for (long long d = 0; d < nd; ++d) {
     BoundaryDof& D = p.dofs[d];
     const std::string w = fmt::format(" of dof {}", d);
-    D.v0 = rd.number("v0" + w);
-    D.v = rd.number("v" + w);
-    D.inv_mass = rd.number("inv_mass" + w);
-    D.scale = rd.number("scale" + w);
+    problem_file::read_dof_scalars(rd, D, w);
     const long long m = rd.integer("the number of rows" + w, 0, nr);
     D.rows.resize(m);
     D.an.resize(m);

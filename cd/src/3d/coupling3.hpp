@@ -2,10 +2,13 @@
 // the velocities of their bodies (BodyCoupling3, the sibling of 2D's
 // BodyCoupling), the laws chosen once per scene, and what the sweep asks of
 // a row (its law residual, its impulse norm; the boundary dof is
-// world3.hpp's CellDof3).
+// contact_problem3.hpp's CellDof3).
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <variant>
 
 #include "contact3.hpp"
 #include "law3.hpp"
@@ -29,6 +32,7 @@ struct SphereLaw3 {
   static constexpr bool offsets = Offsets && Friction;
   static constexpr bool orthotropic = Orthotropic && Friction;
   static constexpr bool extra = offsets || orthotropic;  // reads RowExtra3
+  static constexpr bool cohesive = Cohesion;
   static void solve(const SphereRow& r, [[maybe_unused]] const RowExtra3* e, const Vec3& q, Vec3& out) {
     const double a = Cohesion ? r.adh : 0.0;
     if constexpr (orthotropic) {
@@ -40,6 +44,50 @@ struct SphereLaw3 {
     }
   }
 };
+
+// The laws a scene can need, one type each: the variant a ContactProblem3
+// carries, resolved once per solve into a template instance of the sweep.
+using LocalLaw3 =
+    std::variant<SphereLaw3<false, false>, SphereLaw3<false, true>, SphereLaw3<true, false, false, false>,
+                 SphereLaw3<true, false, false, true>, SphereLaw3<true, false, true, false>,
+                 SphereLaw3<true, false, true, true>, SphereLaw3<true, true, false, false>,
+                 SphereLaw3<true, true, false, true>, SphereLaw3<true, true, true, false>,
+                 SphereLaw3<true, true, true, true>>;
+
+// The law of a scene: friction and the two RowExtra3 options only with
+// friction (a frictionless law reads neither).
+inline LocalLaw3 choose_law3(bool friction, bool cohesion, bool offsets, bool orthotropic) {
+  LocalLaw3 out;
+  bool found = false;
+  auto pick = [&]<std::size_t... I>(std::index_sequence<I...>) {
+    (([&] {
+       using L = std::variant_alternative_t<I, LocalLaw3>;
+       if (!found && L::tangential == friction && L::cohesive == cohesion &&
+           L::offsets == (friction && offsets) && L::orthotropic == (friction && orthotropic)) {
+         out = L{};
+         found = true;
+       }
+     }()),
+     ...);
+  };
+  pick(std::make_index_sequence<std::variant_size_v<LocalLaw3>>{});
+  return out;
+}
+
+// "frictionless" or "coulomb", then "+adhesion", "+offsets", "+orthotropic"
+// as the law has them (the .cdp3 files' law line).
+inline std::string law_name3(const LocalLaw3& l) {
+  return std::visit(
+      [](auto x) {
+        using L = decltype(x);
+        std::string s = L::tangential ? "coulomb" : "frictionless";
+        if (L::cohesive) s += "+adhesion";
+        if (L::offsets) s += "+offsets";
+        if (L::orthotropic) s += "+orthotropic";
+        return s;
+      },
+      l);
+}
 
 inline double impulse_norm(const SphereRow& r) { return r.r.norm(); }
 

@@ -16,13 +16,6 @@ namespace cd {
 namespace {
 
 
-template <class L>
-SolveStats solve_with(std::vector<SphereRow>& rows, const std::vector<RowExtra3>& extra, const Colouring& col,
-                      std::vector<BodyVel3>& vel, const SolverParams& prm, std::vector<CellDof3>* dofs) {
-  sweep::BodyCoupling3 c{vel.data(), extra.empty() ? nullptr : extra.data(), rows.data()};
-  return sweep::solve<L>(rows, col, c, prm, dofs, {});
-}
-
 // exp(h w) q: the rotation by the angle h |w| about w (world frame), then
 // renormalised so that round-off does not accumulate in |q|.
 Quat rotate(const Quat& q, const Vec3& w, double h) {
@@ -34,45 +27,6 @@ Quat rotate(const Quat& q, const Vec3& w, double h) {
 }
 
 }  // namespace
-
-double update_dof(CellDof3& d, SphereRow* rows) {
-  // core/cell_dof.hpp's damped step, with the 3D rows' impulses and
-  // responses (W = diag(W_nn, W_tt, W_tt)).
-  double s = 0.0, k = 0.0;
-  const std::size_t m = d.rows.size();
-  for (std::size_t i = 0; i < m; ++i) {
-    const SphereRow& r = rows[d.rows[i]];
-    const Vec3& a = d.a[i];
-    s += a.dot(r.r);
-    if (r.r[0] + r.adh > 0.0) k += a[0] * a[0] / r.wnn + (a[1] * a[1] + a[2] * a[2]) / r.wtt;
-  }
-  double res;
-  const double dv = cell_dof::damped_step(d.v0, d.v, d.inv_mass, s, k, res);
-  for (std::size_t i = 0; i < m; ++i) {
-    const std::int32_t j = d.rows[i];
-    rows[j].bn += d.a[i][0] * dv;
-    if (d.extra) {
-      d.extra[j].bt1 += d.a[i][1] * dv;
-      d.extra[j].bt2 += d.a[i][2] * dv;
-    }
-  }
-  d.v += dv;
-  return std::abs(res) / (d.inv_mass * d.scale);
-}
-
-// The sweep instance of a scene: each flag fixed here, once.
-template <bool F, bool C, bool O>
-World3::SolveFn pick_law(bool ortho) {
-  return ortho ? &solve_with<SphereLaw3<F, C, O, true>> : &solve_with<SphereLaw3<F, C, O, false>>;
-}
-template <bool F, bool C>
-World3::SolveFn pick_law(bool offsets, bool ortho) {
-  return offsets ? pick_law<F, C, true>(ortho) : pick_law<F, C, false>(ortho);
-}
-template <bool F>
-World3::SolveFn pick_law(bool cohesion, bool offsets, bool ortho) {
-  return cohesion ? pick_law<F, true>(offsets, ortho) : pick_law<F, false>(offsets, ortho);
-}
 
 void World3::configure() {
   gravity_on_ = prm_.gravity.squaredNorm() > 0.0;
@@ -93,6 +47,7 @@ void World3::configure() {
   // Images move relative to the bodies: Lees-Edwards, or lengths that move.
   moving_images_ = (le && (prm_.le_velocity != 0.0 || prm_.shear_rate != 0.0)) || dofs_on_;
   cm_ = prm_.cell;
+  if (!dofs_on_) prob_.dofs.clear();
   // Contacts within the alert distance enter the solver with the gap term
   // u_n + g_m/dt >= 0, which closes gaps without overlap (as in 2D). With
   // restitution the law acts at effective contacts only (gap <= 0): a gap
@@ -105,8 +60,7 @@ void World3::configure() {
   // the orthotropic mu_b are the rows' RowExtra3.
   const bool offsets = prm_.e_t > 0.0 || moving_images_;
   extras_on_ = friction && (offsets || prm_.orthotropic);
-  solve_fn_ = friction ? pick_law<true>(adhesion_on_, offsets, prm_.orthotropic)
-                       : pick_law<false>(adhesion_on_, false, false);
+  prob_.law = choose_law3(friction, adhesion_on_, offsets, prm_.orthotropic);
 }
 
 PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const {
@@ -156,23 +110,23 @@ void World3::predict() {
 
 void World3::detect_stage() {
   if (periodic_on_)
-    detect3(bodies, xm_, alert_, cell_at(prm_.le_offset + 0.5 * prm_.dt * prm_.le_velocity, cm_), grid_, rows_,
+    detect3(bodies, xm_, alert_, cell_at(prm_.le_offset + 0.5 * prm_.dt * prm_.le_velocity, cm_), grid_, prob_.rows,
             info_, prm_.solver.min_parallel);
   else
-    detect3(bodies, xm_, alert_, grid_, rows_, info_, prm_.solver.min_parallel);
+    detect3(bodies, xm_, alert_, grid_, prob_.rows, info_, prm_.solver.min_parallel);
 }
 
 void World3::build() {
   const double dt = prm_.dt;
   const auto& V = bodies.vel;
-  const std::size_t nr = rows_.size();
+  const std::size_t nr = prob_.rows.size();
   const bool par = static_cast<int>(nr) >= prm_.solver.min_parallel;
   const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
   const double a = adhesion_on_ ? prm_.adhesion * dt : 0.0;
-  extra_.assign(extras_on_ ? nr : 0, RowExtra3{});
+  prob_.extra.assign(extras_on_ ? nr : 0, RowExtra3{});
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t k = 0; k < nr; ++k) {
-    SphereRow& r = rows_[k];
+    SphereRow& r = prob_.rows[k];
     if (prm_.orthotropic) {
       // t1 along the friction axis projected on the tangent plane.
       const Vec3 ta = prm_.axis_a - prm_.axis_a.dot(r.n) * r.n;
@@ -185,7 +139,7 @@ void World3::build() {
     set_block(r, V[r.b1], V[r.b2]);
     const bool wall = bodies.driven[r.b1];
     r.mu = wall ? prm_.mu_wall : prm_.mu;
-    RowExtra3* x = extras_on_ ? &extra_[k] : nullptr;
+    RowExtra3* x = extras_on_ ? &prob_.extra[k] : nullptr;
     if (x) {
       *x = RowExtra3{};
       x->mu_b = prm_.orthotropic ? (wall ? prm_.mu_wall_b : prm_.mu_b) : r.mu;
@@ -233,22 +187,22 @@ void World3::build() {
 }
 
 void World3::colour() {
-  colouring_ = colour_by_bodies(
-      static_cast<int>(rows_.size()), bodies.size(), [&](int i) { return rows_[i].b1; },
-      [&](int i) { return rows_[i].b2; }, [&](std::int32_t b) { return bodies.is_dynamic(b); });
-  const std::vector<std::int32_t>& perm = colouring_.perm;
-  std::vector<SphereRow> r(rows_.size());
+  prob_.colouring = colour_by_bodies(
+      static_cast<int>(prob_.rows.size()), bodies.size(), [&](int i) { return prob_.rows[i].b1; },
+      [&](int i) { return prob_.rows[i].b2; }, [&](std::int32_t b) { return bodies.is_dynamic(b); });
+  const std::vector<std::int32_t>& perm = prob_.colouring.perm;
+  std::vector<SphereRow> r(prob_.rows.size());
   std::vector<ContactInfo3> f(info_.size());
-  std::vector<RowExtra3> e(extra_.size());
-#pragma omp parallel for schedule(static) if (static_cast<int>(rows_.size()) >= prm_.solver.min_parallel)
-  for (std::size_t k = 0; k < rows_.size(); ++k) {
-    r[k] = rows_[perm[k]];
+  std::vector<RowExtra3> e(prob_.extra.size());
+#pragma omp parallel for schedule(static) if (static_cast<int>(prob_.rows.size()) >= prm_.solver.min_parallel)
+  for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
+    r[k] = prob_.rows[perm[k]];
     f[k] = info_[perm[k]];
-    if (!e.empty()) e[k] = extra_[perm[k]];
+    if (!e.empty()) e[k] = prob_.extra[perm[k]];
   }
-  rows_.swap(r);
+  prob_.rows.swap(r);
   info_.swap(f);
-  extra_.swap(e);
+  prob_.extra.swap(e);
 }
 
 void World3::solve() {
@@ -262,20 +216,16 @@ void World3::solve() {
       if (bodies.is_dynamic(i)) V[i].v += dv;
   }
   // Warm-start impulses into the velocities (sequential: bodies are shared).
-  for (const SphereRow& r : rows_) {
-    const Vec3 P = r.to_world(r.r);
-    BodyVel3& A = V[r.b1];
-    BodyVel3& B = V[r.b2];
-    B.v += B.inv_m * P;
-    B.w += B.inv_I * r.c2.cross(P);
-    A.v -= A.inv_m * P;
-    A.w -= A.inv_I * r.c1.cross(P);
-  }
-  last_.solve = solve_fn_(rows_, extra_, colouring_, V, prm_.solver, dofs_on_ ? &dofs_ : nullptr);
-  for (const CellDof3& d : dofs_) prm_.cell_rate[d.axis] = d.v;
+  apply_impulses(prob_.rows, V);
+  // The problem takes the velocities for the solve and gives them back.
+  prob_.vel.swap(V);
+  if (hook_) hook_(prob_, prm_.solver);
+  last_.solve = solver_ ? solver_(prob_, prm_.solver) : nlgs_solve3(prob_, prm_.solver);
+  prob_.vel.swap(V);
+  for (const CellDof3& d : prob_.dofs) prm_.cell_rate[d.axis] = d.v;
 
   // Keep the impulses (world frame) for the next step's warm start.
-  const std::size_t nr = rows_.size();
+  const std::size_t nr = prob_.rows.size();
   std::vector<std::size_t> idx(nr);
   std::iota(idx.begin(), idx.end(), 0);
   std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return info_[a].key < info_[b].key; });
@@ -283,7 +233,7 @@ void World3::solve() {
   warm_.p.resize(nr);
   for (std::size_t k = 0; k < nr; ++k) {
     warm_.keys[k] = info_[idx[k]].key;
-    warm_.p[k] = rows_[idx[k]].to_world(rows_[idx[k]].r);
+    warm_.p[k] = prob_.rows[idx[k]].to_world(prob_.rows[idx[k]].r);
   }
 }
 
@@ -296,7 +246,7 @@ void World3::solve() {
 void World3::set_dofs(const Eigen::Matrix3d& K) {
   const double dt = prm_.dt, M = prm_.cell_mass;
   const double V = cm_.x() * cm_.y() * cm_.z();
-  dofs_.clear();
+  prob_.dofs.clear();
   for (int a = 0; a < 3; ++a) {
     if (!prm_.cell_dof[a]) continue;
     CellDof3 d;
@@ -307,13 +257,13 @@ void World3::set_dofs(const Eigen::Matrix3d& K) {
                                    cell_dof::floor(prm_.max_strain_rate, cm_[a], alert_, dt));
     d.v = d.v0;
     d.scale = dt * prm_.pressure * area;
-    d.extra = extras_on_ ? extra_.data() : nullptr;
+    d.extra = extras_on_ ? prob_.extra.data() : nullptr;
     const double dv = d.v0 - v_start;
-    for (std::size_t k = 0; k < rows_.size(); ++k) {
+    for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
       const ContactInfo3& f = info_[k];
       const int i = a == 0 ? f.ix : a == 1 ? f.iy : f.iz;
       if (i == 0) continue;
-      SphereRow& r = rows_[k];
+      SphereRow& r = prob_.rows[k];
       // The image of body 2 moves at i dL_a/dt e_a: u += i (n_a, t1_a, t2_a) v.
       const Vec3 c(i * r.n[a], d.extra ? i * r.t1[a] : 0.0, d.extra ? i * r.t2[a] : 0.0);
       d.rows.push_back(static_cast<std::int32_t>(k));
@@ -324,7 +274,7 @@ void World3::set_dofs(const Eigen::Matrix3d& K) {
         d.extra[k].bt2 += c[2] * dv;
       }
     }
-    dofs_.push_back(std::move(d));
+    prob_.dofs.push_back(std::move(d));
   }
 }
 
@@ -390,12 +340,12 @@ void World3::wrap_into_cell(double off) {
 }
 
 void World3::observe() {
-  const std::size_t nr = rows_.size();
+  const std::size_t nr = prob_.rows.size();
   last_.contacts = static_cast<int>(nr);
   int active = 0, nover = 0;
   double omax = 0, osum = 0;
   for (std::size_t k = 0; k < nr; ++k) {
-    if (rows_[k].r[0] + rows_[k].adh > 0.0) ++active;
+    if (prob_.rows[k].r[0] + prob_.rows[k].adh > 0.0) ++active;
     const double ov = -info_[k].gap;
     if (ov > 0) {
       ++nover;
@@ -409,7 +359,7 @@ void World3::observe() {
   double work = 0.0;
   if (prm_.overlap_correction > 0.0)
     for (std::size_t k = 0; k < nr; ++k)
-      if (info_[k].gap < 0.0 && rows_[k].bn < 0.0) work += rows_[k].r[0] * -rows_[k].bn;
+      if (info_[k].gap < 0.0 && prob_.rows[k].bn < 0.0) work += prob_.rows[k].r[0] * -prob_.rows[k].bn;
   last_.correction_work = work;
   last_.max_overlap = omax / prm_.d_ref;
   last_.mean_overlap = nover ? osum / nover / prm_.d_ref : 0.0;
@@ -427,10 +377,10 @@ double World3::kinetic_energy() const {
 
 std::vector<obs::Contact<3>> World3::contact_forces() const {
   std::vector<obs::Contact<3>> cs;
-  cs.reserve(rows_.size());
+  cs.reserve(prob_.rows.size());
   const double inv_dt = 1.0 / prm_.dt;
-  for (std::size_t k = 0; k < rows_.size(); ++k) {
-    const SphereRow& r = rows_[k];
+  for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
+    const SphereRow& r = prob_.rows[k];
     const Vec3 ft = (r.r[1] * r.t1 + r.r[2] * r.t2) * inv_dt;
     const Vec3& l = info_[k].branch;
     cs.push_back({r.b1, r.b2, {r.n.x(), r.n.y(), r.n.z()}, r.r[0] * inv_dt, {ft.x(), ft.y(), ft.z()},

@@ -19,11 +19,13 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
 #include "bodies3.hpp"
 #include "contact3.hpp"
+#include "contact_problem3.hpp"
 #include "detect3.hpp"
 #include "observables.hpp"
 #include "solver.hpp"
@@ -96,22 +98,6 @@ struct WorldParams3 {
   double strain = 0.0;
 };
 
-// A cell length as a boundary dof of the 3D sweep (the 3D sibling of 2D's
-// BoundaryDof): its velocity v enters the relative velocity of the rows
-// that touch an image across its face as a.(u_n, u_t1, u_t2) += a v, and
-// their impulses act back. Updated between sweeps by core/cell_dof.hpp's
-// damped step; the change goes into the rows' offsets (bn, and the
-// tangential ones in `extra`, null in frictionless scenes).
-struct CellDof3 {
-  double v0 = 0.0, v = 0.0, inv_mass = 0.0;
-  double scale = 1.0;  // impulse scale of the convergence test (the imposed impulse)
-  int axis = 0;
-  std::vector<std::int32_t> rows;
-  std::vector<Vec3> a;  // coefficients in the row's frame (n, t1, t2)
-  RowExtra3* extra = nullptr;
-};
-double update_dof(CellDof3& d, SphereRow* rows);
-
 class World3 {
  public:
   explicit World3(const WorldParams3& p) : prm_(p) { configure(); }
@@ -132,8 +118,20 @@ class World3 {
   // The last step's rows (solved) and their records, in colour order
   // (extras: empty unless the scene has tangential offsets or an
   // orthotropic cone).
-  const std::vector<SphereRow>& rows() const { return rows_; }
-  const std::vector<RowExtra3>& row_extras() const { return extra_; }
+  const std::vector<SphereRow>& rows() const { return prob_.rows; }
+  const std::vector<RowExtra3>& row_extras() const { return prob_.extra; }
+  // The contact problem of the last step (solved), in colour order; its
+  // `vel` is empty outside the solve stage (the velocities are in bodies).
+  const ContactProblem3& problem() const { return prob_; }
+
+  // The solve stage's solver (default nlgs_solve3): a study may put another
+  // one in (cd/bench), the rest of the step unchanged.
+  using Solver = std::function<SolveStats(ContactProblem3&, const SolverParams&)>;
+  void set_solver(Solver s) { solver_ = std::move(s); }
+  // Called with the problem just before it is solved (its impulses the warm
+  // start, already in its velocities): --dump-problem writes it out.
+  using ProblemHook = std::function<void(const ContactProblem3&, const SolverParams&)>;
+  void set_problem_hook(ProblemHook h) { hook_ = std::move(h); }
   const std::vector<ContactInfo3>& infos() const { return info_; }
 
   double kinetic_energy() const;    // translational + rotational, dynamic bodies
@@ -171,10 +169,6 @@ class World3 {
   // Restores the warm-start memory (a checkpoint; checkpoint3.cpp).
   void set_warm_start(WarmStart w) { warm_ = std::move(w); }
 
-  // A scene's sweep instance (chosen in configure).
-  using SolveFn = SolveStats (*)(std::vector<SphereRow>&, const std::vector<RowExtra3>&, const Colouring&,
-                                 std::vector<BodyVel3>&, const SolverParams&, std::vector<CellDof3>*);
-
  private:
   void configure();
   void predict();
@@ -193,18 +187,16 @@ class World3 {
   bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, periodic_on_ = false,
        moving_images_ = false, extras_on_ = false, dofs_on_ = false;
   double alert_ = 0.0;
-  SolveFn solve_fn_ = nullptr;
   StepStats last_;
   std::vector<Vec3> xm_;
   std::vector<Quat> qm_;
-  std::vector<SphereRow> rows_;
+  ContactProblem3 prob_;  // rows, extras (empty unless extras_on_), colouring, dofs, law
   std::vector<ContactInfo3> info_;
-  std::vector<RowExtra3> extra_;  // same index as rows_; empty unless extras_on_
-  Colouring colouring_;
   CellGrid3 grid_;
   WarmStart warm_;
   Vec3 cm_ = Vec3::Zero();  // the cell's lengths at the step's midpoint
-  std::vector<CellDof3> dofs_;
+  Solver solver_;
+  ProblemHook hook_;
 };
 
 }  // namespace cd

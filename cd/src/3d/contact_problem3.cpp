@@ -1,0 +1,185 @@
+#include "contact_problem3.hpp"
+
+#include <climits>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "cell_dof.hpp"
+#include "problem_file.hpp"
+#include "text_reader.hpp"
+
+namespace cd {
+
+double update_dof(CellDof3& d, SphereRow* rows) {
+  // core/cell_dof.hpp's damped step, with the 3D rows' impulses and
+  // responses (W = diag(W_nn, W_tt, W_tt)).
+  double s = 0.0, k = 0.0;
+  const std::size_t m = d.rows.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    const SphereRow& r = rows[d.rows[i]];
+    const Vec3& a = d.a[i];
+    s += a.dot(r.r);
+    if (r.r[0] + r.adh > 0.0) k += a[0] * a[0] / r.wnn + (a[1] * a[1] + a[2] * a[2]) / r.wtt;
+  }
+  double res;
+  const double dv = cell_dof::damped_step(d.v0, d.v, d.inv_mass, s, k, res);
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::int32_t j = d.rows[i];
+    rows[j].bn += d.a[i][0] * dv;
+    if (d.extra) {
+      d.extra[j].bt1 += d.a[i][1] * dv;
+      d.extra[j].bt2 += d.a[i][2] * dv;
+    }
+  }
+  d.v += dv;
+  return std::abs(res) / (d.inv_mass * d.scale);
+}
+
+SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer) {
+  RowExtra3* extra = p.extra.empty() ? nullptr : p.extra.data();
+  for (CellDof3& d : p.dofs) d.extra = extra;
+  std::vector<CellDof3>* dofs = p.dofs.empty() ? nullptr : &p.dofs;
+  return std::visit(
+      [&](auto law) {
+        using L = decltype(law);
+        sweep::BodyCoupling3 c{p.vel.data(), extra, p.rows.data()};
+        return sweep::solve<L>(p.rows, p.colouring, c, prm, dofs, observer);
+      },
+      p.law);
+}
+
+void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& vel) {
+  for (const SphereRow& r : rows) {
+    const Vec3 P = r.to_world(r.r);
+    BodyVel3& A = vel[r.b1];
+    BodyVel3& B = vel[r.b2];
+    B.v += B.inv_m * P;
+    B.w += B.inv_I * r.c2.cross(P);
+    A.v -= A.inv_m * P;
+    A.w -= A.inv_I * r.c1.cross(P);
+  }
+}
+
+// ---- .cdp3 files -----------------------------------------------------------
+
+namespace {
+
+using problem_file::hex;
+std::string x(double v) { return hex(v); }
+std::string x3(const Vec3& v) { return fmt::format("{:a} {:a} {:a}", v[0], v[1], v[2]); }
+
+Vec3 vec3(TextReader& rd, const std::string& what) {
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) v[i] = rd.number(fmt::format("{}[{}]", what, i));
+  return v;
+}
+
+}  // namespace
+
+void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, std::ostream& out) {
+  out << "cdlab-contact-problem3 1\n";
+  out << "law " << law_name3(p.law) << "\n";
+  problem_file::write_solver(out, prm);
+  out << "bodies " << p.vel.size() << "\n";
+  for (const BodyVel3& v : p.vel) out << fmt::format("{} {} {} {}\n", x3(v.v), x3(v.w), x(v.inv_m), x(v.inv_I));
+  problem_file::write_colouring(out, p.colouring);
+  out << "rows " << p.rows.size() << "\n";
+  for (const SphereRow& r : p.rows)
+    out << fmt::format("{} {} {} {} {} {} {} {} {} {} {} {} {}\n", r.b1, r.b2, x3(r.n), x3(r.t1), x3(r.t2),
+                       x3(r.c1), x3(r.c2), x(r.wnn), x(r.wtt), x(r.bn), x3(r.r), x(r.mu), x(r.adh));
+  out << "extras " << p.extra.size() << "\n";
+  for (const RowExtra3& e : p.extra) out << fmt::format("{} {} {}\n", x(e.bt1), x(e.bt2), x(e.mu_b));
+  out << "dofs " << p.dofs.size() << "\n";
+  for (const CellDof3& d : p.dofs) {
+    out << problem_file::dof_scalars(d) << ' ' << d.axis << ' ' << d.rows.size() << '\n';
+    for (std::size_t m = 0; m < d.rows.size(); ++m) out << fmt::format("{} {}\n", d.rows[m], x3(d.a[m]));
+  }
+}
+
+ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name, SolverParams& prm) {
+  TextReader rd(in, name);
+  rd.expect("cdlab-contact-problem3", "at the start (not a cdlab 3D problem file)");
+  rd.integer("the format version", 1, 1);
+  ContactProblem3 p;
+  p.law = problem_file::read_law<LocalLaw3>(rd, [](const LocalLaw3& l) { return law_name3(l); });
+  problem_file::read_solver(rd, prm, "after the law");
+  if (!(prm.tol > 0)) rd.fail(fmt::format("the tolerance is {}, not positive", prm.tol));
+  rd.expect("bodies", "after the solver's parameters");
+  const long long nb = rd.integer("the number of bodies", 0, INT_MAX);
+  p.vel.resize(nb);
+  for (long long i = 0; i < nb; ++i) {
+    BodyVel3& v = p.vel[i];
+    const std::string w = fmt::format(" of body {}", i);
+    v.v = vec3(rd, "v" + w);
+    v.w = vec3(rd, "w" + w);
+    v.inv_m = rd.number("inv_m" + w);
+    v.inv_I = rd.number("inv_I" + w);
+    if (v.inv_m < 0 || v.inv_I < 0) rd.fail(fmt::format("negative inverse mass or inertia{}", w));
+  }
+  p.colouring = problem_file::read_colouring(rd, 1 << 16, "after the bodies");
+  const long long nr = problem_file::read_row_count(rd, p.colouring);
+  p.rows.resize(nr);
+  for (long long k = 0; k < nr; ++k) {
+    SphereRow& r = p.rows[k];
+    const std::string w = fmt::format(" of row {}", k);
+    problem_file::read_row_bodies(rd, r, nb, w);
+    r.n = vec3(rd, "n" + w);
+    r.t1 = vec3(rd, "t1" + w);
+    r.t2 = vec3(rd, "t2" + w);
+    r.c1 = vec3(rd, "c1" + w);
+    r.c2 = vec3(rd, "c2" + w);
+    r.wnn = rd.number("W_nn" + w);
+    r.wtt = rd.number("W_tt" + w);
+    r.bn = rd.number("b_n" + w);
+    r.r = vec3(rd, "r" + w);
+    r.mu = rd.number("mu" + w);
+    r.adh = rd.number("the adhesion impulse" + w);
+    if (!(r.wnn > 0) || !(r.wtt > 0)) rd.fail(fmt::format("W_nn or W_tt{} not positive", w));
+    if (r.mu < 0 || r.adh < 0) rd.fail(fmt::format("mu or the adhesion impulse{} negative", w));
+  }
+  rd.expect("extras", "after the rows");
+  const long long ne = rd.integer("the number of row extras (0 or the rows)", 0, nr);
+  if (ne != 0 && ne != nr) rd.fail(fmt::format("{} row extras for {} rows: expected 0 or {}", ne, nr, nr));
+  const bool needs_extra = std::visit([](auto l) { return decltype(l)::extra; }, p.law);
+  if (needs_extra && ne == 0) rd.fail(fmt::format("law '{}' needs the rows' extras, the file has none", law_name3(p.law)));
+  p.extra.resize(ne);
+  for (long long k = 0; k < ne; ++k) {
+    RowExtra3& e = p.extra[k];
+    const std::string w = fmt::format(" of row extra {}", k);
+    e.bt1 = rd.number("b_t1" + w);
+    e.bt2 = rd.number("b_t2" + w);
+    e.mu_b = rd.number("mu_b" + w);
+    if (e.mu_b < 0) rd.fail(fmt::format("mu_b{} negative", w));
+  }
+  rd.expect("dofs", "after the extras");
+  const long long nd = rd.integer("the number of dofs", 0, 3);
+  p.dofs.resize(nd);
+  for (long long d = 0; d < nd; ++d) {
+    CellDof3& D = p.dofs[d];
+    const std::string w = fmt::format(" of dof {}", d);
+    problem_file::read_dof_scalars(rd, D, w);
+    if (!(D.inv_mass > 0) || !(D.scale > 0)) rd.fail(fmt::format("inv_mass or scale{} not positive", w));
+    D.axis = static_cast<int>(rd.integer("the axis" + w, 0, 2));
+    const long long m = rd.integer("the number of rows" + w, 0, nr);
+    D.rows.resize(m);
+    D.a.resize(m);
+    for (long long j = 0; j < m; ++j) {
+      D.rows[j] = static_cast<std::int32_t>(rd.integer("a row" + w, 0, nr - 1));
+      D.a[j] = vec3(rd, "a" + w);
+    }
+  }
+  if (!rd.token().empty()) rd.fail("unexpected text after the last dof");
+  return p;
+}
+
+ContactProblem3 read_contact_problem3(const std::string& path, SolverParams& prm) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open for reading", path));
+  return read_contact_problem3(in, path, prm);
+}
+
+}  // namespace cd

@@ -1,0 +1,84 @@
+// The contact problem of one 3D time step, as plain data: the seam between
+// World3's step (whose build, colour and solve stages fill it) and the
+// solver (nlgs_solve3, which consumes it), the 3D sibling of
+// 2d/contact_problem.hpp. Nothing in it knows of spheres' radii, planes,
+// cells or walls; cdproblem replays it from a .cdp3 file, and its matrix form
+// (W = H^T M^-1 H, q, mu: to_matrix, problem3.hpp) goes to FCLib files.
+//
+// A problem is:
+//   rows       one per contact: frame (n, t1, t2), lever arms, the block
+//              diag(W_nn, W_tt, W_tt), the normal offset b_n (gap term,
+//              restitution, image velocity), mu, the adhesion impulse and
+//              the impulse r, in colour order;
+//   extra      same index: tangential offsets and mu_b (RowExtra3), empty
+//              unless the law reads them or a cell dof writes them;
+//   colouring  which rows may be updated at once;
+//   vel        every body's velocity and inverse mass and inertia, with the
+//              rows' impulses (the warm start) already in it;
+//   dofs       the cell lengths solved with the contacts (CellDof3);
+//   law        the local law, one type for the whole problem (coupling3.hpp).
+#pragma once
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "bodies3.hpp"
+#include "contact3.hpp"
+#include "coupling3.hpp"
+#include "solver.hpp"
+
+namespace cd {
+
+// A cell length as a boundary dof of the 3D sweep (the 3D sibling of 2D's
+// BoundaryDof): its velocity v enters the relative velocity of the rows
+// that touch an image across its face as a.(u_n, u_t1, u_t2) += a v, and
+// their impulses act back. Updated between sweeps by core/cell_dof.hpp's
+// damped step; the change goes into the rows' offsets (bn, and the
+// tangential ones in `extra`, null in frictionless scenes).
+struct CellDof3 {
+  double v0 = 0.0, v = 0.0, inv_mass = 0.0;
+  double scale = 1.0;  // impulse scale of the convergence test (the imposed impulse)
+  int axis = 0;
+  std::vector<std::int32_t> rows;
+  std::vector<Vec3> a;  // coefficients in the row's frame (n, t1, t2)
+  RowExtra3* extra = nullptr;  // the problem's extras (set by nlgs_solve3), or null
+};
+double update_dof(CellDof3& d, SphereRow* rows);
+
+struct ContactProblem3 {
+  std::vector<SphereRow> rows;
+  std::vector<RowExtra3> extra;
+  Colouring colouring;
+  std::vector<BodyVel3> vel;
+  std::vector<CellDof3> dofs;
+  LocalLaw3 law;
+};
+
+// Solves the problem in place (impulses, velocities, dofs) from the impulses
+// held in the rows, which must already be in the velocities. The law is
+// resolved here, once, into a template instance of core/sweep.hpp.
+SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer = {});
+
+// Adds the impulses held in the rows to the body velocities (warm start);
+// in row order, one thread (bodies are shared).
+void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& vel);
+
+// ---- files -------------------------------------------------------------
+// cdlab's own text format of a ContactProblem3 (".cdp3"): every number a C
+// hexadecimal float, so that a problem read back is the same bits and its
+// solve the same impulses as the step it was dumped from. Layout: a header
+// line "cdlab-contact-problem3 1", then `law NAME` (law_name3), the
+// solver's `tol`, `max_iter`, `min_parallel` and optional `residual_tol`;
+// `bodies N` and N lines "vx vy vz wx wy wz inv_m inv_I"; `colours C
+// overflow 0|1` and the lines "start" and "split"; `rows R` and R lines "b1
+// b2 n(3) t1(3) t2(3) c1(3) c2(3) wnn wtt bn r(3) mu adh"; `extras E` (0 or
+// R) and E lines "bt1 bt2 mu_b"; `dofs D` and per dof "v0 v inv_mass scale
+// axis M" then M lines "row a_n a_t1 a_t2". Malformed input throws
+// std::runtime_error naming the file, the line and what was expected.
+// (dump3.cpp writes the text with core/files.hpp's atomic write.)
+void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, std::ostream& out);
+ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name, SolverParams& prm);
+ContactProblem3 read_contact_problem3(const std::string& path, SolverParams& prm);
+
+}  // namespace cd

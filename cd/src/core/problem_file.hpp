@@ -1,0 +1,117 @@
+// The parts of cdlab's frozen-step files (.cdp for 2D, .cdp3 for 3D;
+// 2d/contact_problem.hpp, 3d/contact_problem3.hpp) that do not depend on
+// the dimension: the solver's parameters and the colouring, written and read
+// the same way by both, every number a C hexadecimal float (read back to the
+// same bits) and every malformed value reported by TextReader with the file
+// and the line.
+#pragma once
+#include <climits>
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <utility>
+#include <variant>
+
+#include <fmt/format.h>
+
+#include "solver.hpp"
+#include "text_reader.hpp"
+
+namespace cd::problem_file {
+
+// %a: hexadecimal floats, read back to the same bits by strtod.
+inline std::string hex(double v) { return fmt::format("{:a}", v); }
+
+// "tol T", "max_iter N", "min_parallel N" and, when > 0, "residual_tol R".
+inline void write_solver(std::ostream& out, const SolverParams& prm) {
+  out << "tol " << hex(prm.tol) << "\nmax_iter " << prm.max_iter << "\nmin_parallel " << prm.min_parallel << "\n";
+  if (prm.residual_tol > 0) out << "residual_tol " << hex(prm.residual_tol) << "\n";
+}
+
+inline void read_solver(TextReader& rd, SolverParams& prm, const std::string& after) {
+  rd.expect("tol", after);
+  prm.tol = rd.number("the tolerance");
+  rd.expect("max_iter", "after tol");
+  prm.max_iter = static_cast<int>(rd.integer("the sweep cap", 1, INT_MAX));
+  rd.expect("min_parallel", "after max_iter");
+  prm.min_parallel = static_cast<int>(rd.integer("the parallel threshold", 0, INT_MAX));
+  if (rd.peek() == "residual_tol") {  // optional: written when > 0
+    rd.token();
+    prm.residual_tol = rd.number("the residual tolerance");
+  }
+}
+
+// "colours C overflow 0|1", "start ..." (C + 1 values), "split ..." (C).
+inline void write_colouring(std::ostream& out, const Colouring& c) {
+  out << "colours " << c.split.size() << " overflow " << (c.overflow ? 1 : 0) << "\nstart";
+  for (const auto v : c.start) out << ' ' << v;
+  out << "\nsplit";
+  for (const auto v : c.split) out << ' ' << v;
+  out << "\n";
+}
+
+// Reads what write_colouring wrote; `max_colours` bounds the count.
+inline Colouring read_colouring(TextReader& rd, long long max_colours, const std::string& after) {
+  Colouring col;
+  rd.expect("colours", after);
+  const long long nc = rd.integer("the number of colours", 0, max_colours);
+  rd.expect("overflow", "after the number of colours");
+  col.overflow = rd.integer("overflow (0 or 1)", 0, 1) == 1;
+  rd.expect("start", "after the colour count");
+  col.start.resize(nc + 1);
+  for (auto& v : col.start) v = static_cast<std::int32_t>(rd.integer("a colour start", 0, INT_MAX));
+  rd.expect("split", "after the colour starts");
+  col.split.resize(nc);
+  for (long long c = 0; c < nc; ++c)
+    col.split[c] = static_cast<std::int32_t>(rd.integer("a colour split", col.start[c], col.start[c + 1]));
+  return col;
+}
+
+// "rows R" after the colouring, which must cover the rows [0, R) in order.
+inline long long read_row_count(TextReader& rd, const Colouring& c) {
+  rd.expect("rows", "after the colouring");
+  const long long nr = rd.integer("the number of rows", 0, INT_MAX);
+  if (c.start.front() != 0 || c.start.back() != nr)
+    rd.fail(fmt::format("the colours cover rows {} to {}, the problem has {}", c.start.front(), c.start.back(), nr));
+  return nr;
+}
+
+// A row's two bodies, each in [0, nb).
+template <class Row>
+void read_row_bodies(TextReader& rd, Row& r, long long nb, const std::string& w) {
+  r.b1 = static_cast<std::int32_t>(rd.integer("body 1" + w, 0, nb - 1));
+  r.b2 = static_cast<std::int32_t>(rd.integer("body 2" + w, 0, nb - 1));
+}
+
+// "law NAME": the alternative of the law variant V whose name(law) is NAME.
+template <class V, class Name>
+V read_law(TextReader& rd, Name&& name) {
+  rd.expect("law", "after the header");
+  const std::string law(rd.need("the law's name"));
+  V out;
+  bool found = false;
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    ((!found && name(V{std::variant_alternative_t<I, V>{}}) == law
+          ? (out = std::variant_alternative_t<I, V>{}, found = true)
+          : false),
+     ...);
+  }(std::make_index_sequence<std::variant_size_v<V>>{});
+  if (!found) rd.fail(fmt::format("unknown law '{}'", law));
+  return out;
+}
+
+// A boundary dof's scalars "v0 v inv_mass scale" (2D BoundaryDof, 3D
+// CellDof3), `w` naming the dof in messages.
+template <class Dof>
+std::string dof_scalars(const Dof& d) {
+  return fmt::format("{} {} {} {}", hex(d.v0), hex(d.v), hex(d.inv_mass), hex(d.scale));
+}
+template <class Dof>
+void read_dof_scalars(TextReader& rd, Dof& d, const std::string& w) {
+  d.v0 = rd.number("v0" + w);
+  d.v = rd.number("v" + w);
+  d.inv_mass = rd.number("inv_mass" + w);
+  d.scale = rd.number("scale" + w);
+}
+
+}  // namespace cd::problem_file
