@@ -440,5 +440,4 @@ TEST(Scene3, BadInputIsRefusedNamingTheKey) {
   refused("--set 'contact.axis_a=[0,0,0]'", {"contact.axis_a", "non-zero"});
   refused("--set 'contact.axis_a=[1,0]'", {"contact.axis_a"});
   refused("--set 'contact.axis_a=[1,0,inf]'", {"contact.axis_a", "finite"});
-  refused("--dump-problem 3", {"--dump-problem", "dimension = 3"});
 }

@@ -1,13 +1,13 @@
 // cdproblem: replays a frozen contact problem with the production solver.
 //   cdproblem solve FILE.dat [--tol 1e-6] [--max-sweeps N] [--check-every K] [--lemke]
-//   cdproblem solve FILE.cdp [--tol T] [--max-sweeps N] [--out IMPULSES.txt]
+//   cdproblem solve FILE.cdp|FILE.cdp3 [--tol T] [--max-sweeps N] [--out IMPULSES.txt]
 //   cdproblem solve FILE.hdf5 [--tol 1e-6] [--max-sweeps N] [--check-every K] [--lemke --facets E]
 // FILE.dat: Siconos' text format (W, q, mu), solved by the simulator's sweep
 // through the blocks of W (problem.hpp); prints the problem size, the sweep's
 // change and the law residual every K sweeps, Siconos' error and the time;
 // with --lemke, the reference LCP solve instead.
-// FILE.cdp: a step dumped by `cdsim --dump-problem` (contact_problem.hpp),
-// solved exactly as the step was (same rows, colouring, law, dofs and,
+// FILE.cdp, FILE.cdp3: a 2D or 3D step dumped by `cdsim --dump-problem`
+// (contact_problem.hpp, contact_problem3.hpp), solved exactly as the step was (same rows, colouring, law, dofs and,
 // unless overridden, tolerance and cap): the same impulses to the bit.
 // FILE.hdf5: an FCLib 3D problem (local, or global condensed to W, q),
 // solved by the 3D NLGS with the exact local solver (3d/problem3.hpp); with
@@ -23,6 +23,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "contact_problem3.hpp"
 #include "lemke.hpp"
 #include "lemke3.hpp"
 #include "nlgs.hpp"
@@ -118,32 +119,61 @@ int solve3(const std::string& path, const cd::NlgsOptions& opt, bool lemke, int 
   return st.converged ? 0 : 1;
 }
 
+// The dumped steps of the two engines (.cdp, .cdp3), as solve_step sees
+// them: read, describe, solve, and the impulses as hex floats, a row a line.
+struct Step2 {
+  using Problem = cd::ContactProblem;
+  static Problem read(const std::string& path, cd::SolverParams& prm) { return cd::read_contact_problem(path, prm); }
+  static std::string describe(const Problem& p) {
+    return fmt::format("{} rows, {} bodies, {} colours, {} boundary dofs, law {}, rotation {}", p.rows.size(),
+                       p.vel.size(), p.colouring.split.size(), p.dofs.size(), cd::law_name(p.law),
+                       p.rotation ? "on" : "off");
+  }
+  static cd::SolveStats solve(Problem& p, const cd::SolverParams& prm) { return cd::nlgs_solve(p, prm); }
+  static std::string impulses(const Problem& p) {
+    std::string text;
+    for (const cd::ContactRow& r : p.rows) text += fmt::format("{:a} {:a}\n", r.pn, r.pt);
+    return text;
+  }
+};
+
+struct Step3 {
+  using Problem = cd::ContactProblem3;
+  static Problem read(const std::string& path, cd::SolverParams& prm) { return cd::read_contact_problem3(path, prm); }
+  static std::string describe(const Problem& p) {
+    return fmt::format("{} rows, {} bodies, {} colours, {} cell dofs, law {}", p.rows.size(), p.vel.size(),
+                       p.colouring.split.size(), p.dofs.size(), cd::law_name3(p.law));
+  }
+  static cd::SolveStats solve(Problem& p, const cd::SolverParams& prm) { return cd::nlgs_solve3(p, prm); }
+  static std::string impulses(const Problem& p) {
+    std::string text;
+    for (const cd::SphereRow& r : p.rows) text += fmt::format("{:a} {:a} {:a}\n", r.r[0], r.r[1], r.r[2]);
+    return text;
+  }
+};
+
 // A dumped step: the production solve of its rows, with the step's own
 // tolerance and cap unless given. Writes the impulses (row order, hex
 // floats: exact) to `out` if given.
-int solve_step(const std::string& path, double tol, int max_sweeps, double residual_tol,
-               const std::string& out) {
+template <class Step>
+int solve_step(const std::string& path, double tol, int max_sweeps, double residual_tol, const std::string& out) {
   cd::SolverParams prm;
-  cd::ContactProblem p = cd::read_contact_problem(path, prm);
+  typename Step::Problem p = Step::read(path, prm);
   if (tol > 0) prm.tol = tol;
   if (max_sweeps > 0) prm.max_iter = max_sweeps;
   if (residual_tol >= 0) prm.residual_tol = residual_tol;
-  fmt::print("{}: {} rows, {} bodies, {} colours, {} boundary dofs, law {}, rotation {}\n", path,
-             p.rows.size(), p.vel.size(), p.colouring.split.size(), p.dofs.size(),
-             cd::law_name(p.law), p.rotation ? "on" : "off");
+  fmt::print("{}: {}\n", path, Step::describe(p));
   const auto t0 = std::chrono::steady_clock::now();
-  const cd::SolveStats st = cd::nlgs_solve(p, prm);
+  const cd::SolveStats st = Step::solve(p, prm);
   const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   fmt::print(
       "nlgs: {} after {} sweeps (rms |dp|/|p| {:.3e}, tol {:.3g}), residual max {:.3e} mean "
       "{:.3e} (mean |p| {:.3e}), time {:.3g} s\n",
-      st.cap_hit ? "NOT converged (sweep cap)" : st.residual_met ? "converged (law residual)" : "converged", st.iterations, st.dp_rel, prm.tol,
-      st.residual_max, st.residual_mean, st.p_mean, t);
+      st.cap_hit ? "NOT converged (sweep cap)" : st.residual_met ? "converged (law residual)" : "converged",
+      st.iterations, st.dp_rel, prm.tol, st.residual_max, st.residual_mean, st.p_mean, t);
   if (!out.empty()) {
-    std::string text;
-    for (const cd::ContactRow& r : p.rows) text += fmt::format("{:a} {:a}\n", r.pn, r.pt);
     std::ofstream f(out);
-    if (!(f << text) || !f.flush())
+    if (!(f << Step::impulses(p)) || !f.flush())
       throw std::runtime_error(fmt::format("{}: cannot write the impulses", out));
   }
   return st.cap_hit ? 1 : 0;
@@ -152,13 +182,13 @@ int solve_step(const std::string& path, double tol, int max_sweeps, double resid
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"cdproblem: solve frozen frictional contact problems (2D .dat, .cdp; 3D FCLib .hdf5)"};
+  CLI::App app{"cdproblem: solve frozen frictional contact problems (2D .dat, .cdp; 3D .cdp3, FCLib .hdf5)"};
   app.require_subcommand(1);
   CLI::App* cmd = app.add_subcommand("solve", "solve one problem file with NLGS (or Lemke)");
   std::string path;
   cd::NlgsOptions opt;
   bool lemke = false;
-  cmd->add_option("file", path, "problem file (.dat: Siconos matrix form; .cdp: a step dumped by cdsim; .hdf5: FCLib 3D)")->required();
+  cmd->add_option("file", path, "problem file (.dat: Siconos matrix form; .cdp, .cdp3: a 2D or 3D step dumped by cdsim; .hdf5: FCLib 3D)")->required();
   cmd->add_option("--tol", opt.tol, "tolerance on the sweep's rms |dr|/mean|r| (the production test), in (0, 1]")
       ->check(CLI::Validator(
           [](std::string& v) {
@@ -180,10 +210,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 64))
       ->capture_default_str();
   std::string out;
-  cmd->add_option("--out", out, "(.cdp) write the impulses, one row a line, as hex floats");
+  cmd->add_option("--out", out, "(.cdp, .cdp3) write the impulses, one row a line, as hex floats");
   double residual_tol = -1;
   cmd->add_option("--residual-tol", residual_tol,
-                  "(.cdp) also stop when the largest law residual is below this (checked every 10 "
+                  "(.cdp, .cdp3) also stop when the largest law residual is below this (checked every 10 "
                   "sweeps; solver.residual_tol); 0: off; default: the step's own")
       ->check(CLI::Range(0.0, 1.0));
   try {
@@ -192,11 +222,12 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;  // --help: 0; every usage error: bad input
   }
   try {
-    if (path.size() > 4 && path.substr(path.size() - 4) == ".cdp") {
-      if (lemke) throw std::runtime_error("--lemke takes a .dat problem (matrix form)");
+    const auto ends = [&](const std::string& e) { return path.size() > e.size() && path.ends_with(e); };
+    if (ends(".cdp") || ends(".cdp3")) {
+      if (lemke) throw std::runtime_error("--lemke takes a .dat or .hdf5 problem (matrix form)");
       const bool tol_given = cmd->count("--tol") > 0, cap_given = cmd->count("--max-sweeps") > 0;
-      return solve_step(path, tol_given ? opt.tol : 0.0, cap_given ? opt.max_sweeps : 0, residual_tol,
-                        out);
+      return (ends(".cdp") ? solve_step<Step2> : solve_step<Step3>)(path, tol_given ? opt.tol : 0.0,
+                                                       cap_given ? opt.max_sweeps : 0, residual_tol, out);
     }
     if (path.size() > 5 && path.substr(path.size() - 5) == ".hdf5") return solve3(path, opt, lemke, facets);
     return solve(path, opt, lemke);

@@ -43,7 +43,8 @@ int main(int argc, char** argv) {
   std::vector<std::int64_t> dump_steps;
   app.add_option("--dump-problem", dump_steps,
                  "write step STEP's contact problem into the output folder (repeatable): "
-                 "problem_STEP.cdp (replayed exactly by cdproblem), .dat (Siconos), .impulses")
+                 "problem_STEP.cdp (2D) or .cdp3 (3D), replayed exactly by cdproblem; .dat (2D, Siconos' "
+                 "matrix form) or .hdf5 (3D, FCLib); .impulses")
       ->check(CLI::PositiveNumber);
   std::int64_t max_steps = 0;
   app.add_option("--max-steps", max_steps,
@@ -77,8 +78,6 @@ int main(int argc, char** argv) {
     }
     if (out.empty()) out = "outputs/" + scene.name;
     const bool three = scene.dimension == 3;
-    if (three && !dump_steps.empty())
-      throw cd::SceneError("--dump-problem writes 2D contact problems; this scene has dimension = 3");
     // Everything is built and checked before anything is written.
     std::optional<cd::World> world;
     std::optional<cd::World3> world3;

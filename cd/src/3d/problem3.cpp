@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <climits>
 #include <cmath>
 #include <limits>
@@ -22,6 +23,7 @@ extern "C" {
 }
 
 #include "colour_blocks.hpp"
+#include "contact_problem3.hpp"
 #include "sweep.hpp"
 
 namespace cd {
@@ -131,6 +133,128 @@ struct Coulomb3 {
 };
 
 }  // namespace
+
+Problem3 to_matrix(const ContactProblem3& cp) {
+  if (std::visit([](auto l) { return decltype(l)::cohesive; }, cp.law))
+    throw std::invalid_argument("a cohesive problem (adhesion impulse > 0) has no FCLib matrix form");
+  const auto& rows = cp.rows;
+  const auto& V = cp.vel;
+  const int nc = static_cast<int>(rows.size()), nb = static_cast<int>(V.size());
+  const int nd = static_cast<int>(cp.dofs.size());
+  // H (6nb + nd x 3nc): column 3k + j is row k's frame vector e_j (n, t1,
+  // t2); body b's rows 6b..6b+2 its velocity, 6b+3..6b+5 its angular
+  // velocity (u_k,j = e_j.(v2 - v1) + w2.(c2 x e_j) - w1.(c1 x e_j)), then
+  // one row per cell dof (u_k,j += a_j v). MH = M^-1 H keeps only what has
+  // an inverse mass, so W = H^T MH has no structural entry through a wall.
+  Triplets h, mh;
+  h.reserve(36 * static_cast<std::size_t>(nc));
+  mh.reserve(36 * static_cast<std::size_t>(nc));
+  auto add = [&](int b, const Vec3& lin, const Vec3& ang, int col) {
+    for (int i = 0; i < 3; ++i) {
+      h.emplace_back(6 * b + i, col, lin[i]);
+      h.emplace_back(6 * b + 3 + i, col, ang[i]);
+      if (V[b].inv_m != 0.0) mh.emplace_back(6 * b + i, col, V[b].inv_m * lin[i]);
+      if (V[b].inv_I != 0.0) mh.emplace_back(6 * b + 3 + i, col, V[b].inv_I * ang[i]);
+    }
+  };
+  for (int k = 0; k < nc; ++k) {
+    const SphereRow& r = rows[k];
+    const Vec3 e[3] = {r.n, r.t1, r.t2};
+    for (int j = 0; j < 3; ++j) {
+      add(r.b2, e[j], r.c2.cross(e[j]), 3 * k + j);
+      add(r.b1, -e[j], -r.c1.cross(e[j]), 3 * k + j);
+    }
+  }
+  // A cell dof is one more body: its v0 part is already in the rows'
+  // offsets and v = v0 before the solve, so it adds inv_mass a a^T to W and
+  // nothing to q (2D's assemble_problem, the same argument).
+  for (int d = 0; d < nd; ++d) {
+    const CellDof3& D = cp.dofs[d];
+    for (std::size_t m = 0; m < D.rows.size(); ++m)
+      for (int j = 0; j < 3; ++j) {
+        h.emplace_back(6 * nb + d, 3 * D.rows[m] + j, D.a[m][j]);
+        mh.emplace_back(6 * nb + d, 3 * D.rows[m] + j, D.inv_mass * D.a[m][j]);
+      }
+  }
+  SpMat H(6 * nb + nd, 3 * nc), MH(6 * nb + nd, 3 * nc);
+  H.setFromTriplets(h.begin(), h.end());
+  MH.setFromTriplets(mh.begin(), mh.end());
+  Problem3 P;
+  P.nc = nc;
+  P.W = SpMat(H.transpose() * MH);
+  P.W.makeCompressed();
+  // The bodies' velocities hold the warm start (H^T U includes W_body r),
+  // the dofs' do not (v = v0): q = H_b^T U - W_b r + b.
+  Eigen::VectorXd U(6 * nb), r(3 * nc), b(3 * nc);
+  for (int i = 0; i < nb; ++i) U.segment<6>(6 * i) << V[i].v, V[i].w;
+  for (int k = 0; k < nc; ++k) {
+    r.segment<3>(3 * k) = rows[k].r;
+    b.segment<3>(3 * k) = Vec3(rows[k].bn, cp.extra.empty() ? 0.0 : cp.extra[k].bt1,
+                               cp.extra.empty() ? 0.0 : cp.extra[k].bt2);
+  }
+  const SpMat Hb = H.topRows(6 * nb), MHb = MH.topRows(6 * nb);
+  const SpMat Wb(Hb.transpose() * MHb);
+  P.q = Hb.transpose() * U - Wb * r + b;
+  P.mu.resize(nc);
+  for (int k = 0; k < nc; ++k) P.mu[k] = rows[k].mu;
+  if (std::visit([](auto l) { return decltype(l)::orthotropic; }, cp.law)) {
+    P.mu_b.resize(nc);
+    for (int k = 0; k < nc; ++k) P.mu_b[k] = cp.extra[k].mu_b;
+  }
+  return P;
+}
+
+void write_fclib(const Problem3& p, const std::string& path, const std::string& title,
+                 const std::string& description, const Eigen::VectorXd* solution, const Eigen::VectorXd* guess) {
+  check_shape(p);
+  if (p.mu_b.size())
+    throw std::invalid_argument(path + ": an orthotropic cone has no FCLib form (one mu a contact)");
+  SpMat W = p.W;
+  W.makeCompressed();
+  // FCLib's structs hold non-const pointers; it only reads through them.
+  fclib_matrix m{};
+  m.nzmax = static_cast<int>(W.nonZeros());
+  m.m = static_cast<int>(W.rows());
+  m.n = static_cast<int>(W.cols());
+  m.p = W.outerIndexPtr();
+  m.i = W.innerIndexPtr();
+  m.x = W.valuePtr();
+  m.nz = -1;  // compressed columns
+  Eigen::VectorXd q = p.q, mu = p.mu;
+  std::string t = title, d = description, math = "";
+  fclib_info info{t.data(), d.data(), math.data()};
+  fclib_local L{};
+  L.W = &m;
+  L.mu = mu.data();
+  L.q = q.data();
+  L.spacedim = 3;
+  L.info = &info;
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  std::remove(path.c_str());  // fclib_write_local adds to an existing file
+  if (!fclib_write_local(&L, path.c_str()))
+    throw std::runtime_error(fmt::format("{}: FCLib could not write the problem", path));
+  auto as_solution = [&](const Eigen::VectorXd& r, Eigen::VectorXd& rr, Eigen::VectorXd& u) {
+    if (r.size() != p.q.size())
+      throw std::invalid_argument(fmt::format("{}: a solution of {} values for {} contacts", path, r.size(), p.nc));
+    rr = r;
+    u = p.W * r + p.q;
+    fclib_solution s{};
+    s.u = u.data();
+    s.r = rr.data();
+    return s;
+  };
+  Eigen::VectorXd r1, u1, r2, u2;
+  if (solution) {
+    fclib_solution s = as_solution(*solution, r1, u1);
+    if (!fclib_write_solution(&s, path.c_str()))
+      throw std::runtime_error(fmt::format("{}: FCLib could not write the solution", path));
+  }
+  if (guess) {
+    fclib_solution s = as_solution(*guess, r2, u2);
+    if (!fclib_write_guesses(1, &s, path.c_str()))
+      throw std::runtime_error(fmt::format("{}: FCLib could not write the guess", path));
+  }
+}
 
 Fclib3 read_fclib(const std::string& path) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported here, not printed by HDF5

@@ -38,6 +38,25 @@ struct Fclib3 {
   Eigen::VectorXd r_ref; // the file's stored solution r, if any (else empty)
 };
 
+struct ContactProblem3;
+
+// The matrix form of a step's problem (contact_problem3.hpp): W = H^T M^-1
+// H over the bodies' 6 dofs (scalar inertia) and the cell dofs (one more
+// body each: inv_mass a a^T), q the relative velocities the bodies' free
+// velocities give (theirs less M^-1 H r of the warm start) plus the rows'
+// offsets, mu (and mu_b for an orthotropic law), in the problem's row
+// order. Throws std::invalid_argument for a cohesive law (no such form).
+Problem3 to_matrix(const ContactProblem3& p);
+
+// Writes p as an FCLib local problem (fclib_write_local: W in compressed
+// columns, q, mu, spacedim 3) with `title` and `description`, and, when
+// given, the solution r (u = W r + q) and one guess (the warm start).
+// Throws std::runtime_error if FCLib cannot write it, std::invalid_argument
+// for orthotropic cones (FCLib has one mu a contact).
+void write_fclib(const Problem3& p, const std::string& path, const std::string& title,
+                 const std::string& description, const Eigen::VectorXd* solution = nullptr,
+                 const Eigen::VectorXd* guess = nullptr);
+
 // Reads an FCLib .hdf5 problem of space dimension 3. Throws
 // std::runtime_error naming the file and what was wrong (not HDF5, no
 // fclib_local/fclib_global group, dimension 2, equality constraints G, bad

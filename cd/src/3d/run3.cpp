@@ -7,6 +7,7 @@
 
 #include "checkpoint3.hpp"
 #include "derived.hpp"
+#include "dump3.hpp"
 #include "output3.hpp"
 
 namespace cd {
@@ -99,8 +100,9 @@ namespace {
 
 class Engine3 final : public RunEngine {
  public:
-  Engine3(World3& w, const Scene& s)
-      : w_(w), cell_(w.cell_volume() > 0.0), density_(s.density), d_mean_(mean_diameter(s)) {}
+  Engine3(World3& w, const Scene& s, const RunOptions& opt)
+      : w_(w), dump_(w, opt.out, opt.dump_steps), cell_(w.cell_volume() > 0.0), density_(s.density),
+        d_mean_(mean_diameter(s)) {}
   void step() override {
     w_.step();
     last_ = w_.last();
@@ -121,7 +123,8 @@ class Engine3 final : public RunEngine {
 
   // A tri-periodic cell: its columns (cell_columns3), the contact stress
   // averaged over the interval's steps.
-  void after_step(std::int64_t) override {
+  void after_step(std::int64_t k) override {
+    dump_.after_step(k);
     if (!cell_) return;
     sigma_ += w_.contact_stress();
     ++nsig_;
@@ -137,6 +140,7 @@ class Engine3 final : public RunEngine {
 
  private:
   World3& w_;
+  ProblemDump3 dump_;
   bool cell_;
   double density_, d_mean_;
   Eigen::Matrix3d sigma_ = Eigen::Matrix3d::Zero();
@@ -148,7 +152,7 @@ class Engine3 final : public RunEngine {
 }  // namespace
 
 RunSummary run3(World3& w, const Scene& s, const RunOptions& opt) {
-  Engine3 e(w, s);
+  Engine3 e(w, s, opt);
   return run_loop(e, plan_of(s, w.params().dt), opt);
 }
 

@@ -22,11 +22,12 @@ struct RunOptions {
   bool quiet = false;       // no progress line
   std::string scene_toml;   // resolved scene, written as scene.toml
   bool fresh = false;       // start over even if `out` holds a checkpoint
-  // Steps whose contact problem is written into `out` before it is solved
-  // (2D only): problem_STEP.cdp (exact, contact_problem.hpp; cdproblem
-  // replays it to the same impulses), problem_STEP.dat (Siconos' matrix
-  // form; not for cohesive steps) and, after the solve,
-  // problem_STEP.impulses (the step's impulses, row order, hex floats).
+  // Steps whose contact problem is written into `out` before it is solved:
+  // 2D problem_STEP.cdp (exact, contact_problem.hpp; cdproblem replays it
+  // to the same impulses), problem_STEP.dat (Siconos' matrix form; not for
+  // cohesive steps); 3D problem_STEP.cdp3 and .hdf5 (FCLib; 3d/dump3.hpp);
+  // and, after the solve, problem_STEP.impulses (the step's impulses, row
+  // order, hex floats).
   std::vector<std::int64_t> dump_steps;
   // > 0: stop after this many steps of this call (at a step boundary, with
   // a series row and, if checkpoints are on, a checkpoint to resume from).

@@ -1,0 +1,260 @@
+// A 3D step's contact problem taken out of the run (issue 27): `cdsim
+// --dump-problem STEP` on a 3D shear writes problem_STEP.cdp3 (cdlab's
+// exact text form), problem_STEP.hdf5 (FCLib's local form) and the step's
+// impulses; `cdproblem solve` replays the .cdp3 to the same impulses bit for
+// bit, and the FCLib file, read back by the reader the frozen-problem tests
+// use (read_fclib), holds the W, q and mu of the problem the step solved:
+// W against H^T M^-1 H assembled here, body by body, from the .cdp3's rows
+// and bodies; q against the free velocities (the bodies' less the warm
+// start's impulses, one body at a time) plus the rows' offsets; and the
+// step's own impulses meet the law on (W, q) to the step's residual, which a
+// wrong sign of q or of a frame would not allow. The other laws (cohesive,
+// orthotropic, restitution) replay exactly through a .cdp3 written and read
+// in memory.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <omp.h>
+
+#include "cli_util.hpp"
+#include "contact_problem3.hpp"
+#include "pile3d.hpp"
+#include "problem3.hpp"
+#include "setup3.hpp"
+#include "shear3_util.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kCdsim = CDLAB_BINARY_DIR "/cd/cdsim";
+const std::string kCdproblem = CDLAB_BINARY_DIR "/cd/cdproblem";
+const std::string kConfigs = CDLAB_SOURCE_DIR "/configs/";
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// [c]x: c x y = [c]x y.
+Eigen::Matrix3d cross(const cd::Vec3& c) {
+  Eigen::Matrix3d m;
+  m << 0, -c.z(), c.y(), c.z(), 0, -c.x(), -c.y(), c.x(), 0;
+  return m;
+}
+
+Eigen::Matrix3d frame(const cd::SphereRow& r) {
+  Eigen::Matrix3d F;
+  F.row(0) = r.n.transpose();
+  F.row(1) = r.t1.transpose();
+  F.row(2) = r.t2.transpose();
+  return F;
+}
+
+// W = H^T M^-1 H, dense: for each pair of rows and each body they share,
+// F_k (s_k s_l) (inv_m I - inv_I [c_k]x [c_l]x) F_l^T (the velocity at k
+// that an impulse at l gives through that body), and for each cell dof
+// inv_mass a_k a_l^T.
+Eigen::MatrixXd assembled_W(const cd::ContactProblem3& p) {
+  const int nc = static_cast<int>(p.rows.size());
+  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(3 * nc, 3 * nc);
+  for (int k = 0; k < nc; ++k)
+    for (int l = 0; l < nc; ++l) {
+      const cd::SphereRow &a = p.rows[k], &b = p.rows[l];
+      Eigen::Matrix3d blk = Eigen::Matrix3d::Zero();
+      for (int body : {a.b1, a.b2}) {
+        if (body == a.b1 && body == a.b2) continue;
+        const double sa = body == a.b2 ? 1.0 : -1.0;
+        const cd::Vec3 ca = body == a.b2 ? a.c2 : a.c1;
+        if (body != b.b1 && body != b.b2) continue;
+        const double sb = body == b.b2 ? 1.0 : -1.0;
+        const cd::Vec3 cb = body == b.b2 ? b.c2 : b.c1;
+        const cd::BodyVel3& V = p.vel[body];
+        blk += sa * sb * (V.inv_m * Eigen::Matrix3d::Identity() - V.inv_I * cross(ca) * cross(cb));
+      }
+      W.block<3, 3>(3 * k, 3 * l) = frame(a) * blk * frame(b).transpose();
+    }
+  for (const cd::CellDof3& d : p.dofs)
+    for (std::size_t i = 0; i < d.rows.size(); ++i)
+      for (std::size_t j = 0; j < d.rows.size(); ++j)
+        W.block<3, 3>(3 * d.rows[i], 3 * d.rows[j]) += d.inv_mass * d.a[i] * d.a[j].transpose();
+  return W;
+}
+
+// q: the relative velocity of each row at the free velocities (every row's
+// warm-start impulse taken out of its bodies), plus its offsets.
+Eigen::VectorXd free_q(const cd::ContactProblem3& p) {
+  std::vector<cd::BodyVel3> v = p.vel;
+  for (const cd::SphereRow& r : p.rows) {
+    const cd::Vec3 P = r.to_world(r.r);
+    v[r.b2].v -= v[r.b2].inv_m * P;
+    v[r.b2].w -= v[r.b2].inv_I * r.c2.cross(P);
+    v[r.b1].v += v[r.b1].inv_m * P;
+    v[r.b1].w += v[r.b1].inv_I * r.c1.cross(P);
+  }
+  Eigen::VectorXd q(3 * p.rows.size());
+  for (std::size_t k = 0; k < p.rows.size(); ++k) {
+    const cd::SphereRow& r = p.rows[k];
+    const cd::Vec3 b(r.bn, p.extra.empty() ? 0.0 : p.extra[k].bt1, p.extra.empty() ? 0.0 : p.extra[k].bt2);
+    q.segment<3>(3 * k) = frame(r) * cd::relative_velocity(r, v[r.b1], v[r.b2]) + b;
+  }
+  return q;
+}
+
+}  // namespace
+
+// 100 spheres compacted, then sheared at I = 0.1 with the height at imposed
+// stress (Lees-Edwards images and a cell dof coupled to the crossing rows),
+// step 20 dumped; solver.tol 1e-4 given (the bounds below are for it, not
+// for whatever the scene's policy picks).
+TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
+  const fs::path dir = cdtest::scratch_dir("problem_dump3", "shear");
+  const std::string prep = (dir / "prep").string(), shear = (dir / "shear").string();
+  auto r = cdtest::run_command(kCdsim + " " + kConfigs +
+                               "shear3-prep.toml --set particles.n=100 --set time.duration=0.005 --quiet --out " +
+                               prep);
+  ASSERT_EQ(r.code, 0) << r.out;
+  r = cdtest::run_command(kCdsim + " " + kConfigs + "shear3-inertial.toml --set shear.start=" + prep +
+                          "/checkpoint.bin --set shear.strain=0.3 --set shear.inertial_number=0.1 --set solver.tol=1e-4 "
+                          "--quiet "
+                          "--dump-problem 20 --out " + shear);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path cdp = fs::path(shear) / "problem_20.cdp3", h5 = fs::path(shear) / "problem_20.hdf5",
+                 imp = fs::path(shear) / "problem_20.impulses";
+  ASSERT_TRUE(fs::exists(cdp) && fs::exists(h5) && fs::exists(imp)) << r.out;
+
+  // The replay, on one and two threads: the same bytes.
+  for (int t : {1, 2}) {
+    const fs::path out = dir / ("replay" + std::to_string(t) + ".txt");
+    r = cdtest::run_command("OMP_NUM_THREADS=" + std::to_string(t) + " " + kCdproblem + " solve " + cdp.string() +
+                            " --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(slurp(out), slurp(imp)) << "threads " << t;
+  }
+
+  cd::SolverParams prm;
+  const cd::ContactProblem3 p = cd::read_contact_problem3(cdp.string(), prm);
+  const int nc = static_cast<int>(p.rows.size());
+  ASSERT_GT(nc, 100);
+  ASSERT_EQ(p.dofs.size(), 1u);
+  ASSERT_GT(p.dofs[0].rows.size(), 5u);
+
+  const cd::Fclib3 f = cd::read_fclib(h5.string());
+  ASSERT_FALSE(f.global);
+  ASSERT_EQ(f.problem.nc, nc);
+  // W: the same matrix to round-off (sums in another order).
+  const Eigen::MatrixXd W = assembled_W(p), Wf = Eigen::MatrixXd(f.problem.W);
+  const double wscale = W.cwiseAbs().maxCoeff();
+  EXPECT_LT((W - Wf).cwiseAbs().maxCoeff(), 1e-13 * wscale);
+  // q: the free velocities' scale is the bodies' speeds (cancellation in
+  // taking the warm start out costs a few ulps of them).
+  const Eigen::VectorXd q = free_q(p);
+  double vscale = 0;
+  for (const cd::BodyVel3& v : p.vel) vscale = std::max(vscale, v.v.norm());
+  EXPECT_LT((q - f.problem.q).cwiseAbs().maxCoeff(), 1e-12 * vscale);
+  for (int k = 0; k < nc; ++k) EXPECT_EQ(f.problem.mu[k], p.rows[k].mu);
+
+  // The stored solution is the step's impulses, to the bit, and they meet
+  // the law on (W, q) to the residual the step stopped at (tol 1e-4 in
+  // rms |dp|/|p|: law residuals of a few 1e-3 of mean |r|); a wrong sign in
+  // q or a frame would leave O(1).
+  ASSERT_EQ(f.r_ref.size(), 3 * nc);
+  std::istringstream in(slurp(imp));
+  for (int k = 0; k < 3 * nc; ++k) {
+    std::string s;
+    in >> s;
+    const double v = std::strtod(s.c_str(), nullptr);
+    EXPECT_EQ(std::memcmp(&v, &f.r_ref[k], sizeof v), 0) << "impulse " << k;
+  }
+  const cd::Residual res = cd::problem_residual(f.problem, f.r_ref);
+  std::printf("[ dump3 ] %d rows, %zu dof rows: step's impulses on the FCLib problem: law residual max %.2e, "
+              "Siconos error %.2e\n",
+              nc, p.dofs[0].rows.size(), res.max, cd::siconos_error(f.problem, f.r_ref));
+  EXPECT_LT(res.max, 2e-2);
+  EXPECT_LT(cd::siconos_error(f.problem, f.r_ref), 1e-4);
+}
+
+// The laws FCLib cannot hold replay exactly through the .cdp3 text, and
+// the FCLib file is not written for them (to_matrix refuses cohesion,
+// write_fclib an orthotropic cone).
+TEST(ProblemDump3, EveryLawReplaysExactly) {
+  omp_set_num_threads(1);
+  struct Variant {
+    const char* name;
+    void (*change)(cd::WorldParams3&);
+  };
+  const Variant variants[] = {
+      {"coulomb", [](cd::WorldParams3&) {}},
+      {"frictionless", [](cd::WorldParams3& p) { p.mu = p.mu_wall = 0.0; }},
+      {"cohesive", [](cd::WorldParams3& p) {
+         p.adhesion = 1e-3;
+         p.debond = 5e-4;
+       }},
+      {"restitution", [](cd::WorldParams3& p) {
+         p.e_n = 0.5;
+         p.e_t = 0.2;
+       }},
+      {"orthotropic", [](cd::WorldParams3& p) {
+         p.orthotropic = true;
+         p.axis_a = cd::Vec3(1, 1, 0);
+         p.mu_b = 0.2;
+         p.mu_wall_b = 0.6;
+       }},
+  };
+  for (const Variant& v : variants) {
+    cd::Pile3dParams q;
+    q.n_spheres = 200;
+    q.solver.tol = 1e-6;
+    q.solver.max_iter = 300;
+    cd::World3 w = cd::make_pile3d(q);
+    cd::WorldParams3 prm = w.params();
+    v.change(prm);
+    w.set_params(prm);
+    for (int k = 0; k < 79; ++k) w.step();
+    std::string text;
+    w.set_problem_hook([&](const cd::ContactProblem3& p, const cd::SolverParams& s) {
+      std::ostringstream o;
+      cd::write_contact_problem(p, s, o);
+      text = o.str();
+    });
+    w.step();
+    std::istringstream in(text);
+    cd::SolverParams s;
+    cd::ContactProblem3 p = cd::read_contact_problem3(in, v.name, s);
+    const cd::SolveStats st = cd::nlgs_solve3(p, s);
+    EXPECT_EQ(st.iterations, w.last().solve.iterations) << v.name;
+    ASSERT_EQ(p.rows.size(), w.rows().size());
+    ASSERT_GT(p.rows.size(), 100u) << v.name;
+    int differ = 0;
+    for (std::size_t k = 0; k < p.rows.size(); ++k)
+      differ += std::memcmp(p.rows[k].r.data(), w.rows()[k].r.data(), 3 * sizeof(double)) != 0;
+    EXPECT_EQ(differ, 0) << v.name;
+    std::printf("[ dump3 ] %-12s law %-24s %zu rows, %d sweeps, replay bit-identical: %s\n", v.name,
+                cd::law_name3(p.law).c_str(), p.rows.size(), st.iterations, differ ? "no" : "yes");
+    if (std::string(v.name) == "cohesive") EXPECT_THROW(cd::to_matrix(p), std::invalid_argument);
+    if (std::string(v.name) == "orthotropic")
+      EXPECT_THROW(cd::write_fclib(cd::to_matrix(p), "unused.hdf5", "", ""), std::invalid_argument);
+  }
+}
+
+// A malformed .cdp3 is refused with the file and line named.
+TEST(ProblemDump3, MalformedFileNamesTheLine) {
+  std::istringstream in("cdlab-contact-problem3 1\nlaw coulomb\ntol 0x1p-10\nmax_iter 0\n");
+  cd::SolverParams s;
+  try {
+    cd::read_contact_problem3(in, "bad.cdp3", s);
+    FAIL() << "accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.cdp3:4:"), std::string::npos) << e.what();
+  }
+  std::istringstream law("cdlab-contact-problem3 1\nlaw sticky\n");
+  EXPECT_THROW(cd::read_contact_problem3(law, "law.cdp3", s), std::runtime_error);
+}
