@@ -44,6 +44,8 @@ help:
 	@echo "make campaign-pressure[-ladder]  steady shear at PRESSURE_I under each p of PRESSURE_P (ladder: lowest p up)"
 	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
 	@echo "make frozen-shear   steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into $(FROZEN)/ [FS_N=1000]"
+	@echo "make mutants        apply each deliberate physics bug of tests/mutants/ to a scratch copy, run the tests it names,"
+	@echo "                    print the survivors and the score ($(BUILD)/mutants/; MUTANTS=\"01-mu-half-sphere-sphere ...\": some)"
 	@echo "make regress        re-run the 2D and 3D reference campaigns, refit mu(I), compare with tests/data/regress*/"
 	@echo "make prep-overlap   ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N (1000): fails if an overlap reaches 0.01 d_small"
 	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity [DIM=3] [WINDOW=50%:100%]"
@@ -479,6 +481,16 @@ regress3-campaign: build
 	rm -rf $(REGRESS3_DIR)
 	$(MAKE) --no-print-directory -j $(JOBS) campaign-inertial DIM=3 CAMPAIGNS=$(REGRESS3_DIR) N=200 STRAIN=3 P=1e5 SHEAR_TOL=1e-4 \
 	  INERTIAL_I="$(REGRESS3_I)"
+
+# Mutation score (not part of make test): each tests/mutants/*.mut is a
+# deliberate physics bug applied alone to a scratch copy of the sources in
+# $(BUILD)/mutants/ (its own build, ccache), with the test executables it names;
+# prints killed / survived / stale (anchor no longer in the code) and the
+# score, fails unless every mutant is killed (tests/mutants/README.md).
+MUTANTS ?=
+.PHONY: mutants
+mutants: deps
+	nice -n 5 tests/mutants/run.sh $(BUILD)/mutants $(MUTANTS)
 
 clean:
 	rm -rf $(BUILD)
