@@ -289,15 +289,26 @@ TEST(Fabric3, StressFabricRelationPlanar) {
   EXPECT_NEAR(r.sum_2_5, r.qp, 0.15 * r.qp);
 }
 
-// Small anisotropies: the relation holds to first order (relative error O(a)).
+// Small anisotropies: the relation holds to first order (relative error
+// O(a)). Through the code's estimators on contacts sampled from the forms:
+// contact_stress3's q/p and anisotropy3's (2/5)(a_c + a_n + a_t) of the
+// same contacts agree within the sampling error of q/p (16 blocks) plus the
+// second-order remainder, a few per cent of q/p at a ~ 0.03 (the forms' own
+// second-order stress, predicted_stress, puts it at 1.4 %); and the
+// estimated sum is the forms' true one within its sampling error.
 TEST(Fabric3, StressFabricRelationFirstOrder) {
   Forms F;
   const V3 e(1, 2, 0.5);
   F.Ac = axisym(0.02, e);
   F.An = axisym(0.03, e);
   F.At = axisym(0.01, e);
-  const double qp_exact = Stress3{T(predicted_stress(F))}.q_over_p();
-  EXPECT_NEAR(qp_exact, 0.4 * 0.06, 0.02 * 0.4 * 0.06);
+  const auto r = relation(F, 7);
+  std::printf("first order: q/p %.5f +- %.5f (forms %.5f), (2/5) sum a %.5f (forms %.5f)\n", r.qp, r.qp_se,
+              r.qp_exact, r.sum_2_5, r.sum_true);
+  EXPECT_NEAR(r.qp, r.qp_exact, 5 * r.qp_se + 1e-4);
+  EXPECT_NEAR(r.sum_2_5, r.qp, 5 * r.qp_se + 0.03 * r.qp);
+  EXPECT_NEAR(r.sum_2_5, r.sum_true, 5 * r.qp_se + 0.03 * r.sum_true);
+  EXPECT_NEAR(r.qp_exact, r.sum_true, 0.02 * r.sum_true);
 }
 
 // ---------------------------------------------------------------- stress
@@ -345,7 +356,10 @@ TEST(Stress3, LatticeThroughImagesExact) {
 // with the series row of its time (from contacts.pvd): with V = L_x L_y L_z
 // its stress is the series' stress of that step (the same contacts and
 // branches at the step's midpoint), to the CSV's digits, and so are p, the
-// von Mises q and z.
+// von Mises q and z; and the stress summed by hand from the snapshot's
+// contacts (fields read back from the file) is the series' too, so that the
+// run's and the analysis' stress code (which share obs::contact_stress)
+// are checked against a sum written here, not against each other only.
 TEST(Stress3, SnapshotMatchesTheSeriesOfARealRun) {
   cd::Scene sc;
   sc.dimension = 3;
@@ -404,9 +418,17 @@ TEST(Stress3, SnapshotMatchesTheSeriesOfARealRun) {
     double scale = 0;
     for (int i = 0; i < 3; ++i) scale = std::max(scale, std::abs(f.stress.s[i][i]));
     ASSERT_GT(scale, 0.0);
+    // By hand from the snapshot's contacts, apart from both the run's and
+    // the analysis' stress code: (1/V) sum (f_n n + f_t)_i l_j.
+    double hand[3][3] = {};
+    for (const auto& c : cs)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) hand[i][j] += (c.c.fn * c.c.n[i] + c.c.ft[i]) * c.c.l[j] / V;
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
+      for (int j = 0; j < 3; ++j) {
         EXPECT_NEAR(f.stress.s[i][j], series.column(names[i][j])[row], 1e-6 * scale) << names[i][j] << " at " << t;
+        EXPECT_NEAR(hand[i][j], series.column(names[i][j])[row], 1e-6 * scale) << names[i][j] << " at " << t;
+      }
     EXPECT_NEAR(f.stress.p(), series.column("p")[row], 1e-6 * scale);
     EXPECT_NEAR(f.stress.q_vm(), series.column("q")[row], 1e-6 * scale);
     ASSERT_TRUE(f.connectivity);

@@ -231,6 +231,32 @@ TEST(Frozen, ReadsEveryFile) {
   EXPECT_EQ(s.q[1], -8.407368208001527065675873e+00);
 }
 
+// A row of siconos-nsgs.txt: Siconos' fc2d NSGS on a file at a tol.
+struct SiconosRun {
+  bool converged = false;
+  int iterations = 0;
+  double error = 0;
+};
+SiconosRun siconos_reference(const std::string& file, double tol) {
+  std::ifstream in(kData + "siconos-nsgs.txt");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ss(line);
+    std::string f;
+    int nc, info;
+    double t;
+    SiconosRun r;
+    ss >> f >> nc >> t >> info >> r.iterations >> r.error;
+    if (f == file && std::abs(t - tol) < 1e-3 * tol) {
+      r.converged = info == 0;
+      return r;
+    }
+  }
+  ADD_FAILURE() << "no Siconos reference for " << file << " at tol " << tol;
+  return {};
+}
+
 TEST(Frozen, ProductionNlgsReachesTheLawResidual) {
   // Total well under a second (most of it the 2020-contact file).
   for (const Frozen& f : kFrozen) {
@@ -244,6 +270,18 @@ TEST(Frozen, ProductionNlgsReachesTheLawResidual) {
                 f.file, st.sweeps, st.dr_rel, st.residual.max, st.siconos_error);
     EXPECT_TRUE(st.converged) << f.file << ": " << st.sweeps << " sweeps, residual "
                               << st.residual.max;
+    // Against Siconos' own NSGS on the same file (siconos-nsgs.txt, made by
+    // siconos_nsgs.py beside the data): at the tol 1e-6 row, this solution's
+    // Siconos error is within 10x of what Siconos reaches (slider-crank:
+    // Siconos stalls at 1.9e-6 and 3.1e-6 after 1e5 sweeps; here 5.9e-6 and
+    // 4.3e-6 after 453 and 475; 2020 contacts: 1.0e-6 in 1086 against 1.1e-6
+    // in 2283), and where Siconos converged our sweeps are within 3x of its
+    // (our stopping test is another one).
+    const SiconosRun ref = siconos_reference(f.file, 1e-6);
+    EXPECT_LT(st.siconos_error, std::max(10 * ref.error, 1e-12)) << f.file;
+    if (ref.converged) {
+      EXPECT_LT(st.sweeps, 3 * siconos_reference(f.file, f.tol < 1e-7 ? 1e-8 : 1e-6).iterations) << f.file;
+    }
     EXPECT_LT(cd::problem_residual(p, r).max, f.residual) << f.file;
     EXPECT_GT(r.cwiseAbs().maxCoeff(), 0.0) << f.file;  // not the trivial r = 0
   }
