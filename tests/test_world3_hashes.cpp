@@ -7,7 +7,10 @@
 // values were recorded on main before the refactor (commit 6d4d12b, this
 // build's Release flags); a change that alters any of these paths by a bit
 // shows here. A stated bug fix changes the hashes of the scenes it touches,
-// and the comment beside the value says which fix.
+// and the comment beside the value says which fix. Changed so far: the
+// "orthotropic mu = 0" scene (0x05e69d0165f636ff before), when the build
+// stage stopped zeroing the tangential warm start of an orthotropic cone
+// with mu = 0 and mu_b > 0 (one friction decision, World3::configure).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -99,7 +102,7 @@ TEST(World3Hashes, OptionalPhysicsBitIdentical) {
       }),
   };
   const Case expect[] = {
-      {"restitution pile", 0x28a4504330a780d8ull},  {"orthotropic pile", 0x565a602263430743ull}, {"orthotropic mu = 0", 0x05e69d0165f636ffull},
+      {"restitution pile", 0x28a4504330a780d8ull},  {"orthotropic pile", 0x565a602263430743ull}, {"orthotropic mu = 0", 0xb149e53c4568edb4ull},
       {"compaction", 0xb01270695a1cd9b4ull},        {"shear", 0xe5c9f72700140155ull},            {"cohesive shear", 0x91302f7e2690f82cull},
   };
   for (std::size_t k = 0; k < std::size(got); ++k) {

@@ -20,6 +20,7 @@
 #include "coupling3.hpp"
 #include "detect3.hpp"
 #include "law3.hpp"
+#include "pile3d.hpp"
 #include "world3.hpp"
 #include "world3_hash.hpp"
 
@@ -318,6 +319,51 @@ TEST(Orthotropic3, SlidesAlongTheEllipticLawsDirection) {
 // Starting at rest with |D^-1 g_t| = 0.95 g_n (direction 60 deg from a,
 // where a round cone of mu_b would slide) the sphere sticks, with friction
 // -m g_t dt; at 1.05 g_n it slides.
+// One friction decision (issue 27): an orthotropic cone with mu = 0 along
+// t1 and mu_b > 0 along t2 has friction, so the next step's warm start keeps
+// the remembered tangential impulse on the new frame. Before the fix the
+// build stage decided friction from mu and mu_wall alone and zeroed it,
+// while the law (which counted mu_b) solved with friction: each step started
+// its tangential impulses from 0. Checked on a settling pile: the rows
+// handed to the solver carry the previous step's impulse, re-projected,
+// tangential part included.
+TEST(Orthotropic3, WarmStartKeepsFrictionWhenOnlyMuBIsSet) {
+  Pile3dParams q;
+  q.n_spheres = 100;
+  q.solver.tol = 1e-6;
+  q.solver.max_iter = 300;
+  World3 w = make_pile3d(q);
+  WorldParams3 p = w.params();
+  p.orthotropic = true;
+  p.axis_a = Vec3(1, 0, 0);
+  p.mu = p.mu_wall = 0.0;
+  p.mu_b = p.mu_wall_b = 0.4;
+  w.set_params(p);
+  for (int k = 0; k < 150; ++k) w.step();
+  const World3::WarmStart warm = w.warm_start();
+  double tmax = 0;
+  for (const Vec3& P : warm.p) tmax = std::max(tmax, P.norm());
+  ASSERT_GT(tmax, 0.0);
+  int matched = 0, tangential = 0, differ = 0;
+  w.set_problem_hook([&](const ContactProblem3& pr, const SolverParams&) {
+    for (std::size_t k = 0; k < pr.rows.size(); ++k) {
+      const SphereRow& r = pr.rows[k];
+      const auto it = std::lower_bound(warm.keys.begin(), warm.keys.end(), w.infos()[k].key);
+      if (it == warm.keys.end() || *it != w.infos()[k].key) continue;
+      ++matched;
+      const Vec3 expect = r.to_frame(warm.p[it - warm.keys.begin()]);
+      if (std::hypot(expect[1], expect[2]) > 1e-9 * tmax) ++tangential;
+      differ += r.r != expect;
+    }
+  });
+  w.step();
+  std::printf("orthotropic mu = 0, mu_b = 0.4: %d warm-started rows, %d with a tangential impulse, %d differ\n",
+              matched, tangential, differ);
+  EXPECT_GT(matched, 100);
+  EXPECT_GT(tangential, 10);
+  EXPECT_EQ(differ, 0);
+}
+
 TEST(Orthotropic3, SticksBelowTheEllipticThreshold) {
   const double mu_a = 0.6, mu_b = 0.2, gn = kG, phi = 60 * std::numbers::pi / 180;
   const Vec3 n = Vec3(-0.1, 0.25, 1.0).normalized(), axis(0.2, 1.0, 0.0);

@@ -54,13 +54,15 @@ void World3::configure() {
   // term would stop a body short of the contact and lose the impact speed.
   alert_ = restitution_on_ ? 0.0 : prm_.alert;
   if (adhesion_on_) alert_ = std::max(alert_, prm_.debond);
-  const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0 ||
-                        (prm_.orthotropic && (prm_.mu_b > 0.0 || prm_.mu_wall_b > 0.0));
+  // Friction, decided here once: any coefficient of the cone (mu_b counts
+  // on an orthotropic one); the law, the extras and the warm start follow.
+  friction_on_ = prm_.mu > 0.0 || prm_.mu_wall > 0.0 ||
+                 (prm_.orthotropic && (prm_.mu_b > 0.0 || prm_.mu_wall_b > 0.0));
   // Tangential offsets: tangential restitution or moving images; they and
   // the orthotropic mu_b are the rows' RowExtra3.
   const bool offsets = prm_.e_t > 0.0 || moving_images_;
-  extras_on_ = friction && (offsets || prm_.orthotropic);
-  prob_.law = choose_law3(friction, adhesion_on_, offsets, prm_.orthotropic);
+  extras_on_ = friction_on_ && (offsets || prm_.orthotropic);
+  prob_.law = choose_law3(friction_on_, adhesion_on_, offsets, prm_.orthotropic);
 }
 
 PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const {
@@ -121,7 +123,6 @@ void World3::build() {
   const auto& V = bodies.vel;
   const std::size_t nr = prob_.rows.size();
   const bool par = static_cast<int>(nr) >= prm_.solver.min_parallel;
-  const bool friction = prm_.mu > 0.0 || prm_.mu_wall > 0.0;
   const double a = adhesion_on_ ? prm_.adhesion * dt : 0.0;
   prob_.extra.assign(extras_on_ ? nr : 0, RowExtra3{});
 #pragma omp parallel for schedule(static) if (par)
@@ -181,7 +182,7 @@ void World3::build() {
     const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
     if (it != warm_.keys.end() && *it == info_[k].key) {
       r.r = r.to_frame(warm_.p[it - warm_.keys.begin()]);
-      if (!friction) r.r[1] = r.r[2] = 0.0;
+      if (!friction_on_) r.r[1] = r.r[2] = 0.0;
     }
   }
 }

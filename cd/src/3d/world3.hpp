@@ -185,7 +185,7 @@ class World3 {
 
   WorldParams3 prm_;
   bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, periodic_on_ = false,
-       moving_images_ = false, extras_on_ = false, dofs_on_ = false;
+       moving_images_ = false, extras_on_ = false, dofs_on_ = false, friction_on_ = false;
   double alert_ = 0.0;
   StepStats last_;
   std::vector<Vec3> xm_;
