@@ -382,7 +382,7 @@ TEST(Frozen, MalformedFilesAreClearErrors) {
   expect_error(good, "locations 2 to 4", "locations 3 to 4", "starts at location 3, expected 2");
   expect_error(good, "1334-by-1334, nzmax", "1334-by-1333, nzmax", "sparse W says 1334x1333");
   expect_error(good, "2\n667\n2\n", "3\n667\n2\n", "only 2D problems");
-  expect_error(good, "2\n667\n2\n", "2\n667\n1\n", "storage type 1");
+  expect_error(good, "2\n667\n2\n", "2\n667\n3\n", "storage type");
   expect_error(good, "2\n667\n2\n1334\n", "2\n667\n2\n1336\n", "W is 1336x1334");
   EXPECT_NE(error_of("2\n1\n0\n2\n2\n2\t2\n1 0 0 1\n0 0\n-0.5\n", "neg.dat").find("negative"),
             std::string::npos);

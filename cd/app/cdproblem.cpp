@@ -2,8 +2,9 @@
 //   cdproblem solve FILE.dat [--tol 1e-6] [--max-sweeps N] [--check-every K] [--lemke]
 //   cdproblem solve FILE.cdp|FILE.cdp3 [--tol T] [--max-sweeps N] [--out IMPULSES.txt]
 //   cdproblem solve FILE.hdf5 [--tol 1e-6] [--max-sweeps N] [--check-every K] [--lemke --facets E]
-// FILE.dat: Siconos' text format (W, q, mu), solved by the simulator's sweep
-// through the blocks of W (problem.hpp); prints the problem size, the sweep's
+// FILE.dat: Siconos' text format (W, q, mu; 2D or 3D, core/siconos_dat.hpp),
+// solved by the simulator's sweep through the blocks of W (problem.hpp,
+// problem3.hpp); prints the problem size, the sweep's
 // change and the law residual every K sweeps, Siconos' error and the time;
 // with --lemke, the reference LCP solve instead.
 // FILE.cdp, FILE.cdp3: a 2D or 3D step dumped by `cdsim --dump-problem`
@@ -29,6 +30,7 @@
 #include "nlgs.hpp"
 #include "problem.hpp"
 #include "problem3.hpp"
+#include "siconos_dat.hpp"
 
 namespace {
 
@@ -36,8 +38,7 @@ namespace {
 // of it: past this size it is minutes and gigabytes, not a reference.
 constexpr int kLemkeMaxContacts = 1000;
 
-int solve(const std::string& path, const cd::NlgsOptions& opt, bool lemke) {
-  const cd::Problem p = cd::read_problem(path);
+int solve2(const cd::Problem& p, const std::string& path, const cd::NlgsOptions& opt, bool lemke) {
   double wmin = p.nc ? p.W.diagonal().minCoeff() : 0, wmax = p.nc ? p.W.diagonal().maxCoeff() : 0;
   fmt::print(
       "{}: dim {}, {} contacts, W {}x{} with {} entries (diagonal {:.4g} to {:.4g}), "
@@ -84,15 +85,11 @@ void print_history(const cd::NlgsStats& st) {
                c.residual_mean);
 }
 
-int solve3(const std::string& path, const cd::NlgsOptions& opt, bool lemke, int facets) {
-  const cd::Fclib3 f = cd::read_fclib(path);
-  const cd::Problem3& p = f.problem;
-  fmt::print("{}: dim 3, {} contacts ({}), W {}x{} with {} entries, mu {:.4g} to {:.4g}\n", path,
-             p.nc, f.global ? fmt::format("global, {} body dofs, condensed", f.bodies_dofs) : "local",
-             p.W.rows(), p.W.cols(), p.W.nonZeros(), p.nc ? p.mu.minCoeff() : 0.0,
-             p.nc ? p.mu.maxCoeff() : 0.0);
-  if (f.r_ref.size())
-    fmt::print("stored solution: Siconos error {:.3e}\n", cd::siconos_error(p, f.r_ref));
+// A 3D problem in matrix form (FCLib or Siconos .dat), `what` the line that
+// describes it.
+int solve3(const cd::Problem3& p, const std::string& what, const cd::NlgsOptions& opt, bool lemke, int facets) {
+  fmt::print("{}, W {}x{} with {} entries, mu {:.4g} to {:.4g}\n", what, p.W.rows(), p.W.cols(), p.W.nonZeros(),
+             p.nc ? p.mu.minCoeff() : 0.0, p.nc ? p.mu.maxCoeff() : 0.0);
   if (lemke) {
     if ((2 * facets + 2) * p.nc > kLemke3MaxUnknowns)
       throw std::runtime_error(fmt::format(
@@ -117,6 +114,36 @@ int solve3(const std::string& path, const cd::NlgsOptions& opt, bool lemke, int 
       st.residual.max, st.residual.mean, st.residual.r_mean, st.siconos_error, st.time,
       st.sweeps ? 1e3 * st.time / st.sweeps : 0.0);
   return st.converged ? 0 : 1;
+}
+
+int solve_fclib(const std::string& path, const cd::NlgsOptions& opt, bool lemke, int facets) {
+  const cd::Fclib3 f = cd::read_fclib(path);
+  const cd::Problem3& p = f.problem;
+  if (f.r_ref.size()) {
+    // Siconos' global test files store zeros there (test_frozen3): say so
+    // rather than print the error of r = 0 as if it were a reference.
+    const bool zero = f.r_ref.cwiseAbs().maxCoeff() == 0.0;
+    fmt::print("stored solution: {}Siconos error {:.3e}\n", zero ? "r = 0 everywhere (a placeholder, not a solution), " : "",
+               cd::siconos_error(p, f.r_ref));
+  }
+  return solve3(p,
+                fmt::format("{}: dim 3, {} contacts ({})", path, p.nc,
+                            f.global ? fmt::format("global, {} body dofs, condensed", f.bodies_dofs) : "local"),
+                opt, lemke, facets);
+}
+
+// A Siconos .dat file: 2D or 3D, as its first number says.
+int solve_dat(const std::string& path, const cd::NlgsOptions& opt, bool lemke, int facets) {
+  cd::SiconosDat d = cd::read_siconos_dat(path);
+  if (d.dim == 3) {
+    cd::Problem3 p;
+    p.nc = d.nc;
+    p.W = std::move(d.W);
+    p.q = std::move(d.q);
+    p.mu = std::move(d.mu);
+    return solve3(p, fmt::format("{}: dim 3, {} contacts (Siconos .dat)", path, p.nc), opt, lemke, facets);
+  }
+  return solve2(cd::Problem{d.dim, d.nc, std::move(d.W), std::move(d.q), std::move(d.mu)}, path, opt, lemke);
 }
 
 // The dumped steps of the two engines (.cdp, .cdp3), as solve_step sees
@@ -188,7 +215,7 @@ int main(int argc, char** argv) {
   std::string path;
   cd::NlgsOptions opt;
   bool lemke = false;
-  cmd->add_option("file", path, "problem file (.dat: Siconos matrix form; .cdp, .cdp3: a 2D or 3D step dumped by cdsim; .hdf5: FCLib 3D)")->required();
+  cmd->add_option("file", path, "problem file (.dat: Siconos matrix form, 2D or 3D; .cdp, .cdp3: a 2D or 3D step dumped by cdsim; .hdf5: FCLib 3D)")->required();
   cmd->add_option("--tol", opt.tol, "tolerance on the sweep's rms |dr|/mean|r| (the production test), in (0, 1]")
       ->check(CLI::Validator(
           [](std::string& v) {
@@ -206,7 +233,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   cmd->add_flag("--lemke", lemke, "solve as an LCP with Lemke's method (small problems)");
   int facets = 4;
-  cmd->add_option("--facets", facets, "(.hdf5 with --lemke) face pairs e of the polyhedral cone")
+  cmd->add_option("--facets", facets, "(3D .hdf5 or .dat with --lemke) face pairs e of the polyhedral cone")
       ->check(CLI::Range(2, 64))
       ->capture_default_str();
   std::string out;
@@ -229,8 +256,8 @@ int main(int argc, char** argv) {
       return (ends(".cdp") ? solve_step<Step2> : solve_step<Step3>)(path, tol_given ? opt.tol : 0.0,
                                                        cap_given ? opt.max_sweeps : 0, residual_tol, out);
     }
-    if (path.size() > 5 && path.substr(path.size() - 5) == ".hdf5") return solve3(path, opt, lemke, facets);
-    return solve(path, opt, lemke);
+    if (ends(".hdf5")) return solve_fclib(path, opt, lemke, facets);
+    return solve_dat(path, opt, lemke, facets);
   } catch (const std::exception& e) {
     std::cerr << "cdproblem: error: " << e.what() << "\n";
     return 2;

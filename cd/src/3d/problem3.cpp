@@ -24,6 +24,7 @@ extern "C" {
 
 #include "colour_blocks.hpp"
 #include "contact_problem3.hpp"
+#include "siconos_dat.hpp"
 #include "sweep.hpp"
 
 namespace cd {
@@ -316,9 +317,20 @@ Fclib3 read_fclib(const std::string& path) {
   if (solution) {
     fclib_solution* s = fclib_read_solution(path.c_str());
     if (s && s->r) out.r_ref = Eigen::Map<const Eigen::VectorXd>(s->r, 3 * p.nc);
+    if (s && s->v && out.global) out.v_ref = Eigen::Map<const Eigen::VectorXd>(s->v, out.bodies_dofs);
     if (s) fclib_delete_solutions(s, 1);
   }
   return out;
+}
+
+Problem3 read_dat3(const std::string& path) {
+  SiconosDat d = read_siconos_dat(path, 3);
+  Problem3 p;
+  p.nc = d.nc;
+  p.W = std::move(d.W);
+  p.q = std::move(d.q);
+  p.mu = std::move(d.mu);
+  return p;
 }
 
 Residual problem_residual(const Problem3& p, const Eigen::VectorXd& r) {

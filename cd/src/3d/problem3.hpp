@@ -35,7 +35,10 @@ struct Fclib3 {
   Problem3 problem;
   bool global = false;   // read from fclib_global (condensed) or fclib_local
   int bodies_dofs = 0;   // global: size of M
-  Eigen::VectorXd r_ref; // the file's stored solution r, if any (else empty)
+  // The file's stored solution r (and, global, v), if any (else empty).
+  // Siconos' global test files store r = 0 and v = 0 there, equal to their
+  // guess: a placeholder, not a solution (tests/test_frozen3.cpp).
+  Eigen::VectorXd r_ref, v_ref;
 };
 
 struct ContactProblem3;
@@ -62,6 +65,11 @@ void write_fclib(const Problem3& p, const std::string& path, const std::string& 
 // fclib_local/fclib_global group, dimension 2, equality constraints G, bad
 // matrix indices, M not positive definite).
 Fclib3 read_fclib(const std::string& path);
+
+// Reads a 3D problem in Siconos' text form (.dat; core/siconos_dat.hpp:
+// dense, sparse-block or sparse W). Throws std::runtime_error naming the
+// file and line (a 2D file is refused: dimension 2).
+Problem3 read_dat3(const std::string& path);
 
 // Law residual (law_residual3 with rho = 1/W_nn), max and mean over contacts
 // divided by the mean |r_k|.
