@@ -66,14 +66,27 @@ endef
 deps:
 	$(call install_missing,deps,$(DEB_PKGS))
 
+# Quiet builds: no "Entering directory" pair from each of CMake's nested
+# gmake calls (MAKEFLAGS reaches them), CMake's configure messages only when
+# something is wrong, and no "Built target" line per target (the build prints
+# one line per file compiled or linked).
+MAKEFLAGS += --no-print-directory
 $(BUILD)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	@echo "make: configuring $(BUILD)/ (CMake, Release)"
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DCMAKE_TARGET_MESSAGES=OFF --log-level=WARNING
+# $(call build_only,TARGETS): build these CMake targets and what they need.
+build_only = cmake --build $(BUILD) -j $(JOBS) $(addprefix --target ,$(1))
 
+# Everything: the programs, the tests and the benchmarks.
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
-run: build
-	$(BUILD)/cd/cdsim $(SCENE) --out $(OUT)
+# `make run` builds cdsim only (a third of `make build`); SET="--set k=v ..."
+# adds scene overrides (cdsim --set, docs/scenes.md).
+SET ?=
+run: deps $(BUILD)/CMakeCache.txt
+	$(call build_only,cdsim)
+	$(BUILD)/cd/cdsim $(SCENE) --out $(OUT) $(SET)
 	@echo ""
 	@echo "Outputs in $(OUT)/: series.csv (time series, columns in docs/outputs.md), scene.toml"
 	@echo "(resolved scene), shapes.pvd, particles.pvd, contacts.pvd, walls.pvd (VTK collections)."
@@ -88,7 +101,8 @@ test: build
 # docs/scene-parameters.md is generated: a fixed header, then exactly what
 # `cdsim --help-scene` prints (tests/test_help_scene.cpp fails when they differ).
 SCENE_DOC := docs/scene-parameters.md
-scene-doc: build
+scene-doc: deps $(BUILD)/CMakeCache.txt
+	$(call build_only,cdsim)
 	{ printf '%s\n' '# Scene parameters' '' \
 	    'Every key a scene file may set: default, unit, rule and meaning. How scenes are' \
 	    'written, and what the generated particles are: [scenes.md](scenes.md).' '' \
