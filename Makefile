@@ -27,29 +27,106 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 all: build
 
+# Every target and every variable a user may set, with its current value
+# (the default unless given): tests/check_help.cmake (ctest Make.HelpComplete)
+# fails when a target of this Makefile, or a variable it reads with ?= or
+# never sets, is missing here.
+help_space := $() $()
+help_q = '$(subst ','\'',$(1))'
+help_var = @printf '  %-34s %s\n' $(call help_q,$(1)=$(if $(findstring $(help_space),$($(1))),"$($(1))",$($(1))))\
+  $(call help_q,$(2))
 help:
-	@echo "make run            build and run the default scene into $(OUT)/"
-	@echo "make test           build and run the test suite (ctest)"
-	@echo "make bench          build and run the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv;"
-	@echo "                    3D: outputs/bench/3d/, N = 1e3-1e4, BIG=1: to 1e5)"
-	@echo "make accuracy-cost  eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s);"
-	@echo "                    3D: polyhedral-cone Lemke against e and the exact NLGS (outputs/accuracy-cost/3d/)"
-	@echo "make accuracy-shear solver settings against steady mu*, phi, z and cost in shear (outputs/accuracy-shear/; hours)"
-	@echo "make tensile        tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
-	@echo "make deps           install the missing Debian packages (idempotent)"
-	@echo "make scene-doc      regenerate docs/scene-parameters.md from cdsim --help-scene (test_help_scene checks it)"
-	@echo "make figures        regenerate docs/figures/ (installs ParaView's pvbatch and xvfb if missing; not part of make test)"
-	@echo "make campaign-inertial|campaign-cohesive|campaign-angularity [N=200 STRAIN=2 P=100 ...]"
-	@echo "make campaign-inertial-ladder  the inertial values from the highest I down, each from the point above"
-	@echo "make campaign-pressure[-ladder]  steady shear at PRESSURE_I under each p of PRESSURE_P (ladder: lowest p up)"
-	@echo "                    shear campaigns into $(CAMPAIGNS)/<name>/ (one folder per run; make -j2 runs two at once)"
-	@echo "make frozen-shear   steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into $(FROZEN)/ [FS_N=1000]"
-	@echo "make mutants        apply each deliberate physics bug of tests/mutants/ to a scratch copy, run the tests it names,"
-	@echo "                    print the survivors and the score ($(BUILD)/mutants/; MUTANTS=\"01-mu-half-sphere-sphere ...\": some)"
-	@echo "make regress        re-run the 2D and 3D reference campaigns, refit mu(I), compare with tests/data/regress*/"
-	@echo "make prep-overlap   ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N (1000): fails if an overlap reaches 0.01 d_small"
-	@echo "make analyze-inertial|analyze-cohesive|analyze-angularity [DIM=3] [WINDOW=50%:100%]"
-	@echo "                    cdanalysis report and fits of outputs/campaigns/<name> into outputs/analysis/<name>/"
+	@echo "Set-up and single runs (docs/setup.md)"
+	@echo "  make deps            install the missing Debian packages (idempotent)"
+	@echo "  make build (= make all)  build everything: cdsim, cdanalysis, cdproblem, tests, benchmarks"
+	@echo "  make run             build cdsim only and run SCENE into OUT (SET: overrides)"
+	@echo "  make test            build everything and run the test suite (ctest)"
+	@echo "  make clean           remove the build folder"
+	@echo "  make scene-doc       regenerate docs/scene-parameters.md from cdsim --help-scene=md (test_help_scene checks it)"
+	@echo "  make figures         regenerate docs/figures/ (installs ParaView's pvbatch and xvfb if missing; not part of make test)"
+	@echo "  make help            this list"
+	@echo "Measurements (docs/accuracy.md)"
+	@echo "  make bench           the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv;"
+	@echo "                       3D: outputs/bench/3d/, N = 1e3-1e4, BIG=1: to 1e5)"
+	@echo "  make accuracy-cost   eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s);"
+	@echo "                       3D: polyhedral-cone Lemke against e and the exact NLGS (outputs/accuracy-cost/3d/)"
+	@echo "  make accuracy-shear  solver settings against steady mu*, phi, z and cost in shear (ACC/; hours)"
+	@echo "  make tensile         tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
+	@echo "  make prep-overlap    ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N: fails if an overlap reaches 0.01 d_small"
+	@echo "  make frozen-shear    steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into FROZEN/N_<FS_N>/"
+	@echo "  make regress         re-run the 2D and 3D reference campaigns, refit mu(I), compare with tests/data/regress*/"
+	@echo "  make mutants         apply each deliberate physics bug of tests/mutants/ to a scratch copy, run the tests it names,"
+	@echo "                       print the survivors and the score (BUILD/mutants/)"
+	@echo "Shear campaigns into CAMPAIGNS/<name>/, one folder per run; make -j2 runs two at once (docs/shear.md)"
+	@echo "  make campaign-inertial          mu(I): one run per I of INERTIAL_I, from a compacted sample"
+	@echo "  make campaign-inertial-ladder   the same values of I from the highest down, each from the point above"
+	@echo "  make campaign-cohesive          each eta of COHESIVE_ETA at each I of COHESIVE_I"
+	@echo "  make campaign-angularity        each shape of ANGULAR_NS (2D) at ANGULAR_I"
+	@echo "  make campaign-pressure          steady shear at PRESSURE_I under each p of PRESSURE_P"
+	@echo "  make campaign-pressure-ladder   the same from the lowest p up, each from the point below"
+	@echo "Analyses of CAMPAIGNS/<name> into outputs/analysis[3d]/<name>/ (docs/analysis.md)"
+	@echo "  make analyze-inertial, analyze-inertial-ladder, analyze-cohesive, analyze-angularity"
+	@echo "  make analyze-pressure, analyze-pressure-ladder   cdanalysis report and the campaign's fits"
+	@echo "Used by the targets above and by scripts"
+	@echo "  make campaign-list CAMPAIGN=inertial      the run folders of a campaign (configs/cluster/job-array.sh)"
+	@echo "  make campaign-prep-of RUN=<run folder>    the sample that run starts from"
+	@echo "  make regress-campaign, regress3-campaign  the reference campaigns of make regress"
+	@echo "  make frozen-shear-runs, accuracy-shear-runs  the runs of make frozen-shear, make accuracy-shear"
+	@echo "Variables (make TARGET VAR=value ...), with their values now"
+	$(call help_var,SCENE,the scene of make run)
+	$(call help_var,OUT,its output folder)
+	$(call help_var,SET,scene overrides for make run: SET="--set k=v --set k2=v2")
+	$(call help_var,BUILD,the build folder)
+	$(call help_var,JOBS,parallel compile jobs)
+	$(call help_var,THREADS,threads of each campaign run; empty: nproc / the -j of make)
+	$(call help_var,DIM,2 (disks/polygons) or 3 (spheres) for campaigns and analyses)
+	$(call help_var,CAMPAIGNS,the campaigns' folder)
+	$(call help_var,N,grains per sample)
+	$(call help_var,STRAIN,shear strain of each run)
+	$(call help_var,LADDER_STRAIN,shear strain of each ladder point)
+	$(call help_var,P,imposed pressure (2D N/m; 3D N/m^2))
+	$(call help_var,SIZE_RATIO,d_max / d_min of the samples)
+	$(call help_var,SIZE_DIST,size distribution (uniform_area or uniform))
+	$(call help_var,SHEAR_TOL,solver.tol for every shear run (empty: by I; docs/shear.md))
+	$(call help_var,PREP_SET,more --set options for the preparations)
+	$(call help_var,INERTIAL_I,the inertial numbers of campaign-inertial[-ladder])
+	$(call help_var,COHESIVE_ETA,cohesion numbers of campaign-cohesive)
+	$(call help_var,COHESIVE_I,its inertial numbers)
+	$(call help_var,COHESIVE_TOL,its solver.tol)
+	$(call help_var,ANGULAR_NS,polygon sides of campaign-angularity (0: disks))
+	$(call help_var,ANGULAR_I,its inertial number)
+	$(call help_var,PRESSURE_P,pressures of campaign-pressure[-ladder])
+	$(call help_var,PRESSURE_I,their inertial number)
+	$(call help_var,CKPT_STRAIN,checkpoint every this much strain)
+	$(call help_var,CKPT_WALL,and every this many seconds of wall clock)
+	$(call help_var,WINDOW,steady window of the fits: a:b (strain) or a%:b%; empty: detected)
+	$(call help_var,CAMPAIGN,campaign of make campaign-list (inertial cohesive angularity ...))
+	$(call help_var,RUN,run folder of make campaign-prep-of)
+	$(call help_var,QUICK,1: the short version of accuracy-cost and tensile)
+	$(call help_var,BIG,1: make bench's 3D sizes up to 1e5)
+	$(call help_var,PO_N,grains of make prep-overlap)
+	$(call help_var,PO_DIR,its output folder)
+	$(call help_var,FROZEN,make frozen-shear's folder)
+	$(call help_var,FS_N,its grains)
+	$(call help_var,FS_SHAPES,its shapes (polygon sides; 0: disks))
+	$(call help_var,FS_STRAIN,strain of its I = 1e-2 runs)
+	$(call help_var,FS_QS_STRAIN,strain of its I = 1e-3 runs)
+	$(call help_var,FS_GAP,steps between its two dumped problems)
+	$(call help_var,FS_PREP_SET,--set options of its preparations)
+	$(call help_var,ACC,make accuracy-shear's folder)
+	$(call help_var,ACC_N,its grains)
+	$(call help_var,ACC_SHAPES,its shapes)
+	$(call help_var,ACC_I,its inertial numbers)
+	$(call help_var,ACC_STRAIN,its strain)
+	$(call help_var,ACC_TOLS,its settings: solver.tol values)
+	$(call help_var,ACC_RTOLS,solver.residual_tol values (at tol 1e-4))
+	$(call help_var,ACC_CAPS,sweep caps (at tol 1e-4))
+	$(call help_var,ACC_DTX,time step factors (at tol 1e-4))
+	$(call help_var,ACC_REF_TOL,solver.tol of the reference)
+	$(call help_var,ACC_REF_CAP,sweep cap of the reference)
+	$(call help_var,REGRESS_DIR,make regress's 2D campaign)
+	$(call help_var,REGRESS3_DIR,its 3D campaign)
+	$(call help_var,MUTANTS,the mutants of make mutants (empty: all of tests/mutants/))
 
 # Idempotent: asks dpkg which packages are missing and installs only those.
 # $(call install_missing,TARGET,PACKAGES)
@@ -106,10 +183,10 @@ scene-doc: deps $(BUILD)/CMakeCache.txt
 	{ printf '%s\n' '# Scene parameters' '' \
 	    'Every key a scene file may set: default, unit, rule and meaning. How scenes are' \
 	    'written, and what the generated particles are: [scenes.md](scenes.md).' '' \
-	    'Generated by `make scene-doc` from `cdsim --help-scene`; do not edit by hand' \
+	    'Generated by `make scene-doc` from `cdsim --help-scene=md`; do not edit by hand' \
 	    '(`tests/test_help_scene.cpp` checks that this file is what cdsim prints).' '' \
 	    '<!-- cdsim --help-scene -->'; \
-	  $(BUILD)/cd/cdsim --help-scene; } > $(SCENE_DOC).tmp && mv $(SCENE_DOC).tmp $(SCENE_DOC)
+	  $(BUILD)/cd/cdsim --help-scene=md; } > $(SCENE_DOC).tmp && mv $(SCENE_DOC).tmp $(SCENE_DOC)
 
 # ---- Figures (docs/figures/; not part of make test) -------------------------
 # The README's pictures: the default scene's pile with its force chains, and

@@ -1,4 +1,4 @@
-// docs/scene-parameters.md is generated from `cdsim --help-scene` (make
+// docs/scene-parameters.md is generated from `cdsim --help-scene=md` (make
 // scene-doc). This test fails when the two drift apart, so that a new or
 // changed scene parameter cannot reach main with stale documentation.
 #include <gtest/gtest.h>
@@ -31,7 +31,7 @@ std::string first_difference(const std::string& a, const std::string& b) {
 }
 
 TEST(HelpScene, DocsSceneParametersIsWhatCdsimPrints) {
-  const cdtest::CmdResult r = cdtest::run_command(kCdsim + " --help-scene");
+  const cdtest::CmdResult r = cdtest::run_command(kCdsim + " --help-scene=md");
   ASSERT_EQ(r.code, 0) << r.out;
   ASSERT_FALSE(r.out.empty());
 

@@ -24,6 +24,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "cli_errors.hpp"
 #include "contact_problem3.hpp"
 #include "lemke.hpp"
 #include "lemke3.hpp"
@@ -246,7 +247,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;  // --help: 0; every usage error: bad input
+    return cd::cli_error(app, e, "cdproblem");  // --help: 0; every usage error: bad input (2)
   }
   try {
     const auto ends = [&](const std::string& e) { return path.size() > e.size() && path.ends_with(e); };

@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "cli_errors.hpp"
 #include "config.hpp"
 #include "load.hpp"
 #include "parallel.hpp"
@@ -30,14 +31,19 @@ int main(int argc, char** argv) {
   std::string scene_path, out;
   std::vector<std::string> sets;
   int threads = -1;
-  bool quiet = false, help_scene = false, fresh = false, print_scene = false;
+  bool quiet = false, fresh = false, print_scene = false;
+  std::string help_scene;
   app.add_option("scene", scene_path, "scene file (TOML)");
   app.add_option("--set", sets, "override a parameter: section.key=value (repeatable)");
   app.add_option("--out", out, "output folder (default: outputs/<scene name>)");
   app.add_option("--threads", threads, "OpenMP threads (default: solver.threads, 0 = all)");
   app.add_flag("--quiet,-q", quiet, "no progress line on stderr");
   app.add_flag("--fresh", fresh, "start over, discarding a checkpoint in the output folder");
-  app.add_flag("--help-scene", help_scene, "print every scene parameter with its default");
+  app.add_option("--help-scene", help_scene,
+                 "print every scene parameter with its default, unit, rule and meaning; "
+                 "--help-scene=md: as the Markdown table of docs/scene-parameters.md")
+      ->expected(0, 1)
+      ->check(CLI::IsMember({"", "md"}));
   app.add_flag("--print-scene", print_scene,
                "print the resolved scene (the scene.toml the run would write, \"auto\" keys set) and exit");
   std::vector<std::int64_t> dump_steps;
@@ -55,13 +61,13 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help prints and exits 0; every usage error is bad input: exit 2.
-    return app.exit(e) == 0 ? 0 : 2;
+    return cd::cli_error(app, e, "cdsim");
   }
   // Status lines reach a log file as they are printed, even if the run is killed.
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
 
-  if (help_scene) {
-    std::cout << cd::parameter_table_markdown();
+  if (app.count("--help-scene")) {
+    std::cout << (help_scene == "md" ? cd::parameter_table_markdown() : cd::parameter_table_text());
     return 0;
   }
   if (scene_path.empty()) {

@@ -9,6 +9,7 @@
 
 #include "checkpoint.hpp"
 #include "observables.hpp"
+#include "start_hint.hpp"
 
 namespace cd {
 
@@ -136,7 +137,7 @@ World build_world(const Scene& s0) {
     try {
       load_checkpoint(s.start, prep);
     } catch (const CheckpointError& e) {
-      throw SceneError(fmt::format("shear.start: {}", e.what()));
+      throw SceneError(fmt::format("shear.start: {}{}", e.what(), missing_start_hint(s)));
     }
     B = prep.bodies;
     w.cell = prep.cell;

@@ -10,6 +10,7 @@
 
 #include "checkpoint3.hpp"
 #include "pile3d.hpp"
+#include "start_hint.hpp"
 
 namespace cd {
 
@@ -224,7 +225,7 @@ void load_start3(const Scene& s, World3& w) {
   try {
     load_checkpoint3(s.start, w);
   } catch (const CheckpointError& e) {
-    throw SceneError(fmt::format("shear.start: {}", e.what()));
+    throw SceneError(fmt::format("shear.start: {}{}", e.what(), missing_start_hint(s)));
   }
   Bodies3& B = w.bodies;
   double dsum = 0;

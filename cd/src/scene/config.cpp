@@ -21,6 +21,7 @@
 #include <toml.hpp>
 
 #include "shear_policy.hpp"
+#include "suggest.hpp"
 
 namespace cd {
 namespace {
@@ -48,7 +49,8 @@ Rule in_open_closed(double lo, double hi) {
           [=](const Val& v) { return num(v) > lo && num(v) <= hi; }};
 }
 Rule vector_of(std::size_t a, std::size_t b) {
-  return {fmt::format("a list of {} or {} numbers", a, b), [=](const Val& v) {
+  return {a == b ? fmt::format("a list of {} numbers", a) : fmt::format("a list of {} or {} numbers", a, b),
+          [=](const Val& v) {
             const auto n = std::get<std::vector<double>>(v).size();
             return n == a || n == b;
           }};
@@ -398,32 +400,6 @@ struct Problems {
   }
 };
 
-// Optimal string alignment distance (edits, adjacent swaps).
-std::size_t distance(std::string_view a, std::string_view b) {
-  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
-  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i)
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1])});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
-        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-    }
-  return d[a.size()][b.size()];
-}
-
-// " (did you mean 'x'?)" for the closest candidate, compared as a whole and by
-// its last component (so 'solver.mu' finds 'contact.mu'), if reasonably close.
-std::string did_you_mean(std::string_view name, const std::vector<std::string>& candidates) {
-  const auto last = [](std::string_view s) { return s.substr(s.rfind('.') + 1); };
-  std::size_t best = 1 + last(name).size() / 5;  // the largest distance accepted
-  std::string hint;
-  for (const std::string& c : candidates)
-    if (const std::size_t d = std::min(distance(name, c), distance(last(name), last(c)) + 1); d <= best)
-      if (d < best || hint.empty()) best = d, hint = c;
-  return hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint);
-}
-
 template <class T>
 std::vector<std::string> labels(const std::vector<Param<T>>& params, const std::string& index = "") {
   std::vector<std::string> out;
@@ -695,28 +671,74 @@ std::string resolved_toml(const Scene& s) {
   return out;
 }
 
+namespace {
+// One row of the parameter table: what --help-scene shows of a key.
+struct DocRow {
+  std::string key, value, unit, rule, doc;
+};
+
+// Every key with its default, from the tables. A list's default is shown as
+// it may be written (nsides = [0], not [0.0]: the lists take integers).
+std::vector<DocRow> doc_rows() {
+  std::vector<DocRow> out;
+  const auto rows = [&](const auto& params, const auto& defaults, const std::string& index) {
+    for (const auto& p : params) {
+      const auto [value, rule] = std::visit([&](auto m) {
+        using F = std::remove_cvref_t<decltype(defaults.*m)>;
+        const bool integer = std::is_integral_v<F> && !std::is_same_v<F, bool>;
+        const bool list = std::is_same_v<F, std::vector<double>> || std::is_same_v<F, std::array<double, 2>>;
+        return std::pair(text(defaults.*m, !list), integer ? trim("integer " + p.rule.text) : p.rule.text);
+      }, p.field);
+      out.push_back({label(p.section, p.key, index), value, p.unit, rule, p.doc});
+    }
+  };
+  rows(scene_params(), Scene{}, "");
+  rows(disk_params(), DiskSpec{}, "i");
+  rows(wall_params(), WallSpec{}, "i");
+  return out;
+}
+
+// `words` cut into lines of at most `width` characters (a longer word alone).
+std::vector<std::string> wrap(const std::string& words, std::size_t width) {
+  std::vector<std::string> lines(1);
+  std::istringstream in(words);
+  for (std::string w; in >> w;) {
+    if (!lines.back().empty() && lines.back().size() + 1 + w.size() > width) lines.emplace_back();
+    lines.back() += (lines.back().empty() ? "" : " ") + w;
+  }
+  return lines;
+}
+}  // namespace
+
 std::string parameter_table_markdown() {
   std::string md = "| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n";
   const auto cell = [](std::string s) {
     for (std::size_t k = 0; (k = s.find('|', k)) != std::string::npos; k += 2) s.insert(k, "\\");
     return s;
   };
-  const auto rows = [&](const auto& params, const auto& defaults, const std::string& index) {
-    for (const auto& p : params) {
-      const auto [value, rule] = std::visit([&](auto m) {
-        using F = std::remove_cvref_t<decltype(defaults.*m)>;
-        const bool integer = std::is_integral_v<F> && !std::is_same_v<F, bool>;
-        return std::pair(text(defaults.*m, true),
-                         integer ? trim("integer " + p.rule.text) : p.rule.text);
-      }, p.field);
-      md += fmt::format("| `{}` | `{}` | {} | {} | {} |\n", label(p.section, p.key, index),
-                        cell(value), p.unit, cell(rule), cell(p.doc));
-    }
-  };
-  rows(scene_params(), Scene{}, "");
-  rows(disk_params(), DiskSpec{}, "i");
-  rows(wall_params(), WallSpec{}, "i");
+  for (const DocRow& r : doc_rows())
+    md += fmt::format("| `{}` | `{}` | {} | {} | {} |\n", r.key, cell(r.value), r.unit, cell(r.rule),
+                      cell(r.doc));
   return md;
+}
+
+std::string parameter_table_text() {
+  const std::vector<DocRow> rows = doc_rows();
+  std::size_t kw = 0, vw = 0;
+  for (const DocRow& r : rows) {
+    kw = std::max(kw, r.key.size());
+    vw = std::max(vw, r.value.size() + (r.unit.empty() ? 0 : r.unit.size() + 1));
+  }
+  std::string out, section;
+  for (const DocRow& r : rows) {
+    const std::string sec = r.key.find('.') == std::string::npos ? "" : r.key.substr(0, r.key.find('.'));
+    if (sec != section && !out.empty()) out += "\n";
+    section = sec;
+    const std::string value = r.unit.empty() ? r.value : r.value + " " + r.unit;
+    out += trim(fmt::format("{:<{}}  {:<{}}  {}", r.key, kw, value, vw, r.rule)) + "\n";
+    for (const std::string& l : wrap(r.doc, 74)) out += "      " + l + "\n";
+  }
+  return out;
 }
 
 }  // namespace cd

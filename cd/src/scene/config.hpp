@@ -33,4 +33,8 @@ std::string resolved_toml(const Scene& s);
 // Markdown table of every parameter: key, default, unit, rule, meaning.
 std::string parameter_table_markdown();
 
+// The same for a terminal: one line per key (key, default and unit, rule,
+// aligned), its meaning wrapped below it, a blank line between sections.
+std::string parameter_table_text();
+
 }  // namespace cd
