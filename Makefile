@@ -99,6 +99,7 @@ help:
 	$(call help_var,PRESSURE_I,their inertial number)
 	$(call help_var,CKPT_STRAIN,checkpoint every this much strain)
 	$(call help_var,CKPT_WALL,and every this many seconds of wall clock)
+	$(call help_var,PROGRESS,seconds of wall clock between the progress lines of a campaign run)
 	$(call help_var,WINDOW,steady window of the fits: a:b (strain) or a%:b%; empty: detected)
 	$(call help_var,CAMPAIGN,campaign of make campaign-list (inertial cohesive angularity ...))
 	$(call help_var,RUN,run folder of make campaign-prep-of)
@@ -309,7 +310,12 @@ snapshot_dt = $(shell awk 'BEGIN { printf "%.6g", 0.2e-3 * sqrt($(RHO) / $(or $(
 # (docs/shear.md). Preparations have no strain: the wall clock alone.
 CKPT_STRAIN ?= 0.1
 CKPT_WALL ?= 300
-CAMPAIGN_SET = --set output.quiet=true --set output.checkpoint_strain=$(CKPT_STRAIN) \
+# Each run prints one line of progress every PROGRESS seconds of wall clock
+# (cdsim --progress: folder, step, share done, ETA), so that a campaign of
+# hours is not silent until a run ends; output.quiet drops the terminal
+# progress line, which two runs of make -j2 would garble.
+PROGRESS ?= 300
+CAMPAIGN_SET = --progress $(PROGRESS) --set output.quiet=true --set output.checkpoint_strain=$(CKPT_STRAIN) \
 	  --set output.checkpoint_wall=$(CKPT_WALL)
 
 inertial_runs   := $(foreach i,$(INERTIAL_I),$(CAMPAIGNS)/inertial/I_$(i))

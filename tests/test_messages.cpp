@@ -155,3 +155,24 @@ TEST(HelpScene, TextIsAlignedWrappedAndHasEveryKeyOfTheTable) {
   }
   EXPECT_NE(md.out.find("| `particles.nsides` | `[0]` |"), std::string::npos);
 }
+
+// A campaign run passes output.quiet (no terminal progress line) and
+// --progress: whole lines on stdout naming the folder, step and ETA
+// (default.toml: dt = 2e-4 s, so 0.01 s is 50 steps).
+TEST(Messages, ProgressLinesInQuietRuns) {
+  const fs::path d = cdtest::scratch_dir("test_messages", "progress");
+  const cdtest::CmdResult r = cdtest::run_command(
+      kCdsim + " " + kConfigs + "/default.toml --quiet --progress 0.001 --set time.duration=0.01 --out " +
+      (d / "run").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  int lines = 0;
+  for (const std::string& l : lines_of(r.out))
+    if (l.rfind("cdsim: " + (d / "run").string() + ": ", 0) == 0) {
+      ++lines;
+      EXPECT_NE(l.find(" % (step "), std::string::npos) << l;
+      EXPECT_NE(l.find(" of 50), "), std::string::npos) << l;
+      EXPECT_NE(l.find(", ETA "), std::string::npos) << l;
+    }
+  EXPECT_GT(lines, 0) << r.out;
+  EXPECT_EQ(r.out.find('\r'), std::string::npos);  // no terminal line in a log
+}

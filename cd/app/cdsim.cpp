@@ -52,6 +52,11 @@ int main(int argc, char** argv) {
                  "problem_STEP.cdp (2D) or .cdp3 (3D), replayed exactly by cdproblem; .dat (2D, Siconos' "
                  "matrix form) or .hdf5 (3D, FCLib); .impulses")
       ->check(CLI::PositiveNumber);
+  double progress_every = 0;
+  app.add_option("--progress", progress_every,
+                 "a progress line on stdout (folder, step, share done, ETA) every SECONDS of wall "
+                 "clock, even with --quiet or into a log (make's campaigns: every 300 s)")
+      ->check(CLI::Range(0.0, 1e9));
   std::int64_t max_steps = 0;
   app.add_option("--max-steps", max_steps,
                  "stop after N steps (a series row and, with checkpoints on, a checkpoint the "
@@ -101,6 +106,7 @@ int main(int argc, char** argv) {
     }
 
     cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps, max_steps};
+    opt.progress_every = progress_every;
     cd::install_stop_handlers();
     const cd::RunSummary s = three ? cd::run3(*world3, scene, opt) : cd::run(*world, scene, opt);
     if (s.first_step > 0)

@@ -201,7 +201,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const auto start = Clock::now();
   const double cpu0 = cpu_seconds();
   sum.load_start = load_average();
-  auto last_print = start, last_ckpt = start;
+  auto last_print = start, last_ckpt = start, last_line = start;
   long iter_total = 0;
   if (k0 < nsteps) tot.sessions += 1;
   // The totals as they stand now: the wall and CPU time of this session added.
@@ -324,6 +324,17 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       break;
     }
 
+    if (opt.progress_every > 0 && k < nsteps) {
+      const auto now = Clock::now();
+      if (now - last_line >= std::chrono::duration<double>(opt.progress_every)) {
+        last_line = now;
+        const double el = std::chrono::duration<double>(now - start).count();
+        std::printf("cdsim: %s: %.1f %% (step %lld of %lld), %.0f s in this session, ETA %.0f s\n",
+                    opt.out.c_str(), 100.0 * double(k) / double(nsteps), static_cast<long long>(k),
+                    static_cast<long long>(nsteps), el, el / double(k - k0) * double(nsteps - k));
+        std::fflush(stdout);
+      }
+    }
     if (progress) {
       const auto now = Clock::now();
       if (now - last_print > std::chrono::milliseconds(500) || k == nsteps) {

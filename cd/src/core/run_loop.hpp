@@ -32,6 +32,10 @@ struct RunOptions {
   // > 0: stop after this many steps of this call (at a step boundary, with
   // a series row and, if checkpoints are on, a checkpoint to resume from).
   std::int64_t max_steps = 0;
+  // > 0: a whole progress line on stdout every this many wall-clock seconds
+  // (folder, step, share done, ETA), quiet or not, terminal or log: what a
+  // campaign of hours shows while its runs go (cdsim --progress).
+  double progress_every = 0;
 };
 
 // A run that produced a non-finite position, velocity, impulse, cell
