@@ -9,7 +9,7 @@
 #include <limits>
 #include <set>
 
-#include "report.hpp"
+#include "plot.hpp"
 #include "run.hpp"
 #include "scene_info.hpp"
 

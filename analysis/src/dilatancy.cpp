@@ -6,7 +6,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "report.hpp"
+#include "plot.hpp"
 #include "scene_info.hpp"
 #include "steady.hpp"
 

@@ -8,10 +8,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numbers>
 
 #include "cohesion.hpp"
 #include "cost.hpp"
+#include "plot.hpp"
 #include "scene_info.hpp"
 #include "trends.hpp"
 
@@ -19,20 +21,6 @@ namespace fs = std::filesystem;
 
 namespace cda {
 namespace {
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) throw InputError(fmt::format("cannot write '{}'", path));
-  out << text;
-}
-
-std::string toml_num(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  std::string s = fmt::format("{:.17g}", v);
-  if (s.find_first_of(".eE") == std::string::npos) s += ".0";
-  return s;
-}
 
 std::string html_escape(const std::string& s) {
   std::string o;
@@ -154,40 +142,6 @@ std::string fits_to_toml(const std::vector<FitResult>& fits, const std::vector<M
                        toml_num(r.value[i]), toml_num(r.error[i]));
   }
   return s;
-}
-
-bool run_gnuplot(const std::string& script) {
-  const std::string cmd = fmt::format("gnuplot '{}' > '{}.log' 2>&1", script, script);
-  return std::system(cmd.c_str()) == 0;
-}
-
-bool plot_both(const std::string& dir, const std::string& stem, const std::string& body, int width,
-               int height) {
-  const std::string gp = (fs::path(dir) / (stem + ".gp")).string();
-  const std::string s = fmt::format(
-      "# cdanalysis plot; rerun with: gnuplot {0}.gp\ncd '{1}'\n"
-      "set terminal pngcairo size {2},{3} enhanced\nset output '{0}.png'\n{4}\n"
-      "set terminal svg size {2},{3} dynamic enhanced\nset output '{0}.svg'\nreplot\nunset output\n",
-      stem, fs::absolute(dir).string(), width, height, body);
-  write_text(gp, s);
-  return run_gnuplot(gp);
-}
-
-bool plot_series(const std::string& dir, const std::string& stem, const Table& series,
-                 const std::string& x_column, const std::string& column, const Window* w) {
-  Table t({x_column, column});
-  const auto& x = series.column(x_column);
-  const auto& y = series.column(column);
-  for (std::size_t i = 0; i < x.size(); ++i) t.add_row({x[i], y[i]});
-  t.write_csv((fs::path(dir) / (stem + ".csv")).string());
-  std::string body = fmt::format("set datafile separator ','\nset key top right\nset xlabel '{}'\n"
-                                 "set ylabel '{}' noenhanced\nset grid\n", x_column, column);
-  if (w)
-    body += fmt::format("set object 1 rect from {},graph 0 to {},graph 1 fc rgb '#cce5ff' fs solid 0.5 behind\n",
-                        w->x_begin, w->x_end);
-  body += fmt::format("plot '{}.csv' using 1:2 every ::1 with lines lc rgb '#1f3b73' title '{}{}' noenhanced\n",
-                      stem, column, w ? " (steady window shaded)" : "");
-  return plot_both(dir, stem, body);
 }
 
 bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
@@ -374,23 +328,27 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         const auto rs = run_steady(run, series, main, xc, std::nullopt);
         w = rs.stats.window;
         have_window = true;
-        std::vector<double> row = {static_cast<double>(k)};
-        double tau = rs.stats.acf.tau, neff = rs.stats.acf.n_eff;
+        // The steady means by column name: the table's row and the point read
+        // the same named values.
+        std::map<std::string, double> row = {{"run", static_cast<double>(k)}};
+        std::map<std::string, Val> mean;
         for (const auto& q : quantities) {
+          Val m;  // nan when the series has no such column
           if (q == "inertial_number" && series.has(q)) {
             const auto st = measured_inertial_number(series, xc, w);  // from <sigma_yy>
-            row.push_back(st.mean);
-            row.push_back(st.err);
+            m = {st.mean, st.err};
           } else if (series.has(q)) {
             const auto st = stats_over(series, q, xc, w);
-            row.push_back(st.mean);
-            row.push_back(st.error());
-          } else {
-            row.push_back(std::nan(""));
-            row.push_back(std::nan(""));
+            m = {st.mean, st.error()};
           }
+          mean[q] = m;
+          row[q] = m.v;
+          row[q + "_err"] = m.err;
         }
-        row.insert(row.end(), {w.x_begin, w.x_end, tau, neff});
+        row["window_begin"] = w.x_begin;
+        row["window_end"] = w.x_end;
+        row["tau_int"] = rs.stats.acf.tau;
+        row["n_eff"] = rs.stats.acf.n_eff;
         // Is the shear homogeneous over the window? (run.hpp shear_profile;
         // nan for a run without particle snapshots or not a periodic shear)
         const Val rate_min = window_rate_min(run, series, xc, w);
@@ -405,12 +363,15 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
             sum.problems.push_back(fmt::format("{}: banded shear (rate_min {:.2f} < {}; cdanalysis profile)", run,
                                                rate_min.v, kBandedRateMin));
         }
-        row.insert(row.end(), {rate_min.v, rate_min.err});
-        row.insert(row.end(), cost.begin(), cost.end());
-        steady.add_row(row);
-        pt.mu = row[1], pt.mu_err = row[2], pt.I = row[3], pt.I_err = row[4];
-        pt.phi = row[5], pt.phi_err = row[6], pt.z = row[7], pt.z_err = row[8];
-        pt.p = row[9], pt.p_err = row[10];
+        row["rate_min"] = rate_min.v;
+        row["rate_min_err"] = rate_min.err;
+        for (std::size_t c = 0; c < kCostColumns.size(); ++c) row[kCostColumns[c]] = cost[c];
+        steady.add_named_row(row);
+        pt.mu = mean[mu_col].v, pt.mu_err = mean[mu_col].err;
+        pt.I = mean["inertial_number"].v, pt.I_err = mean["inertial_number"].err;
+        pt.phi = mean["packing_fraction"].v, pt.phi_err = mean["packing_fraction"].err;
+        pt.z = mean["z"].v, pt.z_err = mean["z"].err;
+        pt.p = mean["p"].v, pt.p_err = mean["p"].err;
         pt.steady = series.has(mu_col) || series.has("packing_fraction");
         ++sum.steady;
       } catch (const AnalysisError& e) {
@@ -425,12 +386,17 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
           const auto fw = window_fabric3(run, series, xc, have_window ? &w : nullptr);
           sum.problems.insert(sum.problems.end(), fw.problems.begin(), fw.problems.end());
           const char* xs = xc == "strain" ? "γ" : "t";
-          std::vector<double> frow = {static_cast<double>(k)};
-          for (const auto& m : fw.mean) frow.insert(frow.end(), {m.v, m.err});
+          std::map<std::string, double> frow = {{"run", static_cast<double>(k)}};
+          for (const auto& c : kFabric3Columns) {
+            frow[c] = fw.of(c).v;
+            frow[c + "_err"] = fw.of(c).err;
+          }
           const double rel = fw.check_rel, rel_err = fw.check_rel_err;
-          frow.insert(frow.end(), {rel, rel_err, static_cast<double>(fw.files.size())});
-          frow.insert(frow.end(), cost.begin(), cost.end());
-          fabric.add_row(frow);
+          frow["check_rel"] = rel;
+          frow["check_rel_err"] = rel_err;
+          frow["fabric_snapshots"] = static_cast<double>(fw.files.size());
+          for (std::size_t c = 0; c < kCostColumns.size(); ++c) frow[kCostColumns[c]] = cost[c];
+          fabric.add_named_row(frow);
           ++sum.fabric;
           const double qp = fw.of("q_over_p").v;
           const std::string what =
@@ -462,14 +428,16 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
           const auto f = run_fabric(run, -1, bins, -1);
           const auto& a = f.fft;
           const auto& b = f.tensor;
-          std::vector<double> frow = {
-              static_cast<double>(k), a.c.a(), a.c.theta(), a.ln.a(), a.lt.a(), a.fn.a(),
-              a.ft.a(), a.sum_half(), f.stress.q_over_p(), b.c.a(), b.ln.a(), b.lt.a(),
-              b.fn.a(), b.ft.a(), f.sliding,
-              f.connectivity ? f.connectivity->z : std::nan(""),
-              f.connectivity ? f.connectivity->non_floating : std::nan("")};
-          frow.insert(frow.end(), cost.begin(), cost.end());
-          fabric.add_row(frow);
+          std::map<std::string, double> frow = {
+              {"run", static_cast<double>(k)}, {"a_c", a.c.a()}, {"theta_c", a.c.theta()},
+              {"a_ln", a.ln.a()}, {"a_lt", a.lt.a()}, {"a_fn", a.fn.a()}, {"a_ft", a.ft.a()},
+              {"sum_half", a.sum_half()}, {"q_over_p", f.stress.q_over_p()}, {"a_c_tensor", b.c.a()},
+              {"a_ln_tensor", b.ln.a()}, {"a_lt_tensor", b.lt.a()}, {"a_fn_tensor", b.fn.a()},
+              {"a_ft_tensor", b.ft.a()}, {"sliding", f.sliding},
+              {"z", f.connectivity ? f.connectivity->z : std::nan("")},
+              {"non_floating", f.connectivity ? f.connectivity->non_floating : std::nan("")}};
+          for (std::size_t c = 0; c < kCostColumns.size(); ++c) frow[kCostColumns[c]] = cost[c];
+          fabric.add_named_row(frow);
           ++sum.fabric;
           sum.plots_ok = plot_polar(out_dir, stem + "_polar", f) && sum.plots_ok;
           html_runs += fmt::format("<p>last snapshot {}</p>\n", html_escape(f.file));

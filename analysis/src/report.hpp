@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fit.hpp"
+#include "plot.hpp"
 #include "run.hpp"
 
 namespace cda {
@@ -15,19 +16,6 @@ namespace cda {
 //   [mu_I.params.mu1]  value, error
 // plus the covariance as an array of rows.
 std::string fits_to_toml(const std::vector<FitResult>& fits, const std::vector<Model>& models);
-
-// Runs gnuplot on a script; returns false (and leaves the script for a rerun)
-// when gnuplot is missing or fails.
-bool run_gnuplot(const std::string& script_path);
-
-// Writes `<stem>.gp` that draws `body` to both <stem>.png and <stem>.svg, and
-// runs it. `body` holds the set/plot commands of one plot.
-bool plot_both(const std::string& dir, const std::string& stem, const std::string& body,
-               int width = 800, int height = 500);
-
-// Time series of `column` with its steady window shaded.
-bool plot_series(const std::string& dir, const std::string& stem, const Table& series,
-                 const std::string& x_column, const std::string& column, const Window* w);
 
 // Polar diagrams of P(theta), <fn>(theta), <ft>(theta) with their Fourier
 // (second-harmonic) fits; 3 plots named <stem>_P, <stem>_fn, <stem>_ft.

@@ -95,6 +95,21 @@ void Table::add_row(const std::vector<double>& values) {
   for (std::size_t j = 0; j < values.size(); ++j) cols_[j].push_back(values[j]);
 }
 
+void Table::add_named_row(const std::map<std::string, double>& values) {
+  std::vector<double> row;
+  row.reserve(names_.size());
+  for (const auto& n : names_) {
+    const auto it = values.find(n);
+    if (it == values.end()) throw AnalysisError(fmt::format("table row without column '{}'", n));
+    row.push_back(it->second);
+  }
+  if (values.size() != names_.size())
+    for (const auto& [n, v] : values)
+      if (std::find(names_.begin(), names_.end(), n) == names_.end())
+        throw AnalysisError(fmt::format("table row with column '{}' the table does not have", n));
+  add_row(row);
+}
+
 void Table::add_column(const std::string& name, std::vector<double> values) {
   if (!cols_.empty() && values.size() != rows())
     throw InputError(fmt::format("column '{}' has {} rows, the table {}", name, values.size(),

@@ -2,6 +2,7 @@
 // writer for the analysis tables. Columns are looked up by name, so a reader
 // never depends on the simulator's column order.
 #pragma once
+#include <map>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,10 @@ class Table {
   const std::string& source() const { return source_; }
 
   void add_row(const std::vector<double>& values);
+  // A row given by column name: every column of the table exactly once
+  // (a missing or unknown name throws), so that a writer never depends on
+  // the order in which it lists them.
+  void add_named_row(const std::map<std::string, double>& values);
   void add_column(const std::string& name, std::vector<double> values);
   // Full precision (%.17g), so a round trip is exact.
   std::string to_csv() const;

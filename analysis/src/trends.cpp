@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <limits>
 
-#include "report.hpp"
+#include "plot.hpp"
 #include "run.hpp"
 #include "scene_info.hpp"
 #include "snapshot.hpp"

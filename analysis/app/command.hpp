@@ -1,0 +1,72 @@
+// The subcommands of cdanalysis as a table of name -> handler (as git's
+// builtin/ and LAMMPS' command styles): each subcommand is one file in
+// commands/ that declares its options on its CLI11 subcommand and returns
+// the handler main runs once that subcommand was parsed. Adding a command
+// is one file and one row in cdanalysis.cpp's table.
+#pragma once
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/src/fit.hpp"
+#include "analysis/src/run.hpp"
+
+namespace cda::cli {
+
+// Runs the parsed subcommand; returns the exit code (error.hpp). Failures
+// are thrown (AnalysisError: 1, InputError: 2) and reported by main.
+using Handler = std::function<int()>;
+// Declares the options of a subcommand on `sub` (bound to state the handler
+// owns) and returns its handler.
+using Declare = Handler (*)(CLI::App& sub);
+
+struct Command {
+  const char* name;
+  const char* help;
+  Declare declare;
+};
+
+// The commands, each defined in commands/<name>.cpp.
+Handler steady(CLI::App& sub);
+Handler fabric(CLI::App& sub);
+Handler profile(CLI::App& sub);
+Handler fit_mu_i(CLI::App& sub);
+Handler fit_cohesion(CLI::App& sub);
+Handler fit_dilatancy(CLI::App& sub);
+Handler fit_angularity(CLI::App& sub);
+Handler fit_nu_i(CLI::App& sub);
+Handler fit_compaction(CLI::App& sub);
+Handler fit_fabric_bounds(CLI::App& sub);
+Handler compare_fits(CLI::App& sub);
+Handler report(CLI::App& sub);
+
+// ---- Shared by the commands (common.cpp) ----
+
+// The command as typed, for the plots' "made by" line (set once by main).
+void set_command_line(int argc, char** argv);
+const std::string& command_line();
+
+void print_fit(const FitResult& r, const Model& m);
+// Writes the fits as TOML to path (nothing when path is empty).
+void write_toml(const std::string& path, const std::vector<FitResult>& f, const std::vector<Model>& m);
+// Run folders from the arguments: a folder holding series.csv is a run, any
+// other folder a campaign whose subfolders are runs (report.hpp).
+std::vector<std::string> expand_runs(const std::vector<std::string>& args);
+// The dimension shared by the runs of one fit (run_dimension); runs of
+// different dimensions are refused: one fit mixes no dimensions.
+int common_dimension(const std::vector<std::string>& runs, const std::string& what);
+std::vector<double> col_or_empty(const Table& t, const std::string& name);
+
+// fit nu-i and fit compaction: one steady state (packing fraction) against
+// I or p, over runs or a table (state_fit.cpp).
+struct StateFitOptions {
+  std::vector<std::string> runs;
+  std::string table, toml_out, out, window;
+  double p0 = 0;  // compaction: reference pressure, 0: the geometric mean of the p's
+};
+int run_state_fit(const StateFitOptions& o, bool is_nu);
+
+}  // namespace cda::cli

@@ -1,0 +1,84 @@
+// cdanalysis fit angularity: mu*(alpha) over steady shear runs of several
+// shapes, with the table of steady quantities against alpha (trends.hpp).
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "analysis/app/command.hpp"
+
+namespace cda::cli {
+
+Handler fit_angularity(CLI::App& sub) {
+  struct Opt {
+    std::vector<std::string> runs;
+    std::string toml_out, out;
+    int snapshots = 5, bins = 36;
+  };
+  auto o = std::make_shared<Opt>();
+  sub.add_option("runs", o->runs, "run or campaign folders (series.csv, scene.toml, contact snapshots)")->required();
+  sub.add_option("--snapshots", o->snapshots, "last contact snapshots averaged per run for the fabric")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  sub.add_option("--bins", o->bins, "angular bins over [0, pi)")->check(CLI::Range(4, 36000))->capture_default_str();
+  sub.add_option("--out", o->out, "folder for angularity.csv, the fit curve and the plots (png, svg)");
+  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file");
+  return [o] {
+    AngularityOptions opt;
+    opt.snapshots = o->snapshots;
+    opt.bins = o->bins;
+    std::vector<AngularityPoint> pts;
+    const auto all = expand_runs(o->runs);
+    for (const auto& r : all) {
+      try {
+        pts.push_back(angularity_point(r, opt));
+      } catch (const AnalysisError& e) {
+        if (all.size() == 1) throw;
+        fmt::print("{}: skipped: {}\n", r, e.what());
+      }
+    }
+    if (pts.empty()) throw AnalysisError("fit angularity: no usable run (each was skipped, see above)");
+    std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.alpha < b.alpha; });
+    fmt::print("sliding: |f_t| >= mu f_n (1 - tol), tol = the run's [solver] tol; fabric: mean +- sem over "
+               "the last {} contact snapshots\n", o->snapshots);
+    fmt::print("{:>3} {:>3} {:>6}  {:>15} {:>15} {:>13} {:>15} {:>15} {:>15} {:>15} {:>15} {:>15} {:>15} "
+               "{:>15} {:>15} {:>7} {:>7} {:>7}\n",
+               "#", "n_s", "alpha", "mu*", "nu*", "z", "a_c", "a_ln", "a_lt", "a_fn", "a_ft", "sliding",
+               "ss share", "q_sv/p", "q_ss/p", "q/p", "sum/2", "tensor");
+    auto pm = [](const Val& v, int w) {
+      return std::isfinite(v.err) ? fmt::format("{:.{}f}±{:.{}f}", v.v, w, v.err, w)
+                                  : (std::isfinite(v.v) ? fmt::format("{:.{}f}", v.v, w) : "n/a");
+    };
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const auto& a = pts[k];
+      fmt::print("{:>3} {:>3} {:>6.4f}  {:>15} {:>15} {:>13} {:>15} {:>15} {:>15} {:>15} {:>15} {:>15} {:>15} "
+                 "{:>15} {:>15} {:>7.4f} {:>7.4f} {:>7.4f}\n",
+                 k, a.nsides, a.alpha, pm(a.mu, 4), pm(a.nu, 4), pm(a.z, 3), pm(a.a_c, 4), pm(a.a_ln, 4),
+                 pm(a.a_lt, 4), pm(a.a_fn, 4), pm(a.a_ft, 4), pm(a.sliding, 4), pm(a.ss_share, 4),
+                 pm(a.q_sv, 4), pm(a.q_ss, 4), a.q_over_p_snap.v, a.sum_half_fft.v, a.sum_half_tensor.v);
+    }
+    for (std::size_t k = 0; k < pts.size(); ++k)
+      fmt::print("  {} = {} (alpha from the {})\n", k, pts[k].run, pts[k].alpha_source);
+    fmt::print("check q/p ~ (sum a)/2: q/p of the snapshots' contact stress against the Fourier sum and the "
+               "tensor sum with directions (columns q/p, sum/2, tensor)\n");
+    std::optional<FitResult> r;
+    try {
+      r = cda::fit_angularity(pts);
+      print_fit(*r, mu_of_alpha());
+      write_toml(o->toml_out, {*r}, {mu_of_alpha()});
+    } catch (const AnalysisError& e) {
+      if (o->out.empty()) throw;
+      fmt::print(stderr, "cdanalysis: refused: {}\n", e.what());
+    }
+    if (!o->out.empty()) {
+      if (!plot_angularity(o->out, pts, r ? &*r : nullptr, command_line()))
+        fmt::print(stderr, "warning: gnuplot failed; the scripts are in {}\n", o->out);
+      fmt::print("wrote {}/angularity.csv and the angularity_*.png/svg plots\n", o->out);
+      if (!r) return 1;
+    }
+    return 0;
+  };
+}
+
+}  // namespace cda::cli

@@ -1,0 +1,46 @@
+// cdanalysis profile RUN: is the shear homogeneous? The local shear rate
+// across the layers of a periodic shear run over its steady window.
+#include <fmt/core.h>
+
+#include <memory>
+
+#include "analysis/app/command.hpp"
+#include "analysis/src/scene_info.hpp"
+
+namespace cda::cli {
+
+Handler profile(CLI::App& sub) {
+  struct Opt {
+    std::string run, window;
+    int layers = 5;
+  };
+  auto o = std::make_shared<Opt>();
+  sub.add_option("run", o->run, "run folder (series.csv, particle snapshots and their .pvd)")->required();
+  sub.add_option("--layers", o->layers, "layers across the gradient direction y")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  sub.add_option("--window", o->window, "as steady's --window (default: the detected steady window of mu)");
+  return [o] {
+    const int layers = o->layers;
+    const auto series = read_series(o->run);
+    const std::string x = default_x_column(series);
+    const auto r =
+        run_steady(o->run, series, mu_column(run_dimension(o->run)), x, window_range(o->window, series.column(x)));
+    const auto& w = r.stats.window;
+    const auto pr = shear_profile(o->run, series, x, w, layers);
+    fmt::print("window     {} {:.4g} to {:.4g}: {} particle snapshots\n", x, w.x_begin, w.x_end, pr.snapshots);
+    fmt::print("local shear rate / mean rate between layer centres (1: homogeneous), mean +- sem over them:\n");
+    for (int i = 0; i < layers; ++i)
+      fmt::print("  gap {:>3}-{:<3} {:.3f} +- {:.3f}{}\n", i, (i + 1) % layers, pr.rate[i].v, pr.rate[i].err,
+                 i + 1 == layers ? "  (across the periodic boundary)" : "");
+    fmt::print("rate_min   {:.3f} +- {:.3f}{}\n", pr.rate_min.v, pr.rate_min.err,
+               is_banded(pr.rate_min.v) ? fmt::format("  banded: below {} (a layer moves nearly as a rigid "
+                                                      "plug; the run's I is not the local one)",
+                                                      kBandedRateMin)
+                                        : std::string());
+    fmt::print("max_rate   {:.3f} +- {:.3f} (per snapshot, then averaged)\n", pr.max_rate.v, pr.max_rate.err);
+    return 0;
+  };
+}
+
+}  // namespace cda::cli
