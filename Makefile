@@ -526,29 +526,34 @@ ANALYSIS := outputs/analysis$(if $(dim3),3d)
 # WINDOW=a:b (strain) or a%:b% (of each run's span, e.g. 50%:100%) fixes the
 # steady window of the fits (cdanalysis --window); default: detected per run.
 fit_window = $(if $(WINDOW),--window $(WINDOW))
+# Each target runs the report and every fit through analysis/analyze.sh,
+# whatever the others gave: runs without a steady window are left out and
+# named, undetermined fits are written and flagged, and the target fails
+# only when no fit could be written (docs/analysis.md, "Campaign analyses").
+ANALYZE := analysis/analyze.sh
 analyze-inertial: build
-	$(CDA) report $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial
-	$(CDA) fit mu-i $(CAMPAIGNS)/inertial $(fit_window) --out $(ANALYSIS)/inertial/mu_I --toml $(ANALYSIS)/inertial/mu_i.toml
-	$(CDA) fit nu-i $(CAMPAIGNS)/inertial $(fit_window) --out $(ANALYSIS)/inertial/nu_i --toml $(ANALYSIS)/inertial/nu_i.toml
-	$(if $(dim3),,$(CDA) fit dilatancy $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial/dilatancy --toml $(ANALYSIS)/inertial/dilatancy.toml)
+	@$(ANALYZE) "$(CDA) report $(CAMPAIGNS)/inertial --out $(ANALYSIS)/inertial" \
+	  "$(CDA) fit mu-i $(CAMPAIGNS)/inertial $(fit_window) --out $(ANALYSIS)/inertial/mu_I --toml $(ANALYSIS)/inertial/mu_i.toml" \
+	  "$(CDA) fit nu-i $(CAMPAIGNS)/inertial $(fit_window) --out $(ANALYSIS)/inertial/nu_i --toml $(ANALYSIS)/inertial/nu_i.toml" \
+	  $(if $(dim3),,"$(CDA) fit dilatancy $(CAMPAIGNS)/inertial $(fit_window) --out $(ANALYSIS)/inertial/dilatancy --toml $(ANALYSIS)/inertial/dilatancy.toml")
 
 # The eta = 0 reference runs (eta_0_I_*) must be in the cohesive campaign.
 analyze-cohesive: build
-	$(CDA) report $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive
-	$(CDA) fit cohesion $(CAMPAIGNS)/cohesive $(fit_window) --out $(ANALYSIS)/cohesive/cohesion --toml $(ANALYSIS)/cohesive/cohesion.toml
+	@$(ANALYZE) "$(CDA) report $(CAMPAIGNS)/cohesive --out $(ANALYSIS)/cohesive" \
+	  "$(CDA) fit cohesion $(CAMPAIGNS)/cohesive $(fit_window) --out $(ANALYSIS)/cohesive/cohesion --toml $(ANALYSIS)/cohesive/cohesion.toml"
 
 analyze-pressure analyze-pressure-ladder: analyze-%: build
-	$(CDA) report $(CAMPAIGNS)/$* --out $(ANALYSIS)/$*
-	$(CDA) fit compaction $(CAMPAIGNS)/$* --out $(ANALYSIS)/$*/compaction --toml $(ANALYSIS)/$*/compaction.toml
+	@$(ANALYZE) "$(CDA) report $(CAMPAIGNS)/$* --out $(ANALYSIS)/$*" \
+	  "$(CDA) fit compaction $(CAMPAIGNS)/$* $(fit_window) --out $(ANALYSIS)/$*/compaction --toml $(ANALYSIS)/$*/compaction.toml"
 
 analyze-inertial-ladder: build
-	$(CDA) report $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder
-	$(CDA) fit mu-i $(CAMPAIGNS)/inertial-ladder $(fit_window) --out $(ANALYSIS)/inertial-ladder/mu_I --toml $(ANALYSIS)/inertial-ladder/mu_i.toml
-	$(CDA) fit nu-i $(CAMPAIGNS)/inertial-ladder $(fit_window) --out $(ANALYSIS)/inertial-ladder/nu_i --toml $(ANALYSIS)/inertial-ladder/nu_i.toml
+	@$(ANALYZE) "$(CDA) report $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder" \
+	  "$(CDA) fit mu-i $(CAMPAIGNS)/inertial-ladder $(fit_window) --out $(ANALYSIS)/inertial-ladder/mu_I --toml $(ANALYSIS)/inertial-ladder/mu_i.toml" \
+	  "$(CDA) fit nu-i $(CAMPAIGNS)/inertial-ladder $(fit_window) --out $(ANALYSIS)/inertial-ladder/nu_i --toml $(ANALYSIS)/inertial-ladder/nu_i.toml"
 
 analyze-angularity: build
-	$(CDA) report $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity
-	$(CDA) fit angularity $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity/fit --toml $(ANALYSIS)/angularity/mu_alpha.toml
+	@$(ANALYZE) "$(CDA) report $(CAMPAIGNS)/angularity --out $(ANALYSIS)/angularity" \
+	  "$(CDA) fit angularity $(CAMPAIGNS)/angularity $(fit_window) --out $(ANALYSIS)/angularity/fit --toml $(ANALYSIS)/angularity/mu_alpha.toml"
 
 # Regression of fitted curves: re-runs the small reference campaigns of
 # tests/data/regress/ (2D: 100 disks) and tests/data/regress3d/ (3D: 200

@@ -14,7 +14,9 @@
 #include <functional>
 #include <numbers>
 #include <random>
+#include <sstream>
 
+#include "analysis/src/compare.hpp"
 #include "analysis/src/cost.hpp"
 #include "analysis/src/report.hpp"
 #include "analysis/src/run.hpp"
@@ -356,4 +358,204 @@ TEST(AnalysisIo, CommandLineExitsNonZeroNamingTheFile) {
   EXPECT_EQ(rc, 0) << msg;
   std::tie(rc, msg) = run(fmt::format("fabric {} --volume 12", (d / "a").string()));
   EXPECT_EQ(rc, 0) << msg;
+}
+
+// ---- Bad input to the command line (issue 28: items 2, 5, 10, 11, 16) ----
+
+namespace {
+
+const fs::path& cda_exe() {
+  static const fs::path exe = fs::path(CDLAB_BINARY_DIR) / "analysis" / "cdanalysis";
+  return exe;
+}
+
+cdtest::CmdResult run_cda(const std::string& args) {
+  return cdtest::run_command(fmt::format("'{}' {}", cda_exe().string(), args));
+}
+
+// A small fit table for the commands that take --table.
+fs::path mu_table(const fs::path& dir) {
+  const auto t = dir / "mu.csv";
+  write(t, "I,mu,mu_err\n0.001,0.26,0.01\n0.01,0.3,0.01\n0.03,0.35,0.01\n0.1,0.42,0.01\n0.3,0.52,0.01\n");
+  return t;
+}
+
+}  // namespace
+
+// Every floating-point option of every subcommand refuses NaN and infinity
+// by name with exit 2. CLI11's ranges let NaN through (every comparison with
+// it is false), after which NaN meant "not given": --tol-sigma nan made
+// compare-fits pass any change. The options are read from each command's
+// --help, so an option added later is covered without editing this test.
+TEST(AnalysisIo, EveryNumericOptionRefusesNanAndInfinity) {
+  ASSERT_TRUE(fs::exists(cda_exe())) << "cdanalysis not built: " << cda_exe();
+  const std::vector<std::string> commands = {"steady", "fabric", "profile", "report", "compare-fits",
+                                             "fit mu-i", "fit cohesion", "fit dilatancy", "fit angularity",
+                                             "fit nu-i", "fit compaction", "fit fabric-bounds"};
+  std::size_t options = 0;
+  for (const auto& c : commands) {
+    const auto help = run_cda(c + " --help");
+    ASSERT_EQ(help.code, 0) << c << ": " << help.out;
+    std::istringstream lines(help.out);
+    std::string line;
+    while (std::getline(lines, line)) {
+      std::istringstream words(line);
+      std::string name, type;
+      words >> name >> type;
+      if (name.rfind("--", 0) != 0 || type.rfind("FLOAT", 0) != 0) continue;
+      ++options;
+      for (const char* bad : {"nan", "-nan", "inf", "1.8e308"}) {
+        // Positionals given, so that only the option can be at fault.
+        const auto r = run_cda(fmt::format("{} a b {} {}", c, name, bad));
+        EXPECT_EQ(r.code, 2) << c << " " << name << " " << bad << ": " << r.out;
+        EXPECT_NE(r.out.find(name), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find("is not a finite number"), std::string::npos) << r.out;
+        EXPECT_LT(r.out.size(), 400u) << "no 309-digit bound in the message: " << r.out;
+      }
+    }
+  }
+  // fabric --volume, fit compaction --p0, fit fabric-bounds --k,
+  // compare-fits --tol-sigma and --tol-rel at least.
+  EXPECT_GE(options, 5u);
+}
+
+TEST(AnalysisIo, CompareFitsWithNanToleranceIsRefusedNotPassed) {
+  const auto d = scratch("cmp_nan");
+  const auto t = mu_table(d);
+  ASSERT_EQ(run_cda(fmt::format("fit mu-i --table {} --toml {}", t.string(), (d / "a.toml").string())).code, 0);
+  // The same fit with mu1 moved by 41 of its sigmas.
+  auto fa = read_fit_toml((d / "a.toml").string());
+  std::ifstream in(d / "a.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const auto& mu1 = fa.models.at("mu_I").params.at("mu1");
+  const std::string from = fmt::format("value = {}", toml_num(mu1.value));
+  ASSERT_NE(text.find(from), std::string::npos) << text;
+  text.replace(text.find(from), from.size(), fmt::format("value = {}", toml_num(mu1.value + 41 * mu1.error)));
+  write(d / "b.toml", text);
+  const std::string ab = fmt::format("compare-fits {} {}", (d / "a.toml").string(), (d / "b.toml").string());
+  EXPECT_EQ(run_cda(ab).code, 1);  // the shift FAILs
+  for (const char* opt : {"--tol-sigma nan", "--tol-rel nan", "--tol-sigma -1"})
+    EXPECT_EQ(run_cda(ab + " " + opt).code, 2) << opt;
+}
+
+// Exit 2 (bad input), not 1 (refused), for what is the input's fault; a
+// folder where a file should be is named as a folder; file content in a
+// message never carries control bytes to the terminal.
+TEST(AnalysisIo, BadInputExitsTwoWithAClearMessage) {
+  const auto d = scratch("bad_cli");
+  make_run(d / "a", 0.3, 0.01, 3);
+  const auto t = mu_table(d);
+  for (const char* w : {"1:x", "2:1", "50%:1", "nan:1", ":"}) {
+    const auto r = run_cda(fmt::format("steady {} --window '{}'", (d / "a").string(), w));
+    EXPECT_EQ(r.code, 2) << w << ": " << r.out;
+    EXPECT_NE(r.out.find("window"), std::string::npos) << r.out;
+  }
+  // An unwritable --toml is refused before anything is done or written.
+  const auto r = run_cda(fmt::format("fit mu-i --table {} --toml {} --out {}", t.string(),
+                                 (d / "no" / "such" / "x.toml").string(), (d / "plot").string()));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("does not exist"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(d / "plot"));
+  // Folders given as files.
+  fs::create_directories(d / "dir.csv");
+  auto f = run_cda(fmt::format("fit mu-i --table {}", (d / "dir.csv").string()));
+  EXPECT_EQ(f.code, 2) << f.out;
+  EXPECT_NE(f.out.find("is a folder, not a file"), std::string::npos) << f.out;
+  f = run_cda(fmt::format("compare-fits {} {}", (d / "dir.csv").string(), (d / "dir.csv").string()));
+  EXPECT_EQ(f.code, 2) << f.out;
+  EXPECT_NE(f.out.find("is a folder, not a file"), std::string::npos) << f.out;
+  fs::create_directories(d / "b" / "series.csv");
+  f = run_cda(fmt::format("steady {}", (d / "b").string()));
+  EXPECT_EQ(f.code, 2) << f.out;
+  EXPECT_NE(f.out.find("is a folder, not a file"), std::string::npos) << f.out;
+  // Binary junk in a table: shown escaped.
+  write(d / "junk.csv", std::string("I,mu\n0.1,\x1b[2J\x07\xff\xfe\n", 21));
+  f = run_cda(fmt::format("fit mu-i --table {}", (d / "junk.csv").string()));
+  EXPECT_EQ(f.code, 2) << f.out;
+  for (const char c : f.out)
+    EXPECT_TRUE(c == '\n' || (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f)) << "byte " << int(c);
+  EXPECT_NE(f.out.find("\\x1B[2J\\x07\\xFF\\xFE"), std::string::npos) << f.out;
+}
+
+// A series whose last row is cut, which repeats a step or whose time runs
+// backwards is refused with file and line: rows of a cut file or of two
+// runs mixed would bias every window average.
+TEST(AnalysisIo, SeriesRowsMustBeWholeAndGoForward) {
+  const auto d = scratch("series_rows");
+  const std::string head = "step,time,strain,q_over_p\n";
+  std::string good = head;
+  for (int i = 0; i < 50; ++i) good += fmt::format("{},{},{},0.3\n", 10 * i, i / 10.0, i / 100.0);
+  const auto expect_refused = [&](const std::string& name, const std::string& text, const std::string& what) {
+    fs::create_directories(d / name);
+    write(d / name / "series.csv", text);
+    const std::string m = message([&] { read_series((d / name).string()); });
+    EXPECT_NE(m.find(what), std::string::npos) << name << ": " << m;
+    const auto r = run_cda(fmt::format("steady {} --column q_over_p", (d / name).string()));
+    EXPECT_EQ(r.code, 2) << name << ": " << r.out;
+  };
+  fs::create_directories(d / "ok");
+  write(d / "ok" / "series.csv", good);
+  EXPECT_EQ(read_series((d / "ok").string()).rows(), 50u);
+  expect_refused("cut", good + "500,5,0.5,0.2", "series.csv' line 52: the last row is cut");
+  expect_refused("repeated", good + "490,5.0,0.5,0.3\n", "line 52: step 490 repeats the previous row's 490 (line 51)");
+  expect_refused("backwards", good + "500,4.8,0.5,0.3\n", "line 52: time 4.8 is before the previous row's 4.9");
+}
+
+// Analyses never dead-end (issue 29, item 1): over a campaign with a run that
+// has no steady window and one whose series is damaged, the report is
+// written with both listed and exits 5 (kExitPartial: written with
+// reservations), fit mu-i leaves them out by name and fits the others
+// (exit 5), and the same campaign without them exits 0. A fit the data do
+// not determine is written and flagged: the undetermined parameters in the
+// TOML, the page and the legend, or, refused, the reason in the TOML.
+TEST(AnalysisIo, ReportAndFitsNeverDeadEnd) {
+  const auto d = scratch("never_dead_end");
+  const double I[] = {1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3};
+  for (int k = 0; k < 6; ++k)
+    make_run(d / "camp" / fmt::format("I_{}", I[k]), 0.28 + 0.34 / (1 + 0.05 / I[k]), I[k], 40 + k);
+  EXPECT_EQ(run_cda(fmt::format("report {} --out {}", (d / "camp").string(), (d / "r0").string())).code, 0);
+  // A run still drifting at its end, and a run whose series is damaged.
+  fs::create_directories(d / "camp" / "I_drift");
+  std::string csv = "step,time,strain,q_over_p,inertial_number\n";
+  for (int i = 0; i < 300; ++i) csv += fmt::format("{},{},{},{},0.05\n", i, i / 10.0, i / 100.0, 0.2 + 0.001 * i);
+  write(d / "camp" / "I_drift" / "series.csv", csv);
+  fs::create_directories(d / "camp" / "I_bad");
+  write(d / "camp" / "I_bad" / "series.csv", "step,time,strain,q_over_p\n0,0,0,0.3\n1,0.1,0.01,x\n");
+
+  const auto rep = run_cda(fmt::format("report {} --out {}", (d / "camp").string(), (d / "r").string()));
+  EXPECT_EQ(rep.code, kExitPartial) << rep.out;
+  EXPECT_NE(rep.out.find("2 of 8 runs left out"), std::string::npos) << rep.out;
+  std::ifstream runs(d / "r" / "runs.csv");
+  const std::string rtext((std::istreambuf_iterator<char>(runs)), {});
+  EXPECT_NE(rtext.find("I_drift\",not steady"), std::string::npos) << rtext;
+  EXPECT_NE(rtext.find("I_bad\",unreadable"), std::string::npos) << rtext;
+  EXPECT_TRUE(fs::exists(d / "r" / "fits.toml"));
+  EXPECT_NE(read_fit_toml((d / "r" / "fits.toml").string()).models.count("mu_I"), 0u);
+
+  const auto fit = run_cda(fmt::format("fit mu-i {} --toml {}", (d / "camp").string(), (d / "mu.toml").string()));
+  EXPECT_EQ(fit.code, kExitPartial) << fit.out;
+  EXPECT_NE(fit.out.find("I_drift: left out: "), std::string::npos) << fit.out;
+  EXPECT_NE(fit.out.find("2 runs left out"), std::string::npos) << fit.out;
+  const auto mu = read_fit_toml((d / "mu.toml").string());
+  // The six good runs alone give the same fit as the report's.
+  EXPECT_EQ(mu.models.at("mu_I").params.at("mu1").value,
+            read_fit_toml((d / "r" / "fits.toml").string()).models.at("mu_I").params.at("mu1").value);
+
+  // Undetermined: four points at small I, flat within their errors, say
+  // nothing of where mu(I) bends (I0).
+  write(d / "flat.csv", "I,mu,mu_err\n0.001,0.30,0.01\n0.002,0.31,0.01\n0.003,0.30,0.01\n0.004,0.31,0.01\n");
+  const auto flat = run_cda(fmt::format("fit mu-i --table {} --toml {} --out {}", (d / "flat.csv").string(),
+                                    (d / "flat.toml").string(), (d / "flat").string()));
+  std::ifstream ft(d / "flat.toml");
+  const std::string ftext((std::istreambuf_iterator<char>(ft)), {});
+  if (flat.code == kExitPartial) {  // fitted, parameters flagged
+    EXPECT_NE(ftext.find("undetermined = ["), std::string::npos) << ftext;
+    EXPECT_NE(ftext.find("\"I0\"]"), std::string::npos) << ftext;
+    EXPECT_NE(flat.out.find("what would determine them"), std::string::npos) << flat.out;
+  } else {  // refused: the reason in the TOML, the points drawn
+    EXPECT_EQ(flat.code, 1) << flat.out;
+    EXPECT_NE(ftext.find("determined = false"), std::string::npos) << ftext;
+    EXPECT_NE(flat.out.find("what would determine it"), std::string::npos) << flat.out;
+  }
+  EXPECT_TRUE(fs::exists(d / "flat" / "mu_I_data.csv"));
 }

@@ -84,6 +84,7 @@ int main(int argc, char** argv) {
     }
     declare(app, kCommands[i], handlers);
   }
+  require_finite_numbers(app);
   set_command_line(argc, argv);
 
   try {
@@ -96,13 +97,13 @@ int main(int argc, char** argv) {
     for (const auto& h : handlers)
       if (h.sub->parsed()) return h.run();
   } catch (const InputError& e) {
-    fmt::print(stderr, "cdanalysis: bad input: {}\n", e.what());
+    fmt::print(stderr, "cdanalysis: bad input: {}\n", printable(e.what()));
     return 2;
   } catch (const AnalysisError& e) {
-    fmt::print(stderr, "cdanalysis: refused: {}\n", e.what());
+    fmt::print(stderr, "cdanalysis: refused: {}\n", printable(e.what()));
     return 1;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "cdanalysis: error: {}\n", e.what());
+    fmt::print(stderr, "cdanalysis: error: {}\n", printable(e.what()));
     return 2;
   }
   return 0;

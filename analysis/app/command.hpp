@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "analysis/src/fit.hpp"
+#include "analysis/src/report.hpp"
 #include "analysis/src/run.hpp"
 
 namespace cda::cli {
@@ -45,13 +46,35 @@ Handler report(CLI::App& sub);
 
 // ---- Shared by the commands (common.cpp) ----
 
+// Option validators. CLI11's own let NaN through (every comparison with NaN
+// is false, so NaN "passes" a range and then means "not given") and print
+// their bounds with %f (DBL_MAX as 309 digits). main adds finite_number()
+// to every floating-point option of every command (declare_all), so a range
+// below only has to say its range.
+CLI::Validator finite_number();
+CLI::Validator positive_number();      // > 0 (and finite)
+CLI::Validator non_negative_number();  // >= 0 (and finite)
+// A file the command will write: its folder exists and is writable, and the
+// path is not a folder; checked before any work is done.
+CLI::Validator writable_file();
+// A --window spec, a:b or a%:b% (run.hpp resolve_window), checked before any run is read.
+CLI::Validator window_spec();
+// Adds finite_number() to every floating-point option of app and of its
+// subcommands, recursively.
+void require_finite_numbers(CLI::App& app);
+
 // The command as typed, for the plots' "made by" line (set once by main).
 void set_command_line(int argc, char** argv);
 const std::string& command_line();
 
 void print_fit(const FitResult& r, const Model& m);
 // Writes the fits as TOML to path (nothing when path is empty).
-void write_toml(const std::string& path, const std::vector<FitResult>& f, const std::vector<Model>& m);
+void write_toml(const std::string& path, const std::vector<FitResult>& f, const std::vector<Model>& m,
+                const std::vector<RefusedFit>& refused = {});
+// The exit code of a fit that was written: kExitPartial (with a line on
+// stderr naming them) when runs were left out or parameters are
+// undetermined (with what would determine them), else 0.
+int with_reservations(const std::string& what, const std::vector<std::string>& left_out, const FitResult& r);
 // Run folders from the arguments: a folder holding series.csv is a run, any
 // other folder a campaign whose subfolders are runs (report.hpp).
 std::vector<std::string> expand_runs(const std::vector<std::string>& args);

@@ -24,6 +24,7 @@ FitFile read_fit_toml(const std::string& path) {
   f.path = path;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(fmt::format("fit file '{}' does not exist", path));
+  refuse_folder(path);
   toml::value root;
   try {
     root = toml::parse(path);
@@ -38,6 +39,11 @@ FitFile read_fit_toml(const std::string& path) {
   std::sort(models.begin(), models.end());
   for (const auto& name : models) {
     const auto& m = root.at(name);
+    // A fit written as undetermined (fits_to_toml's refused fits) has no
+    // parameters: read as missing, so that comparing against it FAILs.
+    if (m.contains("determined") && m.at("determined").is_boolean() && !m.at("determined").as_boolean() &&
+        !m.contains("params"))
+      continue;
     FitRecord r;
     if (m.contains("converged") && m.at("converged").is_boolean()) r.converged = m.at("converged").as_boolean();
     if (!m.contains("params") || !m.at("params").is_table())

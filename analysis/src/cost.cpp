@@ -15,6 +15,7 @@ std::optional<RunCost> read_run_cost(const std::string& run_dir) {
   const std::string file = (fs::path(run_dir) / "summary.toml").string();
   std::error_code ec;
   if (!fs::exists(file, ec)) return std::nullopt;
+  refuse_folder(file);
   toml::value root;
   try {
     root = toml::parse(file);

@@ -3,7 +3,11 @@
 // message always names the file or quantity at fault; the command line prints
 // it and exits non-zero.
 #pragma once
+#include <fmt/core.h>
+
+#include <filesystem>
 #include <stdexcept>
+#include <string>
 
 namespace cda {
 
@@ -12,6 +16,12 @@ namespace cda {
 // honest answer: a degenerate fit, no steady window, a compare-fits FAIL);
 // 2 bad input (usage, unreadable or malformed file, non-finite value);
 // 3 a run diverged (cdsim).
+// 5 done with reservations: everything that could be was written, but some
+// runs were left out (no steady window, unreadable, other dimension) or
+// some fitted parameters are undetermined; each is named on stderr and in
+// the outputs. Scripts that only need "was anything produced" accept 0 and 5.
+inline constexpr int kExitPartial = 5;
+
 struct AnalysisError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -21,5 +31,18 @@ struct AnalysisError : std::runtime_error {
 struct InputError : AnalysisError {
   using AnalysisError::AnalysisError;
 };
+
+// A file the analysis reads is refused as what it is when a folder stands
+// at its path (a reader would see it as an empty or truncated file).
+inline void refuse_folder(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(fmt::format("'{}' is a folder, not a file", path));
+}
+
+// Text from a file or the command line, safe to print in a message: control
+// characters and bytes that are not UTF-8 shown as \xNN, and at most `max`
+// bytes (then "..."), so that binary junk never reaches the terminal.
+std::string printable(const std::string& s, std::size_t max = 4000);
 
 }  // namespace cda

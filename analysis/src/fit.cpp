@@ -27,6 +27,30 @@ double FitResult::operator[](const std::string& name) const {
     if (names[i] == name) return value[i];
   throw AnalysisError(fmt::format("fit '{}' has no parameter '{}'", model, name));
 }
+std::vector<std::string> undetermined_params(const FitResult& r) {
+  std::vector<std::string> u;
+  for (std::size_t i = 0; i < r.names.size(); ++i)
+    if (!(r.error[i] < std::abs(r.value[i]))) u.push_back(r.names[i]);
+  return u;
+}
+
+std::string what_would_determine(const std::string& model) {
+  const std::string common = "longer runs (STRAIN=) for smaller error bars, WINDOW= for runs without a detected "
+                             "steady window";
+  if (model == "mu_I")
+    return "runs on both sides of I0, up to I = 0.3-0.5 where mu(I) bends over (INERTIAL_I=), " + common;
+  if (model == "nu_I") return "runs over a wider range of I (INERTIAL_I=), " + common;
+  if (model == "void_ratio") return "runs at more pressures over a wider range (PRESSURE_P=), " + common;
+  if (model == "cohesion") return "eta > 0 runs at several eta and I (COHESIVE_ETA=, COHESIVE_I=), " + common;
+  if (model == "mu_alpha") return "more shapes (ANGULAR_NS=), " + common;
+  return "more runs, " + common;
+}
+
+std::string undetermined_flag(const FitResult& r, const std::string& name) {
+  const auto u = undetermined_params(r);
+  return std::find(u.begin(), u.end(), name) != u.end() ? " (undetermined)" : "";
+}
+
 double FitResult::err(const std::string& name) const {
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return error[i];

@@ -56,6 +56,15 @@ struct FitResult {
   double err(const std::string& name) const;
 };
 
+// The parameters the data do not determine: an error at least as large as
+// the value (a curve drawn through them says nothing of them), in order.
+std::vector<std::string> undetermined_params(const FitResult& r);
+// What would determine a fit of `model` (its name), for the messages that
+// flag an undetermined fit: which data are missing and how to get them.
+std::string what_would_determine(const std::string& model);
+// " (undetermined)" for such a parameter of r, else "": for legends and pages.
+std::string undetermined_flag(const FitResult& r, const std::string& name);
+
 // Fits `model` to `data` from the starting point p0. Throws AnalysisError if
 // there are fewer points than parameters, a sigma is not positive, or the
 // model is not finite at the start.

@@ -22,6 +22,17 @@ namespace fs = std::filesystem;
 namespace cda {
 namespace {
 
+// A TOML basic string's content: quotes and backslashes escaped.
+std::string toml_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') o += "\\n";
+    else o += c;
+  }
+  return o;
+}
+
 std::string html_escape(const std::string& s) {
   std::string o;
   for (char c : s) {
@@ -117,7 +128,8 @@ bool plot_cost_I(const std::string& dir, const std::vector<Point>& points) {
 
 }  // namespace
 
-std::string fits_to_toml(const std::vector<FitResult>& fits, const std::vector<Model>& models) {
+std::string fits_to_toml(const std::vector<FitResult>& fits, const std::vector<Model>& models,
+                         const std::vector<RefusedFit>& refused) {
   std::string s = "# Fit parameters written by cdanalysis. error = sqrt(error_scale * C_ii),\n"
                   "# C = (J^T W J)^-1; error_scale = max(1, chi2/dof) with error bars,\n"
                   "# chi2/dof without (see analysis/src/fit.hpp).\n";
@@ -137,36 +149,48 @@ std::string fits_to_toml(const std::vector<FitResult>& fits, const std::vector<M
       s += "]";
     }
     s += "]\n";
+    if (const auto u = undetermined_params(r); !u.empty()) {
+      s += "undetermined = [";
+      for (std::size_t i = 0; i < u.size(); ++i) s += fmt::format("{}\"{}\"", i ? ", " : "", u[i]);
+      s += "]\n";
+    }
     for (std::size_t i = 0; i < p; ++i)
       s += fmt::format("\n[{}.params.{}]\nvalue = {}\nerror = {}\n", r.model, r.names[i],
                        toml_num(r.value[i]), toml_num(r.error[i]));
   }
+  for (const auto& f : refused)
+    s += fmt::format("\n[{}]\nformula = \"{}\"\ndetermined = false\nreason = \"{}\"\n", f.model, f.formula,
+                     toml_escape(f.reason));
   return s;
 }
 
 bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
-               std::span<const double> mu_err, const FitResult& r, const std::string& ylabel) {
+               std::span<const double> mu_err, const FitResult* r, const std::string& ylabel) {
   const Model model = mu_of_I();
   std::filesystem::create_directories(dir);
   Table pts({"I", "mu", "mu_err"});
   for (std::size_t i = 0; i < I.size(); ++i) pts.add_row({I[i], mu[i], mu_err[i]});
   pts.write_csv((fs::path(dir) / "mu_I_data.csv").string());
+  const std::string head = fmt::format("set datafile separator ','\nset logscale x\nset xlabel 'I'\nset ylabel '{}'\n"
+                                       "set key top left\nset grid\n", ylabel);
+  if (!r)  // the fit was refused: the points alone, said so
+    return plot_both(dir, "mu_I", head + "plot 'mu_I_data.csv' every ::1 using 1:2:3 with yerrorbars pt 7 lc rgb "
+                                         "'black' title 'runs (μ(I) fit undetermined)'\n");
   Table curve({"I", "mu", "lo", "hi"});
   const double lo = *std::min_element(I.begin(), I.end()) / 2, hi = *std::max_element(I.begin(), I.end()) * 2;
   for (int k = 0; k <= 200; ++k) {
     const double x = lo * std::pow(hi / lo, k / 200.0);
-    const double m = predict(model, r, &x), e = predict_error(model, r, &x);
+    const double m = predict(model, *r, &x), e = predict_error(model, *r, &x);
     curve.add_row({x, m, m - e, m + e});
   }
   curve.write_csv((fs::path(dir) / "mu_I_fit.csv").string());
-  const std::string body = fmt::format(
-      "set datafile separator ','\nset logscale x\nset xlabel 'I'\nset ylabel '{}'\n"
-      "set key top left\nset grid\n"
+  const std::string body = head + fmt::format(
       "plot 'mu_I_fit.csv' every ::1 using 1:3:4 with filledcurves fc rgb '#cce5ff' title '1σ band', \\\n"
       "     'mu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' "
-      "title 'μ_1 = {:.3f}, μ_2 = {:.3f}, I_0 = {:.3g}', \\\n"
+      "title 'μ_1 = {:.3f}{}, μ_2 = {:.3f}{}, I_0 = {:.3g}{}', \\\n"
       "     'mu_I_data.csv' every ::1 using 1:2:3 with yerrorbars pt 7 lc rgb 'black' title 'runs'\n",
-      ylabel, r["mu1"], r["mu2"], r["I0"]);
+      (*r)["mu1"], undetermined_flag(*r, "mu1"), (*r)["mu2"], undetermined_flag(*r, "mu2"), (*r)["I0"],
+      undetermined_flag(*r, "I0"));
   return plot_both(dir, "mu_I", body);
 }
 
@@ -359,6 +383,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
                                        ? " — <b>banded</b>: a layer moves nearly as a rigid plug; this run's I is "
                                          "not the local one (cdanalysis profile)"
                                        : "");
+          if (is_banded(rate_min.v)) status = "banded";
           if (is_banded(rate_min.v))
             sum.problems.push_back(fmt::format("{}: banded shear (rate_min {:.2f} < {}; cdanalysis profile)", run,
                                                rate_min.v, kBandedRateMin));
@@ -459,6 +484,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     for (const double v : cost) runs_csv += "," + or_na(v, "{}");  // shortest exact text
     runs_csv += "," + (pt.cost ? fmt::format("{}", pt.cost->threads) : std::string("n/a")) + "\n";
     pt.status = status;
+    if (status == "skipped" || status == "not steady" || status == "unreadable") ++sum.left_out;
     points.push_back(pt);
   }
   write_text((fs::path(out_dir) / "runs.csv").string(), runs_csv);
@@ -467,6 +493,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
 
   std::vector<FitResult> fits;
   std::vector<Model> models;
+  std::vector<RefusedFit> refused;
   std::string html_fit;
   const std::string report_cmd = fmt::format("cdanalysis report {} --out {}", campaign, out_dir);
 
@@ -520,43 +547,83 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       }
     }
     const std::string sel = by_eta || by_shape ? " (runs with cohesion_number 0 and the first run's shape)" : "";
+    // Never a dead end: a fit the data do not determine is written (fits.toml:
+    // determined = false and the reason, or the undetermined parameters) and
+    // drawn (the points alone, or the curve with the parameters flagged), with
+    // what would determine it.
+    const auto undetermined_html = [&](const std::string& model, const std::string& why) {
+      sum.undetermined.push_back(fmt::format("{}: {}", model, why));
+      return fmt::format("<p><b>Undetermined</b>: {}. What would determine it: {}.</p>\n", html_escape(why),
+                         html_escape(what_would_determine(model)));
+    };
+    const auto flagged = [&](const FitResult& r, const std::string& model) {
+      const auto u = undetermined_params(r);
+      if (u.empty()) return std::string();
+      return undetermined_html(model, fmt::format("{} not determined by the data (error not below the value)",
+                                                  fmt::join(u, ", ")));
+    };
     if (I.size() >= 4) {
+      std::optional<FitResult> r;
+      std::string why;
       try {
-        const auto r = fit_mu_I(I, mu, mu_err);
-        fits.push_back(r);
+        r = fit_mu_I(I, mu, mu_err);
+        fits.push_back(*r);
         models.push_back(mu_of_I());
-        sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r, dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") && sum.plots_ok;
         sum.fits.push_back("mu_I");
-        html_fit += fmt::format("<h3>μ(I){}</h3><img src='mu_I.png' width=600><p>{}: μ1 = {:.4f} ± {:.2g}, "
-                                "μ2 = {:.4f} ± {:.2g}, I0 = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",
-                                sel, html_escape(mu_of_I().formula), r["mu1"], r.err("mu1"), r["mu2"],
-                                r.err("mu2"), r["I0"], r.err("I0"), r.chi2_dof) +
-                    made_by(report_cmd, fmt::format("cdanalysis fit mu-i {} --out DIR", campaign));
       } catch (const AnalysisError& e) {
-        sum.problems.push_back(fmt::format("mu(I) fit: {}", e.what()));
+        why = e.what();
+        refused.push_back({"mu_I", mu_of_I().formula, why});
+        sum.problems.push_back(fmt::format("mu(I) fit: {}", why));
       }
+      sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r ? &*r : nullptr, dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") &&
+                     sum.plots_ok;
+      if (r)
+        html_fit += fmt::format("<h3>μ(I){}</h3><img src='mu_I.png' width=600><p>{}: μ1 = {:.4f} ± {:.2g}{}, "
+                                "μ2 = {:.4f} ± {:.2g}{}, I0 = {:.4g} ± {:.2g}{}, χ²/dof = {:.2f}</p>\n",
+                                sel, html_escape(mu_of_I().formula), (*r)["mu1"], r->err("mu1"),
+                                undetermined_flag(*r, "mu1"), (*r)["mu2"], r->err("mu2"), undetermined_flag(*r, "mu2"),
+                                (*r)["I0"], r->err("I0"), undetermined_flag(*r, "I0"), r->chi2_dof) +
+                    flagged(*r, "mu_I");
+      else
+        html_fit += fmt::format("<h3>μ(I){}</h3><img src='mu_I.png' width=600><p>{}: fit refused.</p>\n", sel,
+                                html_escape(mu_of_I().formula)) +
+                    undetermined_html("mu_I", why);
+      html_fit += made_by(report_cmd, fmt::format("cdanalysis fit mu-i {} --out DIR", campaign));
     } else {
-      html_fit += fmt::format("<p>μ(I) fit skipped: {} steady runs with q_over_p and inertial_number{} "
-                              "(4 needed)</p>\n", I.size(), sel);
+      html_fit += fmt::format("<p>μ(I) fit skipped: {} steady runs with {} and inertial_number{} "
+                              "(4 needed)</p>\n", I.size(), mu_col, sel);
+      if (!I.empty()) html_fit += undetermined_html("mu_I", fmt::format("{} steady runs, 4 needed", I.size()));
     }
     if (sp.size() >= 3) {
+      std::optional<FitResult> r;
+      std::string why;
       try {
-        const auto r = fit_nu_I_points(sp);
-        fits.push_back(r);
+        r = fit_nu_I_points(sp);
+        fits.push_back(*r);
         models.push_back(nu_of_I());
-        sum.plots_ok = plot_nu_I(out_dir, sp, r, report_cmd) && sum.plots_ok;
+        sum.plots_ok = plot_nu_I(out_dir, sp, *r, report_cmd) && sum.plots_ok;
         sum.fits.push_back("nu_I");
-        html_fit += fmt::format("<h3>ν(I){}</h3><img src='nu_I.png' width=600><p>{}: ν_max = {:.4f} ± {:.2g}, "
-                                "a = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",
-                                sel, html_escape(nu_of_I().formula), r["nu_max"], r.err("nu_max"), r["a"],
-                                r.err("a"), r.chi2_dof) +
-                    made_by(report_cmd, fmt::format("cdanalysis fit nu-i {} --out DIR", campaign));
       } catch (const AnalysisError& e) {
-        sum.problems.push_back(fmt::format("nu(I) fit: {}", e.what()));
+        why = e.what();
+        refused.push_back({"nu_I", nu_of_I().formula, why});
+        sum.problems.push_back(fmt::format("nu(I) fit: {}", why));
       }
+      if (r)
+        html_fit += fmt::format("<h3>ν(I){}</h3><img src='nu_I.png' width=600><p>{}: ν_max = {:.4f} ± {:.2g}{}, "
+                                "a = {:.4g} ± {:.2g}{}, χ²/dof = {:.2f}</p>\n",
+                                sel, html_escape(nu_of_I().formula), (*r)["nu_max"], r->err("nu_max"),
+                                undetermined_flag(*r, "nu_max"), (*r)["a"], r->err("a"), undetermined_flag(*r, "a"),
+                                r->chi2_dof) +
+                    flagged(*r, "nu_I");
+      else
+        html_fit += fmt::format("<h3>ν(I){}</h3><p>{}: fit refused.</p>\n", sel, html_escape(nu_of_I().formula)) +
+                    undetermined_html("nu_I", why);
+      html_fit += made_by(report_cmd, fmt::format("cdanalysis fit nu-i {} --out DIR", campaign));
     } else {
       html_fit += fmt::format("<p>ν(I) fit skipped: {} steady runs with packing_fraction{} (3 needed)</p>\n",
                               sp.size(), sel);
+      if (!sp.empty())
+        html_fit += undetermined_html("nu_I", fmt::format("{} steady runs with packing_fraction, 3 needed", sp.size()));
     }
   }
 
@@ -683,7 +750,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       html_fit += made_by(report_cmd, fit_cmd);
     }
   }
-  write_text((fs::path(out_dir) / "fits.toml").string(), fits_to_toml(fits, models));
+  write_text((fs::path(out_dir) / "fits.toml").string(), fits_to_toml(fits, models, refused));
 
   // Cost against I, for a campaign over I (measured I spanning a factor 1.5 or more).
   std::string html_cost;

@@ -14,16 +14,27 @@ namespace cda {
 // Fit results as TOML: one table per fit,
 //   [mu_I]  formula, chi2, dof, chi2_dof, error_scale, converged
 //   [mu_I.params.mu1]  value, error
-// plus the covariance as an array of rows.
-std::string fits_to_toml(const std::vector<FitResult>& fits, const std::vector<Model>& models);
+// plus the covariance as an array of rows, and `undetermined` listing the
+// parameters whose error is not below their value (undetermined_params).
+// A fit the data did not determine at all (refused: a singular Jacobian,
+// too few points) is written as its own table without params:
+//   [mu_I]  formula, determined = false, reason
+// which compare-fits reads as the model missing.
+struct RefusedFit {
+  std::string model, formula, reason;
+};
+std::string fits_to_toml(const std::vector<FitResult>& fits, const std::vector<Model>& models,
+                         const std::vector<RefusedFit>& refused = {});
 
 // Polar diagrams of P(theta), <fn>(theta), <ft>(theta) with their Fourier
 // (second-harmonic) fits; 3 plots named <stem>_P, <stem>_fn, <stem>_ft.
 bool plot_polar(const std::string& dir, const std::string& stem, const RunFabric& f);
-// mu(I) points with error bars, the fit and its 1-sigma band: dir/mu_I.{png,svg}
+// mu(I) points with error bars, the fit and its 1-sigma band (r null: the
+// fit was refused, points alone), undetermined parameters flagged in the
+// legend: dir/mu_I.{png,svg}
 // (with mu_I_data.csv, mu_I_fit.csv). ylabel: what mu is (2D q/p, 3D -sxy/syy).
 bool plot_mu_I(const std::string& dir, std::span<const double> I, std::span<const double> mu,
-               std::span<const double> mu_err, const FitResult& r, const std::string& ylabel = "μ* = q/p");
+               std::span<const double> mu_err, const FitResult* r, const std::string& ylabel = "μ* = q/p");
 
 // Runs of a campaign folder: its subfolders holding series.csv, sorted; the
 // folder itself if it holds series.csv. Throws AnalysisError naming the
@@ -32,6 +43,12 @@ std::vector<std::string> campaign_runs(const std::string& campaign);
 
 struct ReportSummary {
   std::size_t runs = 0, steady = 0, fabric = 0;
+  // Runs left out of every table and fit (not steady, unreadable, of the
+  // other dimension): each named in problems and on the page.
+  std::size_t left_out = 0;
+  // Fits written as undetermined (refused, or a parameter whose error
+  // exceeds its value), with the reason: "mu_I: ...".
+  std::vector<std::string> undetermined;
   // Cost: runs with a summary.toml, and their wall and CPU time summed (s).
   std::size_t costed = 0;
   double wall_time = 0, cpu_time = 0;

@@ -26,7 +26,35 @@ Table read_series(const std::string& run_dir) {
   const std::string path = (fs::path(run_dir) / "series.csv").string();
   if (!fs::exists(path, ec))
     throw InputError(fmt::format("run folder '{}' has no series.csv", run_dir));
-  return Table::read_csv(path);
+  Table t = Table::read_csv(path);
+  // cdsim writes whole rows, one per output step, forward in time: a file
+  // that ends mid-row was cut (a run killed while writing, a full disk), and
+  // a step written twice or a time going backwards means rows of two runs or
+  // two sessions mixed; any of them would bias every window average.
+  {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    char last = '\n';
+    if (in && in.tellg() > 0) {
+      in.seekg(-1, std::ios::end);
+      in.get(last);
+    }
+    if (last != '\n')
+      throw InputError(fmt::format("'{}' line {}: the last row is cut (no end of line after it): the file "
+                                   "ends mid-row",
+                                   path, t.line(t.rows() - 1)));
+  }
+  for (const char* c : {"step", "time"}) {
+    if (!t.has(c)) continue;
+    const auto& v = t.column(c);
+    for (std::size_t i = 1; i < v.size(); ++i)
+      if (!(v[i] > v[i - 1]))
+        throw InputError(fmt::format("'{}' line {}: {} {} {} the previous row's {} (line {}): the rows must "
+                                     "go forward, one per output step",
+                                     path, t.line(i), c, fmt::format("{}", v[i]),
+                                     v[i] == v[i - 1] ? "repeats" : "is before", fmt::format("{}", v[i - 1]),
+                                     t.line(i - 1)));
+  }
+  return t;
 }
 
 std::string default_x_column(const Table& series) {
@@ -386,7 +414,7 @@ WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, co
 
 std::pair<double, double> parse_range(const std::string& s) {
   const auto colon = s.find(':');
-  auto bad = [&] { return AnalysisError(fmt::format("window '{}' is not of the form a:b with a < b", s)); };
+  auto bad = [&] { return InputError(fmt::format("window '{}' is not of the form a:b with a < b", printable(s, 80))); };
   if (colon == std::string::npos) throw bad();
   const std::string a = s.substr(0, colon), b = s.substr(colon + 1);
   char *ea = nullptr, *eb = nullptr;
@@ -401,13 +429,14 @@ std::pair<double, double> resolve_window(const std::string& spec, std::span<cons
   const bool pb = !spec.empty() && spec.back() == '%';
   if (!pa && !pb) return parse_range(spec);
   auto bad = [&] {
-    return AnalysisError(fmt::format("window '{}' is not of the form a:b, or a%:b% with 0 <= a < b <= 100", spec));
+    return InputError(fmt::format("window '{}' is not of the form a:b, or a%:b% with 0 <= a < b <= 100",
+                                  printable(spec, 80)));
   };
   if (!pa || !pb) throw bad();
   std::pair<double, double> f;
   try {  // the numbers as parse_range reads them, the % signs removed
     f = parse_range(spec.substr(0, colon - 1) + spec.substr(colon, spec.size() - colon - 1));
-  } catch (const AnalysisError&) {
+  } catch (const InputError&) {
     throw bad();
   }
   if (!(f.first >= 0 && f.second <= 100)) throw bad();

@@ -35,6 +35,7 @@ SceneInfo read_scene_info(const std::string& run_dir) {
   std::error_code ec;
   if (!fs::exists(s.file, ec))
     throw InputError(fmt::format("run folder '{}' has no scene.toml", run_dir));
+  refuse_folder(s.file);
   toml::value root;
   try {
     root = toml::parse(s.file);

@@ -91,6 +91,7 @@ void capture_message(void* user, const vtkLogger::Message& m) {
 
 vtkSmartPointer<vtkPolyData> read_polydata(const std::string& path) {
   std::error_code ec;
+  refuse_folder(path);
   if (!fs::is_regular_file(path, ec))
     throw InputError(fmt::format("snapshot '{}' does not exist", path));
   vtkNew<vtkXMLPolyDataReader> reader;

@@ -32,7 +32,31 @@ std::vector<std::string> split(const std::string& line) {
 
 Table::Table(std::vector<std::string> names) : names_(std::move(names)), cols_(names_.size()) {}
 
+std::string printable(const std::string& s, std::size_t max) {
+  std::string o;
+  const auto* b = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  for (std::size_t i = 0; i < n;) {
+    if (o.size() >= max) return o + "...";
+    const unsigned char c = b[i];
+    // Length of the UTF-8 sequence starting here (0: not a valid lead byte).
+    const std::size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    bool ok = len > 0 && i + len <= n;
+    for (std::size_t k = 1; ok && k < len; ++k) ok = (b[i + k] & 0xC0) == 0x80;
+    if (ok && len == 1 && (c < 0x20 || c == 0x7F) && c != '\n' && c != '\t') ok = false;
+    if (!ok) {
+      o += fmt::format("\\x{:02X}", c);
+      ++i;
+      continue;
+    }
+    o.append(s, i, len);
+    i += len;
+  }
+  return o;
+}
+
 Table Table::read_csv(const std::string& path, bool allow_nan) {
+  refuse_folder(path);
   std::ifstream in(path);
   if (!in) throw InputError(fmt::format("cannot open '{}'", path));
   Table t;
@@ -62,12 +86,13 @@ Table Table::read_csv(const std::string& path, bool allow_nan) {
       const double v = std::strtod(s, &end);
       if (fields[j].empty() || *end != '\0')
         throw InputError(fmt::format("'{}' line {}, column '{}': '{}' is not a number", path,
-                                        lineno, t.names_[j], fields[j]));
+                                        lineno, t.names_[j], printable(fields[j], 40)));
       if (!std::isfinite(v) && !(allow_nan && std::isnan(v)))
         throw InputError(fmt::format("'{}' line {}, column '{}': '{}' is not a finite number", path,
-                                     lineno, t.names_[j], fields[j]));
+                                     lineno, t.names_[j], printable(fields[j], 40)));
       t.cols_[j].push_back(v);
     }
+    t.lines_.push_back(lineno);
   }
   if (t.rows() == 0) throw InputError(fmt::format("'{}' has a header but no data rows", path));
   return t;

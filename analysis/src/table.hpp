@@ -29,6 +29,8 @@ class Table {
   const std::vector<std::string>& names() const { return names_; }
   std::size_t rows() const { return cols_.empty() ? 0 : cols_.front().size(); }
   const std::string& source() const { return source_; }
+  // The file's line number of a row read by read_csv (0 for rows added in memory).
+  std::size_t line(std::size_t row) const { return row < lines_.size() ? lines_[row] : 0; }
 
   void add_row(const std::vector<double>& values);
   // A row given by column name: every column of the table exactly once
@@ -44,6 +46,7 @@ class Table {
   std::vector<std::string> names_;
   std::vector<std::vector<double>> cols_;
   std::string source_ = "<memory>";
+  std::vector<std::size_t> lines_;
 };
 
 }  // namespace cda

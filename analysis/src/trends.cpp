@@ -107,7 +107,7 @@ AngularityPoint angularity_point(const std::string& run_dir, const AngularityOpt
   a.nsides = *ns;
   a.alpha = angularity_of(a.nsides);
 
-  const auto s = steady_run(run_dir);
+  const auto s = steady_run(run_dir, opt.window);
   if (!s.series.has("q_over_p"))
     throw AnalysisError(fmt::format("run '{}' has no q_over_p column: not a shear run", run_dir));
   a.mu = of(s.main);
@@ -361,10 +361,10 @@ bool plot_nu_I(const std::string& dir, const std::vector<StatePoint>& pts, const
       "# made by: {}\nset datafile separator ','\nset grid\nset xlabel 'I (measured)'\nset ylabel 'ν'\n"
       "set key top right\n"
       "plot 'nu_I_fit.csv' every ::1 using 1:3:4 with filledcurves fc rgb '#cce5ff' title '1σ band', \\\n"
-      "     'nu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' title 'ν_{{max}} = {:.4f}, "
-      "b = {:.3g}', \\\n"
+      "     'nu_I_fit.csv' every ::1 using 1:2 with lines lw 2 lc rgb '#1f3b73' title 'ν_{{max}} = {:.4f}{}, "
+      "a = {:.3g}{}', \\\n"
       "     'nu_I_data.csv' every ::1 using 1:3:2:4 with xyerrorbars pt 7 lc rgb 'black' title 'runs'\n",
-      command, r["nu_max"], r["a"]);
+      command, r["nu_max"], undetermined_flag(r, "nu_max"), r["a"], undetermined_flag(r, "a"));
   return plot_both(dir, "nu_I", body);
 }
 

@@ -56,6 +56,7 @@ Val mean_sem(const std::vector<double>& x);
 struct AngularityOptions {
   int snapshots = 5;  // last K contact snapshots for the fabric
   int bins = 36;
+  std::string window;  // as fit mu-i's --window (run.hpp resolve_window); "": detected
 };
 
 struct AngularityPoint {

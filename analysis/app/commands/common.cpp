@@ -1,7 +1,13 @@
 // What several commands share: printing a fit, writing fit TOML, expanding
 // campaign folders into runs.
 #include <fmt/core.h>
+#include <fmt/format.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
 #include "analysis/app/command.hpp"
@@ -20,6 +26,80 @@ void set_command_line(int argc, char** argv) {
 
 const std::string& command_line() { return g_command_line; }
 
+namespace {
+
+// The option's text as a finite double, or the reason it is not one.
+std::string read_finite(const std::string& text, double& v) {
+  char* end = nullptr;
+  errno = 0;
+  v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') return fmt::format("'{}' is not a number", printable(text, 40));
+  if (!std::isfinite(v) || errno == ERANGE && std::abs(v) > 1)
+    return fmt::format("'{}' is not a finite number", printable(text, 40));
+  return {};
+}
+
+CLI::Validator number_check(const char* name, bool (*ok)(double), const char* rule) {
+  return CLI::Validator(
+      [ok, rule](std::string& text) -> std::string {
+        double v = 0;
+        if (auto why = read_finite(text, v); !why.empty()) return why;
+        if (!ok(v)) return fmt::format("'{}' is not {}", printable(text, 40), rule);
+        return {};
+      },
+      name);
+}
+
+}  // namespace
+
+CLI::Validator finite_number() {
+  return number_check("FINITE", [](double) { return true; }, "finite");
+}
+CLI::Validator positive_number() {
+  return number_check("POSITIVE", [](double v) { return v > 0; }, "> 0");
+}
+CLI::Validator non_negative_number() {
+  return number_check("NONNEGATIVE", [](double v) { return v >= 0; }, ">= 0");
+}
+
+CLI::Validator writable_file() {
+  return CLI::Validator(
+      [](std::string& path) -> std::string {
+        namespace fs = std::filesystem;
+        std::error_code ec;
+        if (fs::is_directory(path, ec)) return fmt::format("'{}' is a folder, not a file", printable(path, 200));
+        fs::path dir = fs::path(path).parent_path();
+        if (dir.empty()) dir = ".";
+        if (!fs::is_directory(dir, ec))
+          return fmt::format("cannot write '{}': folder '{}' does not exist", printable(path, 200),
+                             printable(dir.string(), 200));
+        if (::access(dir.c_str(), W_OK) != 0)
+          return fmt::format("cannot write '{}': folder '{}' is not writable", printable(path, 200),
+                             printable(dir.string(), 200));
+        return {};
+      },
+      "FILE");
+}
+
+CLI::Validator window_spec() {
+  return CLI::Validator(
+      [](std::string& spec) -> std::string {
+        try {
+          resolve_window(spec, std::vector<double>{0, 1});
+        } catch (const AnalysisError& e) {
+          return e.what();
+        }
+        return {};
+      },
+      "a:b|a%:b%");
+}
+
+void require_finite_numbers(CLI::App& app) {
+  for (CLI::Option* o : app.get_options())
+    if (o->get_type_name() == "FLOAT") o->check(finite_number());
+  for (CLI::App* sub : app.get_subcommands({})) require_finite_numbers(*sub);
+}
+
 void print_fit(const FitResult& r, const Model& m) {
   fmt::print("{}  ({})\n", r.model, m.formula);
   for (std::size_t i = 0; i < r.names.size(); ++i)
@@ -28,12 +108,26 @@ void print_fit(const FitResult& r, const Model& m) {
              r.converged ? "converged" : "NOT converged: ", r.message);
 }
 
-void write_toml(const std::string& path, const std::vector<FitResult>& f, const std::vector<Model>& m) {
+void write_toml(const std::string& path, const std::vector<FitResult>& f, const std::vector<Model>& m,
+                const std::vector<RefusedFit>& refused) {
   if (path.empty()) return;
   std::ofstream out(path);
-  if (!out) throw AnalysisError(fmt::format("cannot write '{}'", path));
-  out << fits_to_toml(f, m);
+  if (!out) throw InputError(fmt::format("cannot write '{}'", path));
+  out << fits_to_toml(f, m, refused);
   fmt::print("wrote {}\n", path);
+}
+
+int with_reservations(const std::string& what, const std::vector<std::string>& left_out, const FitResult& r) {
+  const auto u = undetermined_params(r);
+  if (left_out.empty() && u.empty()) return 0;
+  std::string msg;
+  if (!left_out.empty()) msg = fmt::format("{} run{} left out (above)", left_out.size(), left_out.size() == 1 ? "" : "s");
+  if (!u.empty())
+    msg += fmt::format("{}undetermined: {} (error not below the value); what would determine {}: {}",
+                       msg.empty() ? "" : "; ", fmt::join(u, ", "), u.size() == 1 ? "it" : "them",
+                       what_would_determine(r.model));
+  fmt::print(stderr, "cdanalysis {}: written with reservations (exit {}): {}\n", what, kExitPartial, msg);
+  return kExitPartial;
 }
 
 std::vector<std::string> expand_runs(const std::vector<std::string>& args) {

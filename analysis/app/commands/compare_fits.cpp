@@ -18,9 +18,9 @@ Handler compare_fits(CLI::App& sub) {
   sub.add_option("reference", o->ref_toml, "reference fit TOML")->required();
   sub.add_option("new", o->new_toml, "new fit TOML")->required();
   sub.add_option("--tol-sigma", o->tol_sigma, "combined standard uncertainties allowed")
-      ->check(CLI::NonNegativeNumber)->capture_default_str();
+      ->check(non_negative_number())->capture_default_str();
   sub.add_option("--tol-rel", o->tol_rel, "relative change allowed (0: the sigma test alone)")
-      ->check(CLI::NonNegativeNumber)->capture_default_str();
+      ->check(non_negative_number())->capture_default_str();
   return [o] {
     const auto a = read_fit_toml(o->ref_toml);
     const auto b = read_fit_toml(o->new_toml);

@@ -105,7 +105,7 @@ Handler fabric(CLI::App& sub) {
       ->check(CLI::Range(4, 36000))
       ->capture_default_str();
   sub.add_option("--volume", o->volume, "volume (area) V for the stress, > 0; default: stress times V")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   sub.add_option("--out", o->out, "folder for the angular profiles and polar plots");
   return [o] {
     if (run_dimension(o->run) == 3) fabric3(*o);

@@ -14,6 +14,7 @@ Handler fit_angularity(CLI::App& sub) {
   struct Opt {
     std::vector<std::string> runs;
     std::string toml_out, out;
+    std::string window;
     int snapshots = 5, bins = 36;
   };
   auto o = std::make_shared<Opt>();
@@ -22,13 +23,19 @@ Handler fit_angularity(CLI::App& sub) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   sub.add_option("--bins", o->bins, "angular bins over [0, pi)")->check(CLI::Range(4, 36000))->capture_default_str();
+  sub.add_option("--window", o->window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
+                                        "run's span of it (default: detected per run)")
+      ->check(window_spec());
   sub.add_option("--out", o->out, "folder for angularity.csv, the fit curve and the plots (png, svg)");
-  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file");
+  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file")
+      ->check(writable_file());
   return [o] {
     AngularityOptions opt;
     opt.snapshots = o->snapshots;
     opt.bins = o->bins;
+    opt.window = o->window;
     std::vector<AngularityPoint> pts;
+    std::vector<std::string> left_out;
     const auto all = expand_runs(o->runs);
     for (const auto& r : all) {
       try {
@@ -36,6 +43,7 @@ Handler fit_angularity(CLI::App& sub) {
       } catch (const AnalysisError& e) {
         if (all.size() == 1) throw;
         fmt::print("{}: skipped: {}\n", r, e.what());
+        left_out.push_back(r);
       }
     }
     if (pts.empty()) throw AnalysisError("fit angularity: no usable run (each was skipped, see above)");
@@ -77,7 +85,7 @@ Handler fit_angularity(CLI::App& sub) {
       fmt::print("wrote {}/angularity.csv and the angularity_*.png/svg plots\n", o->out);
       if (!r) return 1;
     }
-    return 0;
+    return with_reservations("fit angularity", left_out, *r);
   };
 }
 

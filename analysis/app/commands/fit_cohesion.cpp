@@ -36,14 +36,22 @@ void from_table(const Opt& o) {
   write_toml(o.toml_out, {r}, {cohesion()});
 }
 
-void from_runs(const Opt& o) {
+int from_runs(const Opt& o) {
   if (o.runs.empty()) throw AnalysisError("fit cohesion: give run folders or --table");
   std::vector<SteadyPoint> ref_pts, coh_pts;
   const auto all = expand_runs(o.runs);
   const int dim = common_dimension(all, "fit cohesion");
+  std::vector<std::string> left_out;
   for (const auto& r : all) {
-    const auto p = steady_point(r, o.window);
-    (p.eta == 0 ? ref_pts : coh_pts).push_back(p);
+    // A run without a steady window is left out with the reason; a single run is refused.
+    try {
+      const auto p = steady_point(r, o.window);
+      (p.eta == 0 ? ref_pts : coh_pts).push_back(p);
+    } catch (const AnalysisError& e) {
+      if (all.size() == 1) throw;
+      fmt::print("{}: left out: {}\n", r, e.what());
+      left_out.push_back(r);
+    }
   }
   if (coh_pts.empty()) throw AnalysisError("fit cohesion: no run with eta > 0 among the given runs");
   const auto mode = o.reference == "mu-i"     ? SinPhiReference::Mode::MuI
@@ -100,6 +108,7 @@ void from_runs(const Opt& o) {
   write_toml(o.toml_out, fits, models);
   if (!o.out.empty() && !plot_cohesion(o.out, pts, &r))
     fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", o.out);
+  return with_reservations("fit cohesion", left_out, r);
 }
 
 }  // namespace
@@ -115,16 +124,20 @@ Handler fit_cohesion(CLI::App& sub) {
       ->check(CLI::IsMember({"auto", "mu-i", "interp"}))
       ->capture_default_str();
   sub.add_option("--out", o->out, "folder for c/p data, model curves and the plot (png, svg)");
-  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file");
+  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file")
+      ->check(writable_file());
   sub.add_option("--window", o->window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
-                                        "run's span of it (default: detected per run)");
+                                        "run's span of it (default: detected per run)")
+      ->check(window_spec());
   sub.add_flag("--exclude-banded", o->exclude_banded,
                "leave the cohesive runs whose shear is banded (profile's rate_min below 0.5: not a homogeneous "
                "flow at the run's I) out of the model fit; they stay in the data and the plot (open circles)");
   return [o] {
-    if (!o->table.empty()) from_table(*o);
-    else from_runs(*o);
-    return 0;
+    if (!o->table.empty()) {
+      from_table(*o);
+      return 0;
+    }
+    return from_runs(*o);
   };
 }
 

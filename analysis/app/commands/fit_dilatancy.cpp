@@ -24,14 +24,17 @@ Handler fit_dilatancy(CLI::App& sub) {
                  "blocks of ceil(4 tau) rows averaged into one point (consecutive in strain)")
       ->check(CLI::Range(2, 1000000))
       ->capture_default_str();
-  sub.add_option("--strain", o->strain_range, "use the rows with a <= strain <= b only (a:b; default all)");
+  sub.add_option("--strain,--window", o->strain_range,
+                 "use the rows with a <= strain <= b only (a:b; default all: this fit uses the transient too)");
   sub.add_option("--out", o->out, "folder for the binned points, the fit curve and the plot (png, svg)");
-  sub.add_option("--toml", o->toml_out, "write the fit parameters (fixed and free slope) to this TOML file");
+  sub.add_option("--toml", o->toml_out, "write the fit parameters (fixed and free slope) to this TOML file")
+      ->check(writable_file());
   return [o] {
     DilatancyOptions opt;
     opt.blocks_per_bin = o->blocks_per_bin;
     if (!o->strain_range.empty()) opt.strain = parse_range(o->strain_range);
     std::vector<RunDilatancy> rd;
+    std::vector<std::string> left_out;
     const auto all = expand_runs(o->runs);
     for (const auto& r : all) {
       // A run too short for its bins is skipped with the reason (the
@@ -42,6 +45,7 @@ Handler fit_dilatancy(CLI::App& sub) {
       } catch (const AnalysisError& e) {
         if (all.size() == 1) throw;
         fmt::print("{}: skipped: {}\n", r, e.what());
+        left_out.push_back(r);
         continue;
       }
       const auto& d = rd.back();
@@ -61,7 +65,7 @@ Handler fit_dilatancy(CLI::App& sub) {
     write_toml(o->toml_out, {f.fixed, f.free}, {dilatancy(), dilatancy_free()});
     if (!o->out.empty() && !plot_dilatancy(o->out, f))
       fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", o->out);
-    return 0;
+    return with_reservations("fit dilatancy", left_out, f.fixed);
   };
 }
 

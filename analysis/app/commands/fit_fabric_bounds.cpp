@@ -18,7 +18,7 @@ Handler fit_fabric_bounds(CLI::App& sub) {
   auto o = std::make_shared<Opt>();
   sub.add_option("--table", o->table, "CSV with columns z, a_c (optionally z_err, a_c_err)")->required();
   sub.add_option("--k", o->k, "bound prefactor (1 from method.md's definition)")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->capture_default_str();
   return [o] {
     {  // a 3D fabric table (the report's, with a_n) is refused before its values are read

@@ -17,12 +17,15 @@ Handler fit_mu_i(CLI::App& sub) {
   sub.add_option("runs", o->runs, "run or campaign folders (each run: steady mean of q_over_p and "
                                   "inertial_number)");
   sub.add_option("--table", o->table, "CSV with columns I, mu and optionally mu_err, instead of runs");
-  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file");
+  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file")
+      ->check(writable_file());
   sub.add_option("--out", o->out, "folder for the plot mu_I.png/svg (points, fit, 1-sigma band)");
   sub.add_option("--window", o->window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
-                                        "run's span of it, e.g. 50%:100% the second half (default: detected per run)");
+                                        "run's span of it, e.g. 50%:100% the second half (default: detected per run)")
+      ->check(window_spec());
   return [o] {
     std::vector<double> I, mu, err;
+    std::vector<std::string> left_out;
     std::string mu_label = "μ* = q/p";
     if (!o->table.empty()) {
       const auto t = Table::read_csv(o->table);
@@ -38,10 +41,21 @@ Handler fit_mu_i(CLI::App& sub) {
         mu_label = "μ = −σ_xy/σ_yy";
       }
       for (const auto& r : all) {
-        const auto series = read_series(r);
-        const auto x = default_x_column(series);
-        const auto range = window_range(o->window, series.column(x));
-        const auto s = run_steady(r, series, mu_column(dim), x, range);
+        // A run without a steady window, or whose series is damaged, is left
+        // out with the reason (the others still make a fit); a single run is refused.
+        Table series;
+        std::string x;
+        RunSteady s;
+        try {
+          series = read_series(r);
+          x = default_x_column(series);
+          s = run_steady(r, series, mu_column(dim), x, window_range(o->window, series.column(x)));
+        } catch (const AnalysisError& e) {
+          if (all.size() == 1) throw;
+          fmt::print("{}: left out: {}\n", r, e.what());
+          left_out.push_back(r);
+          continue;
+        }
         const auto si = measured_inertial_number(series, x, s.stats.window);
         I.push_back(si.mean);
         mu.push_back(s.stats.mean);
@@ -54,17 +68,31 @@ Handler fit_mu_i(CLI::App& sub) {
                              "(cdanalysis profile)\n", r, rm.v);
       }
     }
-    const auto r = fit_mu_I(I, mu, err);
-    print_fit(r, mu_of_I());
-    write_toml(o->toml_out, {r}, {mu_of_I()});
+    // Refused (too few runs, a singular Jacobian): the points are still
+    // written and drawn, and the TOML says why, before exit 1.
+    std::optional<FitResult> r;
+    try {
+      r = cda::fit_mu_I(I, mu, err);
+    } catch (const AnalysisError& e) {
+      if (dynamic_cast<const InputError*>(&e)) throw;
+      write_toml(o->toml_out, {}, {}, {{"mu_I", mu_of_I().formula, e.what()}});
+      if (!o->out.empty() && !I.empty()) {
+        if (err.empty()) err.assign(I.size(), 0.0);
+        plot_mu_I(o->out, I, mu, err, nullptr, mu_label);
+        fmt::print("wrote the points (no fit) in {}/mu_I.png\n", o->out);
+      }
+      throw AnalysisError(fmt::format("{}; what would determine it: {}", e.what(), what_would_determine("mu_I")));
+    }
+    print_fit(*r, mu_of_I());
+    write_toml(o->toml_out, {*r}, {mu_of_I()});
     if (!o->out.empty()) {
       if (err.empty()) err.assign(I.size(), 0.0);
-      if (!plot_mu_I(o->out, I, mu, err, r, mu_label))
+      if (!plot_mu_I(o->out, I, mu, err, &*r, mu_label))
         fmt::print("cdanalysis: gnuplot did not run: {}/mu_I.gp written, no PNG\n", o->out);
       else
         fmt::print("wrote {}/mu_I.png and mu_I.svg\n", o->out);
     }
-    return 0;
+    return with_reservations("fit mu-i", left_out, *r);
   };
 }
 

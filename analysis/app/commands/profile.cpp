@@ -19,7 +19,8 @@ Handler profile(CLI::App& sub) {
   sub.add_option("--layers", o->layers, "layers across the gradient direction y")
       ->check(CLI::Range(2, 1000))
       ->capture_default_str();
-  sub.add_option("--window", o->window, "as steady's --window (default: the detected steady window of mu)");
+  sub.add_option("--window", o->window, "as steady's --window (default: the detected steady window of mu)")
+      ->check(window_spec());
   return [o] {
     const int layers = o->layers;
     const auto series = read_series(o->run);

@@ -37,6 +37,13 @@ Handler report(CLI::App& sub) {
                s.fits.empty() ? "none" : fmt::format("{}", fmt::join(s.fits, ", ")));
     for (const auto& p : s.problems) fmt::print(stderr, "problem: {}\n", p);
     fmt::print("open {}/index.html\n", dir);
+    if (s.left_out || !s.undetermined.empty()) {
+      fmt::print(stderr, "cdanalysis report: written with reservations (exit {}): {} of {} runs left out{}\n",
+                 kExitPartial, s.left_out, s.runs,
+                 s.undetermined.empty() ? std::string()
+                                        : fmt::format("; undetermined: {}", fmt::join(s.undetermined, "; ")));
+      return kExitPartial;
+    }
     return 0;
   };
 }

@@ -11,6 +11,7 @@ namespace cda::cli {
 
 int run_state_fit(const StateFitOptions& o, bool is_nu) {
   std::vector<StatePoint> pts;
+  std::vector<std::string> left_out;
   if (!o.table.empty()) {
     if (!o.runs.empty()) throw AnalysisError("fit: give run folders or --table, not both");
     const auto t = Table::read_csv(o.table);
@@ -35,7 +36,16 @@ int run_state_fit(const StateFitOptions& o, bool is_nu) {
     const auto all = expand_runs(o.runs);
     common_dimension(all, is_nu ? "fit nu-i" : "fit compaction");
     for (const auto& r : all) {
-      const auto s = state_point(r, is_nu ? o.window : std::string());
+      // A run without a steady window is left out with the reason; a single run is refused.
+      StatePoint s;
+      try {
+        s = state_point(r, o.window);
+      } catch (const AnalysisError& e) {
+        if (all.size() == 1) throw;
+        fmt::print("{}: left out: {}\n", r, e.what());
+        left_out.push_back(r);
+        continue;
+      }
       if (is_nu)
         fmt::print("{}: I = {:.4g} +- {:.2g}, nu = {:.5f} +- {:.5f}\n", r, s.I.v, s.I.err, s.nu.v, s.nu.err);
       else
@@ -51,6 +61,7 @@ int run_state_fit(const StateFitOptions& o, bool is_nu) {
   FitResult r;
   Model m = nu_of_I();
   double pref = o.p0;
+  try {
   if (is_nu) {
     if (all_err) {
       r = fit_nu_I_points(pts);
@@ -70,6 +81,12 @@ int run_state_fit(const StateFitOptions& o, bool is_nu) {
       r = fit_void_ratio(p, e, {}, pref);
     }
   }
+  } catch (const AnalysisError& e) {
+    // Refused: the TOML says why (the points are printed above), exit 1.
+    if (dynamic_cast<const InputError*>(&e)) throw;
+    write_toml(o.toml_out, {}, {}, {{m.name, m.formula, e.what()}});
+    throw AnalysisError(fmt::format("{}; what would determine it: {}", e.what(), what_would_determine(m.name)));
+  }
   print_fit(r, m);
   write_toml(o.toml_out, {r}, {m});
   if (!o.out.empty()) {
@@ -80,7 +97,7 @@ int run_state_fit(const StateFitOptions& o, bool is_nu) {
     if (!ok) fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", o.out);
     else fmt::print("wrote {}/{}.png and .svg\n", o.out, is_nu ? "nu_I" : "compaction");
   }
-  return 0;
+  return with_reservations(is_nu ? "fit nu-i" : "fit compaction", left_out, r);
 }
 
 }  // namespace cda::cli

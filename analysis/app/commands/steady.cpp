@@ -36,7 +36,8 @@ Handler steady(CLI::App& sub) {
   sub.add_option("--column", o->column, "column of series.csv (default: q_over_p; 3D runs: shear_stress_ratio)");
   sub.add_option("--x", o->xcol, "abscissa column (default: strain if present, else time)");
   sub.add_option("--window", o->window, "steady window a:b in the abscissa, or a%:b% of the run's span of it "
-                                        "(default: detected)");
+                                        "(default: detected)")
+      ->check(window_spec());
   sub.add_option("--out", o->out, "folder for the time-series plot (png, svg) and its data");
   return [o] {
     const auto series = read_series(o->run);
