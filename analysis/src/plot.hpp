@@ -26,8 +26,12 @@ bool run_gnuplot(const std::string& script_path);
 bool plot_both(const std::string& dir, const std::string& stem, const std::string& body,
                int width = 800, int height = 500);
 
-// Time series of `column` with its steady window shaded.
+// A series column's axis label: what it is, then its name ("q/p (q_over_p)").
+std::string column_label(const std::string& column);
+
+// Time series of `column`; with s, its steady window shaded and its steady
+// mean drawn across the window, the mean ± error in the key.
 bool plot_series(const std::string& dir, const std::string& stem, const Table& series,
-                 const std::string& x_column, const std::string& column, const Window* w);
+                 const std::string& x_column, const std::string& column, const SteadyStats* s);
 
 }  // namespace cda

@@ -111,18 +111,31 @@ std::string made_by(const std::string& report_cmd, const std::string& fit_cmd) {
 // Wall time and sweeps per step against the measured I (log-log), the
 // points of an inertial campaign: dir/cost_I.{png,svg}, data in cost_I.csv.
 bool plot_cost_I(const std::string& dir, const std::vector<Point>& points) {
-  Table t({"I", "wall_time", "sweeps_per_step", "cap_share", "steps"});
-  for (const Point& p : points)
-    if (p.cost && std::isfinite(p.I) && p.I > 0)
-      t.add_row({p.I, p.cost->wall_time, p.cost->sweeps_per_step, p.cost->cap_share, p.cost->steps});
+  // Every run with a cost: the runs left out of the fits (no steady window)
+  // are often the most expensive, and leaving them out would make the cost
+  // seem to fall steadily with I. Such a run is placed at its imposed I and
+  // drawn apart (open symbols).
+  Table t({"I", "wall_time", "sweeps_per_step", "cap_share", "steps", "steady"});
+  for (const Point& p : points) {
+    if (!p.cost) continue;
+    const bool measured = p.steady && std::isfinite(p.I) && p.I > 0;
+    const double I = measured ? p.I : p.I_imposed;
+    if (std::isfinite(I) && I > 0)
+      t.add_row({I, p.cost->wall_time, p.cost->sweeps_per_step, p.cost->cap_share, p.cost->steps, measured ? 1.0 : 0.0});
+  }
   t.write_csv((fs::path(dir) / "cost_I.csv").string());
   const std::string body =
       "set datafile separator ','\nset logscale x\nset logscale y\nset logscale y2\n"
-      "set xlabel 'I (measured)'\nset ylabel 'wall time (s)'\nset y2label 'NLGS sweeps per step'\n"
+      "set xlabel 'I (measured; not steady: imposed)'\nset ylabel 'wall time (s)'\nset y2label 'NLGS sweeps per step'\n"
       "set ytics nomirror\nset y2tics\nset key top right\nset grid\n"
-      "plot 'cost_I.csv' every ::1 using 1:2 with linespoints pt 7 lc rgb '#1f3b73' title 'wall time', \\\n"
-      "     'cost_I.csv' every ::1 using 1:3 axes x1y2 with linespoints pt 5 lc rgb '#b03a2e' "
-      "title 'sweeps per step'\n";
+      "plot 'cost_I.csv' every ::1 using 1:($6 > 0 ? $2 : 1/0) with linespoints pt 7 lc rgb '#1f3b73' "
+      "title 'wall time', \\\n"
+      "     'cost_I.csv' every ::1 using 1:($6 > 0 ? $3 : 1/0) axes x1y2 with linespoints pt 5 lc rgb '#b03a2e' "
+      "title 'sweeps per step', \\\n"
+      "     'cost_I.csv' every ::1 using 1:($6 > 0 ? 1/0 : $2) with points pt 6 ps 1.5 lc rgb '#1f3b73' "
+      "title 'wall time, not steady', \\\n"
+      "     'cost_I.csv' every ::1 using 1:($6 > 0 ? 1/0 : $3) axes x1y2 with points pt 4 ps 1.5 lc rgb '#b03a2e' "
+      "title 'sweeps per step, not steady'\n";
   return plot_both(dir, "cost_I", body);
 }
 
@@ -218,21 +231,25 @@ bool plot_polar(const std::string& dir, const std::string& stem, const RunFabric
   struct Q {
     const char* name;
     int col;
-    std::string label, offset;
+    std::string label, offset, unit;
   };
   // <ft> changes sign: it is drawn as <fn> + <ft>(theta) so the radius stays
   // positive (the circle r = <fn> is the zero line).
   const std::string off = toml_num(a.mean_fn);
-  for (const Q& q : {Q{"P", 2, fmt::format("P(θ), a_c = {:.3f}", a.c.a()), "0"},
-                     Q{"fn", 3, fmt::format("<f_n>(θ), a_{{fn}} = {:.3f}", a.fn.a()), "0"},
-                     Q{"ft", 4, fmt::format("<f_n> + <f_t>(θ), a_{{ft}} = {:.3f}", a.ft.a()), off}}) {
+  // The radius is the quantity itself: its unit on the radial axis (forces
+  // in N: cdsim's 2D forces, as the stress is in N/m).
+  for (const Q& q : {Q{"P", 2, fmt::format("P(θ), a_c = {:.3f}", a.c.a()), "0", "P(θ) (1/rad)"},
+                     Q{"fn", 3, fmt::format("<f_n>(θ), a_{{fn}} = {:.3f}", a.fn.a()), "0", "<f_n> (N)"},
+                     Q{"ft", 4, fmt::format("<f_n> + <f_t>(θ), a_{{ft}} = {:.3f}", a.ft.a()), off,
+                       "<f_n> + <f_t> (N)"}}) {
     const std::string body = fmt::format(
         "set datafile separator ','\nset polar\nset angles radians\nset size square\n"
-        "unset xtics\nunset ytics\nset border 0\nset grid polar pi/6\nset key bottom right\n"
+        "unset xtics\nunset ytics\nset border polar\nset grid polar pi/6\nset key bottom right\n"
+        "set rtics format '%g'\nset rlabel '{}'\n"
         "set title '{}'\n"
         "plot '{}_profile.csv' every ::1 using 1:(${}+{}) with points pt 7 ps 0.6 title 'binned', \\\n"
         "     '{}_fourier.csv' every ::1 using 1:(${}+{}) with lines lw 2 title 'Fourier fit'\n",
-        q.label, stem, q.col, q.offset, stem, q.col, q.offset);
+        q.unit, q.label, stem, q.col, q.offset, stem, q.col, q.offset);
     ok = plot_both(dir, stem + "_" + q.name, body, 600, 600) && ok;
   }
   return ok;
@@ -348,10 +365,12 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       const std::string main = series.has(mu_col) ? mu_col : "kinetic_energy";
       Window w{};
       bool have_window = false;
+      std::optional<SteadyStats> main_stats;
       try {
         const auto rs = run_steady(run, series, main, xc, std::nullopt);
         w = rs.stats.window;
         have_window = true;
+        main_stats = rs.stats;
         // The steady means by column name: the table's row and the point read
         // the same named values.
         std::map<std::string, double> row = {{"run", static_cast<double>(k)}};
@@ -404,7 +423,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         sum.problems.push_back(fmt::format("{}: {}", run, e.what()));
         html_runs += fmt::format("<p>not steady: {}</p>\n", html_escape(e.what()));
       }
-      sum.plots_ok = plot_series(out_dir, stem + "_series", series, xc, main, have_window ? &w : nullptr) && sum.plots_ok;
+      sum.plots_ok = plot_series(out_dir, stem + "_series", series, xc, main, main_stats ? &*main_stats : nullptr) && sum.plots_ok;
       html_runs += fmt::format("<img src='{}_series.png' width=600>\n", stem);
       if (dim == 3 && !list_snapshots(run, "contacts").empty()) {
         try {
@@ -592,7 +611,13 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     } else {
       html_fit += fmt::format("<p>μ(I) fit skipped: {} steady runs with {} and inertial_number{} "
                               "(4 needed)</p>\n", I.size(), mu_col, sel);
-      if (!I.empty()) html_fit += undetermined_html("mu_I", fmt::format("{} steady runs, 4 needed", I.size()));
+      if (!I.empty()) {
+        const std::string why = fmt::format("{} steady runs, 4 needed", I.size());
+        refused.push_back({"mu_I", mu_of_I().formula, why});
+        sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, nullptr, dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") &&
+                       sum.plots_ok;
+        html_fit += "<img src='mu_I.png' width=600>\n" + undetermined_html("mu_I", why);
+      }
     }
     if (sp.size() >= 3) {
       std::optional<FitResult> r;
@@ -757,13 +782,16 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   {
     double lo = INFINITY, hi = 0;
     std::size_t n = 0;
-    for (const Point& p : points)
-      if (p.cost && std::isfinite(p.I) && p.I > 0) ++n, lo = std::min(lo, p.I), hi = std::max(hi, p.I);
+    for (const Point& p : points) {
+      const double I = p.steady && std::isfinite(p.I) && p.I > 0 ? p.I : p.I_imposed;
+      if (p.cost && std::isfinite(I) && I > 0) ++n, lo = std::min(lo, I), hi = std::max(hi, I);
+    }
     if (n >= 2 && hi >= 1.5 * lo) {
       sum.cost_plot = true;
       sum.plots_ok = plot_cost_I(out_dir, points) && sum.plots_ok;
       html_cost = "<h2>Cost against I</h2><img src='cost_I.png' width=600>"
-                  "<p>Data: <a href='cost_I.csv'>cost_I.csv</a>.</p>\n";
+                  "<p>Every run with a summary.toml; the runs without a steady window (open symbols) at their "
+                  "imposed I. Data: <a href='cost_I.csv'>cost_I.csv</a>.</p>\n";
     }
   }
 

@@ -34,7 +34,7 @@ std::string read_finite(const std::string& text, double& v) {
   errno = 0;
   v = std::strtod(text.c_str(), &end);
   if (text.empty() || *end != '\0') return fmt::format("'{}' is not a number", printable(text, 40));
-  if (!std::isfinite(v) || errno == ERANGE && std::abs(v) > 1)
+  if (!std::isfinite(v) || (errno == ERANGE && std::abs(v) > 1))
     return fmt::format("'{}' is not a finite number", printable(text, 40));
   return {};
 }

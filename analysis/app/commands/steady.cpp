@@ -48,7 +48,7 @@ Handler steady(CLI::App& sub) {
     print_stats(r);
     if (!o->out.empty()) {
       std::filesystem::create_directories(o->out);
-      if (!plot_series(o->out, "series_" + column, series, x, column, &r.stats.window))
+      if (!plot_series(o->out, "series_" + column, series, x, column, &r.stats))
         fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", o->out);
     }
     return 0;
