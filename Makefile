@@ -163,12 +163,15 @@ build: deps $(BUILD)/CMakeCache.txt
 # adds scene overrides (cdsim --set, docs/scenes.md).
 SET ?=
 run: deps $(BUILD)/CMakeCache.txt
-	$(call build_only,cdsim)
+	$(call build_only,cdsim cdanalysis)
 	$(BUILD)/cd/cdsim $(SCENE) --out $(OUT) $(SET)
 	@echo ""
 	@echo "Outputs in $(OUT)/: series.csv (time series, columns in docs/outputs.md), scene.toml"
 	@echo "(resolved scene), shapes.pvd, particles.pvd, contacts.pvd, walls.pvd (VTK collections)."
 	@echo "Open in ParaView:  paraview $(OUT)/shapes.pvd   (grains as drawn; colour by velocity)"
+	@$(BUILD)/analysis/cdanalysis draw $(OUT) > $(OUT)/picture.log 2>&1 && \
+	  echo "Without ParaView: $$(sed -n 's/^picture: //p' $(OUT)/picture.log)   (last snapshot: grains and force chains)" || \
+	  echo "No picture (cdanalysis draw failed: $(OUT)/picture.log)"
 
 # After the suite, the tree is checked again (tests/check_tree.cmake): no
 # test may leave a file in the sources (they write into the build folder).

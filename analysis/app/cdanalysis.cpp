@@ -31,6 +31,8 @@ const Command kCommands[] = {
      "all OK, 1 some FAIL, 2 a file unreadable.",
      cli::compare_fits},
     {"report", "tables, fits, plots and index.html for a campaign", cli::report},
+    {"draw", "a PNG of a snapshot without ParaView: grains with their outlines and the force chains (3D: a slice)",
+     cli::draw},
 };
 constexpr std::size_t kFitPosition = 3;  // "fit" after profile
 

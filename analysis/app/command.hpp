@@ -43,6 +43,7 @@ Handler fit_compaction(CLI::App& sub);
 Handler fit_fabric_bounds(CLI::App& sub);
 Handler compare_fits(CLI::App& sub);
 Handler report(CLI::App& sub);
+Handler draw(CLI::App& sub);
 
 // ---- Shared by the commands (common.cpp) ----
 
