@@ -60,6 +60,10 @@ CLI::Validator non_negative_number();  // >= 0 (and finite)
 CLI::Validator writable_file();
 // A --window spec, a:b or a%:b% (run.hpp resolve_window), checked before any run is read.
 CLI::Validator window_spec();
+// The options every fit shares, one text and one check each: --window (the
+// steady window of each run, window_spec) and --toml (writable_file).
+CLI::Option* add_window_option(CLI::App& sub, std::string& window);
+CLI::Option* add_toml_option(CLI::App& sub, std::string& path);
 // Adds finite_number() to every floating-point option of app and of its
 // subcommands, recursively.
 void require_finite_numbers(CLI::App& app);

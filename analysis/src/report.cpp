@@ -544,6 +544,21 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
                                                       "nsides, pressure): no fit across runs")
                                         : html_escape(fmt::format("{}", fmt::join(kinds, "; "))));
 
+  // Never a dead end: a fit the data do not determine is written (fits.toml:
+  // determined = false and the reason, or the undetermined parameters) and
+  // drawn (the points alone, or the curve with the parameters flagged), with
+  // what would determine it.
+  const auto undetermined_html = [&](const std::string& model, const std::string& why) {
+    sum.undetermined.push_back(fmt::format("{}: {}", model, why));
+    return fmt::format("<p><b>Undetermined</b>: {}. What would determine it: {}.</p>\n", html_escape(why),
+                       html_escape(what_would_determine(model)));
+  };
+  const auto flagged = [&](const FitResult& r, const std::string& model) {
+    const auto u = undetermined_params(r);
+    if (u.empty()) return std::string();
+    return undetermined_html(model, fmt::format("{} not determined by the data (error not below the value)",
+                                                fmt::join(u, ", ")));
+  };
   // Inertial: mu(I) and nu(I) over the cohesionless runs of one shape.
   if (by_I) {
     std::vector<double> I, mu, mu_err;
@@ -566,21 +581,6 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       }
     }
     const std::string sel = by_eta || by_shape ? " (runs with cohesion_number 0 and the first run's shape)" : "";
-    // Never a dead end: a fit the data do not determine is written (fits.toml:
-    // determined = false and the reason, or the undetermined parameters) and
-    // drawn (the points alone, or the curve with the parameters flagged), with
-    // what would determine it.
-    const auto undetermined_html = [&](const std::string& model, const std::string& why) {
-      sum.undetermined.push_back(fmt::format("{}: {}", model, why));
-      return fmt::format("<p><b>Undetermined</b>: {}. What would determine it: {}.</p>\n", html_escape(why),
-                         html_escape(what_would_determine(model)));
-    };
-    const auto flagged = [&](const FitResult& r, const std::string& model) {
-      const auto u = undetermined_params(r);
-      if (u.empty()) return std::string();
-      return undetermined_html(model, fmt::format("{} not determined by the data (error not below the value)",
-                                                  fmt::join(u, ", ")));
-    };
     if (I.size() >= 4) {
       std::optional<FitResult> r;
       std::string why;
@@ -674,10 +674,13 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
                               "{:.2g}, λ = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",
                               html_escape(void_ratio(p0).formula), r["e0"], r.err("e0"), r["lambda"],
                               r.err("lambda"), r.chi2_dof) +
+                  flagged(r, "void_ratio") +
                   made_by(report_cmd, fmt::format("cdanalysis fit compaction {} --out DIR", campaign));
     } catch (const AnalysisError& e) {
       sum.problems.push_back(fmt::format("compaction fit: {}", e.what()));
-      html_fit += fmt::format("<p>Compaction fit refused: {}</p>\n", html_escape(e.what()));
+      refused.push_back({"void_ratio", "e = e0 - lambda ln(p/p0)", e.what()});
+      html_fit += fmt::format("<p>Compaction fit refused: {}</p>\n", html_escape(e.what())) +
+                  undetermined_html("void_ratio", e.what());
     }
   }
 
@@ -712,10 +715,13 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
                               r["alpha"], r.err("alpha"), r.chi2_dof,
                               ref.dim() == 3 ? "c/p = μ − μ0(I), μ0(I)" : "sin φ(I)", ref_pts.size(),
                               ref.uses_fit() ? "the μ(I) fit" : "interpolation in ln I") +
+                  flagged(r, "cohesion") +
                   made_by(report_cmd, fmt::format("cdanalysis fit cohesion {} --out DIR", campaign));
     } catch (const AnalysisError& e) {
       sum.problems.push_back(fmt::format("cohesion fit: {}", e.what()));
-      html_fit += fmt::format("<p>Cohesion fit refused: {}</p>\n", html_escape(e.what()));
+      refused.push_back({"cohesion", cohesion().formula, e.what()});
+      html_fit += fmt::format("<p>Cohesion fit refused: {}</p>\n", html_escape(e.what())) +
+                  undetermined_html("cohesion", e.what());
     }
   }
 
@@ -741,6 +747,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       sum.fits.push_back("mu_alpha");
     } catch (const AnalysisError& e) {
       sum.problems.push_back(fmt::format("mu*(alpha) fit: {}", e.what()));
+      refused.push_back({"mu_alpha", mu_of_alpha().formula, e.what()});
     }
     if (!ap.empty()) {
       const std::string fit_cmd = fmt::format("cdanalysis fit angularity {} --out DIR", campaign);
@@ -751,9 +758,11 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
         html_fit += fmt::format("<p>{}: μ0 = {:.4f} ± {:.2g}, μ1 = {:.4f} ± {:.2g}, α_c = {:.4g} ± {:.2g}, "
                                 "χ²/dof = {:.2f} (dof {})</p>\n",
                                 html_escape(mu_of_alpha().formula), (*r)["mu0"], r->err("mu0"), (*r)["mu1"],
-                                r->err("mu1"), (*r)["alpha_c"], r->err("alpha_c"), r->chi2_dof, r->dof);
+                                r->err("mu1"), (*r)["alpha_c"], r->err("alpha_c"), r->chi2_dof, r->dof) +
+                    flagged(*r, "mu_alpha");
       else
-        html_fit += "<p>μ*(α) fit refused (see Problems).</p>\n";
+        html_fit += "<p>μ*(α) fit refused (see Problems).</p>\n" +
+                    undetermined_html("mu_alpha", sum.problems.empty() ? "" : sum.problems.back());
       html_fit +=
           "<p>Table: <a href='angularity.csv'>angularity.csv</a>. Series quantities: steady mean ± block-"
           "averaging error; fabric: mean ± sem over the last 5 contact snapshots. Sliding: |f_t| ≥ μ f_n (1 − "

@@ -94,6 +94,18 @@ CLI::Validator window_spec() {
       "a:b|a%:b%");
 }
 
+CLI::Option* add_window_option(CLI::App& sub, std::string& window) {
+  return sub
+      .add_option("--window", window,
+                  "steady window a:b of each run's abscissa (strain), or a%:b% of each run's span of it, e.g. "
+                  "50%:100% the second half (default: detected per run)")
+      ->check(window_spec());
+}
+
+CLI::Option* add_toml_option(CLI::App& sub, std::string& path) {
+  return sub.add_option("--toml", path, "write the fit parameters to this TOML file")->check(writable_file());
+}
+
 void require_finite_numbers(CLI::App& app) {
   for (CLI::Option* o : app.get_options())
     if (o->get_type_name() == "FLOAT") o->check(finite_number());

@@ -23,12 +23,9 @@ Handler fit_angularity(CLI::App& sub) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   sub.add_option("--bins", o->bins, "angular bins over [0, pi)")->check(CLI::Range(4, 36000))->capture_default_str();
-  sub.add_option("--window", o->window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
-                                        "run's span of it (default: detected per run)")
-      ->check(window_spec());
+  add_window_option(sub, o->window);
   sub.add_option("--out", o->out, "folder for angularity.csv, the fit curve and the plots (png, svg)");
-  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file")
-      ->check(writable_file());
+  add_toml_option(sub, o->toml_out);
   return [o] {
     AngularityOptions opt;
     opt.snapshots = o->snapshots;

@@ -124,11 +124,8 @@ Handler fit_cohesion(CLI::App& sub) {
       ->check(CLI::IsMember({"auto", "mu-i", "interp"}))
       ->capture_default_str();
   sub.add_option("--out", o->out, "folder for c/p data, model curves and the plot (png, svg)");
-  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file")
-      ->check(writable_file());
-  sub.add_option("--window", o->window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
-                                        "run's span of it (default: detected per run)")
-      ->check(window_spec());
+  add_toml_option(sub, o->toml_out);
+  add_window_option(sub, o->window);
   sub.add_flag("--exclude-banded", o->exclude_banded,
                "leave the cohesive runs whose shear is banded (profile's rate_min below 0.5: not a homogeneous "
                "flow at the run's I) out of the model fit; they stay in the data and the plot (open circles)");

@@ -12,12 +12,9 @@ Handler fit_compaction(CLI::App& sub) {
   sub.add_option("--table", o->table, "CSV with columns p, e and optionally e_err, instead of runs");
   sub.add_option("--p0", o->p0, "reference pressure (default: the geometric mean of the p's)")
       ->check(positive_number());
-  sub.add_option("--window", o->window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
-                                        "run's span of it (default: detected per run)")
-      ->check(window_spec());
+  add_window_option(sub, o->window);
   sub.add_option("--out", o->out, "folder for the plot compaction.png/svg and its data");
-  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file")
-      ->check(writable_file());
+  add_toml_option(sub, o->toml_out);
   return [o] { return run_state_fit(*o, false); };
 }
 

@@ -17,12 +17,9 @@ Handler fit_mu_i(CLI::App& sub) {
   sub.add_option("runs", o->runs, "run or campaign folders (each run: steady mean of q_over_p and "
                                   "inertial_number)");
   sub.add_option("--table", o->table, "CSV with columns I, mu and optionally mu_err, instead of runs");
-  sub.add_option("--toml", o->toml_out, "write the fit parameters to this TOML file")
-      ->check(writable_file());
+  add_toml_option(sub, o->toml_out);
   sub.add_option("--out", o->out, "folder for the plot mu_I.png/svg (points, fit, 1-sigma band)");
-  sub.add_option("--window", o->window, "steady window a:b of each run's abscissa (strain), or a%:b% of each "
-                                        "run's span of it, e.g. 50%:100% the second half (default: detected per run)")
-      ->check(window_spec());
+  add_window_option(sub, o->window);
   return [o] {
     std::vector<double> I, mu, err;
     std::vector<std::string> left_out;
