@@ -72,23 +72,27 @@ Particle grain(int id, double x, double y, double z, double r, int nsides = 0, d
 }  // namespace
 
 // Two disks and a hexagon (apothem 1) in a row and a column; a strong
-// contact A-B (fn = 10) and a weak one A-C (fn = 1): <fn> = 5.5, so A-B is
-// in class [1.5, 2) and A-C in [0, 1).
+// contact A-B (fn = 10), a weak one A-C (fn = 1) and B on a floor (body 99,
+// not a grain; fn = 5.5, its branch to the wall's middle): <fn> = 5.5, so
+// A-B is in class [1.5, 2), A-C in [0, 1) and the floor contact in [1, 1.5),
+// drawn from B's centre down to its edge, not along its branch.
 TEST(Picture, TwoDimensionalGrainsAndForceChains) {
   if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
   const auto d = scratch("2d");
   const double R6 = 2 / std::sqrt(3.0);  // circumradius of the hexagon of apothem 1
   ParticleSet ps = {grain(0, 0, 0, 0, 1), grain(1, 2, 0, 0, 1), grain(2, 0, 2, 0, R6, 6, 0)};
-  ContactSet cs(2);
+  ContactSet cs(3);
   cs[0].b1 = 0, cs[0].b2 = 1, cs[0].lx = 2, cs[0].ly = 0, cs[0].fn = 10, cs[0].status = 1;
   cs[1].b1 = 0, cs[1].b2 = 2, cs[1].lx = 0, cs[1].ly = 2, cs[1].theta = std::numbers::pi / 2, cs[1].fn = 1,
   cs[1].status = 1;
+  cs[2].b1 = 99, cs[2].b2 = 1, cs[2].lx = -2, cs[2].ly = -1, cs[2].theta = std::numbers::pi / 2, cs[2].fn = 5.5,
+  cs[2].status = 1;
   write_particles((d / "particles_00000.vtp").string(), ps);
   write_contacts((d / "contacts_00000.vtp").string(), cs, ps, true);
   const Picture p = draw_snapshot(d.string(), (d / "pic.png").string());
   ASSERT_TRUE(p.gnuplot_ok);
   EXPECT_EQ(p.grains, 3u);
-  EXPECT_EQ(p.bars, 2u);
+  EXPECT_EQ(p.bars, 3u);
   const Image im = read_png(p.png);
   // The size: the width asked for, the height from the drawn region's aspect.
   EXPECT_EQ(im.width, 1000);
@@ -100,6 +104,8 @@ TEST(Picture, TwoDimensionalGrainsAndForceChains) {
   }
   EXPECT_TRUE(near_colour(im, p, 0, 0.5, hex(kForceClassColour[0]))) << "weak bar";
   EXPECT_FALSE(near_colour(im, p, 0, 0.5, hex(kForceClassColour[2]))) << "weak bar drawn as strong";
+  EXPECT_TRUE(near_colour(im, p, 2, -0.5, hex(kForceClassColour[1]))) << "floor contact";
+  EXPECT_TRUE(blank(im, p, 3, 0.5)) << "floor contact drawn along its branch to the wall's middle";
   // Away from bars and outlines: nothing.
   EXPECT_TRUE(blank(im, p, 2.5, 0.5));
   EXPECT_TRUE(blank(im, p, 1.4, 1.6));

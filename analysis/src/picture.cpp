@@ -111,7 +111,19 @@ Picture draw_snapshot(const std::string& run, const std::string& png, const Pict
     }
   } else {
     // Side-side pairs as one contact: their forces summed (the chain's load).
-    for (const auto& c : merge_side_side(read_contacts(cfile))) add_bar(c.b1, c.b2, c.lx, c.ly, c.fn, 0, 0);
+    // A 2D wall contact's branch runs to the wall segment's middle, not to
+    // the contact: its bar is drawn from the grain's centre to its edge
+    // along n instead (the radius; a polygon's circumradius).
+    for (const auto& c : merge_side_side(read_contacts(cfile))) {
+      const bool w1 = !by_id.count(c.b1), w2 = !by_id.count(c.b2);
+      if (w1 == w2) {
+        add_bar(c.b1, c.b2, c.lx, c.ly, c.fn, 0, 0);
+      } else {
+        const Particle& g = *by_id.at(w1 ? c.b2 : c.b1);
+        const double s = w1 ? -g.radius : g.radius;  // n points from b1 to b2
+        if (c.fn > 0) bars.push_back({g.x, g.y, g.x + s * c.nx(), g.y + s * c.ny(), c.fn});
+      }
+    }
   }
   double mean = 0;
   for (const auto& b : bars) mean += b.fn;

@@ -3,7 +3,8 @@
 // sides at their orientation) and the force chains, every force-bearing
 // contact a bar between the two centres (to the touched periodic image, or
 // from the contact point on a wall), thicker and darker for a larger normal
-// force, drawn by gnuplot into a PNG. A 3D run is drawn as a slice: the
+// force, drawn by gnuplot into a PNG. A 2D wall contact (the wall is not a
+// grain) is a bar from the grain's centre to its edge along the normal. A 3D run is drawn as a slice: the
 // spheres cut by the plane z = z_mid (circles of radius sqrt(r^2 - dz^2))
 // and the contacts whose two ends lie within one mean radius of the plane,
 // projected on it.
