@@ -153,7 +153,8 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   RunTotals tot;                     // the run's cost so far (summary.toml)
   if (resume) {
     try {
-      if (w.load(ckpt, &tot) != key || w.steps() > nsteps)
+      const std::uint64_t stored = w.load(ckpt, &tot);
+      if ((stored != key && !folder_scene_is((dir / "scene.toml").string(), key)) || w.steps() > nsteps)
         throw CheckpointError(fmt::format("checkpoint '{}' was written by a different scene "
                                           "(compare with {})", ckpt, (dir / "scene.toml").string()));
       columns = truncate_series(series_path, w.steps());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 
 #include "checkpoint_io.hpp"
 #include "config.hpp"
@@ -50,7 +51,15 @@ std::uint64_t scene_key(const Scene& scene) {
   s.checkpoint_interval = 0;
   s.checkpoint_strain = 0;
   s.checkpoint_wall = 0;
-  return fnv1a(resolved_toml(s));
+  return fnv1a(resolved_values(s));
+}
+
+bool folder_scene_is(const std::string& scene_toml, std::uint64_t key) {
+  try {
+    return scene_key(load_scene(scene_toml)) == key;
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 }  // namespace cd

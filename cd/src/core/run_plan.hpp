@@ -30,7 +30,14 @@ RunPlan plan_of(const Scene& s, double dt);
 // that change neither the results nor the outputs, so that a restart may
 // change them: solver.threads (results are bit-identical for any thread
 // count), output.quiet, output.checkpoint_interval, output.checkpoint_strain,
-// output.checkpoint_wall, and the scene's file name.
+// output.checkpoint_wall, and the scene's file name. It hashes the values
+// alone (config.hpp's resolved_values), not their documentation.
 std::uint64_t scene_key(const Scene& s);
+
+// Whether the scene.toml in a run folder is the scene of `key`: how a
+// checkpoint whose key hashed the documentation too (written by a cdsim
+// before scene_key hashed the values alone) is recognised as this scene's.
+// False if the file is missing or unreadable.
+bool folder_scene_is(const std::string& scene_toml, std::uint64_t key);
 
 }  // namespace cd

@@ -647,14 +647,21 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   return parse_scene(text.str(), path, overrides);
 }
 
-std::string resolved_toml(const Scene& s) {
-  std::string out = "# Resolved scene: every parameter with the value used";
-  out += s.source.empty() ? ".\n" : fmt::format(" (read from {}).\n", s.source);
+namespace {
+
+// The resolved scene as TOML; docs = false: the values alone (no comments).
+std::string resolved_text(const Scene& s, bool docs) {
+  std::string out;
+  if (docs) {
+    out = "# Resolved scene: every parameter with the value used";
+    out += s.source.empty() ? ".\n" : fmt::format(" (read from {}).\n", s.source);
+  }
   std::string section;
   const auto line = [&](const auto& p, const auto& obj) {
     const std::string kv =
         fmt::format("{} = {}", p.key, std::visit([&](auto m) { return text(obj.*m, true); }, p.field));
-    out += fmt::format("{:<32} # {}{}\n", kv, *p.unit ? fmt::format("[{}] ", p.unit) : "", p.doc);
+    if (docs) out += fmt::format("{:<32} # {}{}\n", kv, *p.unit ? fmt::format("[{}] ", p.unit) : "", p.doc);
+    else out += kv + '\n';
   };
   for (const Param<Scene>& p : scene_params()) {
     if (p.section != section) out += fmt::format("\n[{}]\n", section = p.section);
@@ -670,6 +677,12 @@ std::string resolved_toml(const Scene& s) {
   array(s.walls, wall_params());
   return out;
 }
+
+}  // namespace
+
+std::string resolved_toml(const Scene& s) { return resolved_text(s, true); }
+
+std::string resolved_values(const Scene& s) { return resolved_text(s, false); }
 
 namespace {
 // One row of the parameter table: what --help-scene shows of a key.

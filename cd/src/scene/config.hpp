@@ -30,6 +30,11 @@ Scene parse_scene(const std::string& text, const std::string& path,
 // load_scene reads back to the same Scene.
 std::string resolved_toml(const Scene& s);
 
+// The same without the header and comments: the values alone, what a
+// checkpoint's scene key hashes (core/run_plan.hpp), so that a change of
+// documentation does not orphan the checkpoints of runs in progress.
+std::string resolved_values(const Scene& s);
+
 // Markdown table of every parameter: key, default, unit, rule, meaning.
 std::string parameter_table_markdown();
 
