@@ -6,7 +6,9 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 namespace cdtest {
@@ -23,6 +25,14 @@ inline CmdResult run_command(const std::string& cmd) {
   while (std::fgets(buf.data(), buf.size(), p.get())) out += buf.data();
   const int status = pclose(p.release());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+// A file's bytes ("" if it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
 }
 
 // An empty folder BUILD/<test>/<name> for a test's files (emptied first).

@@ -27,12 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using cdtest::slurp;
 
 // The files of a run folder, by name (no subfolders are written).
 std::set<std::string> names(const fs::path& dir) {

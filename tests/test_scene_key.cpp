@@ -20,12 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using cdtest::slurp;
 
 TEST(SceneKey, HashesTheValuesNotTheirDocumentation) {
   const cd::Scene a = cd::parse_scene("[contact]\nmu = 0.3\n", "a.toml");
