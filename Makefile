@@ -52,6 +52,8 @@ help:
 	@echo "                       3D: polyhedral-cone Lemke against e and the exact NLGS (outputs/accuracy-cost/3d/)"
 	@echo "  make accuracy-shear  solver settings against steady mu*, phi, z and cost in shear (ACC/; hours)"
 	@echo "  make tensile         tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
+	@echo "  make compare-liggghts-shear  a 1000-sphere mu(I) point by LIGGGHTS and cdsim, one thread each: CPU per"
+	@echo "                       unit strain, sweeps, mu, phi, z, the ratio (CMP_DIR; QUICK=1: strain 0.3)"
 	@echo "  make prep-overlap    ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N: fails if an overlap reaches 0.01 d_small"
 	@echo "  make frozen-shear    steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into FROZEN/N_<FS_N>/"
 	@echo "  make regress         re-run the 2D and 3D reference campaigns, refit mu(I), compare with tests/data/regress*/"
@@ -88,6 +90,10 @@ help:
 	$(call help_var,SIZE_RATIO,d_max / d_min of the samples)
 	$(call help_var,SIZE_DIST,size distribution (uniform_area or uniform))
 	$(call help_var,SHEAR_TOL,solver.tol for every shear run (empty: by I; docs/shear.md))
+	$(call help_var,SHEAR_SET,more --set options for every shear run (e.g. --set solver.anderson=5))
+	$(call help_var,CMP_DIR,make compare-liggghts-shear's folder)
+	$(call help_var,CMP_I,its inertial number)
+	$(call help_var,CMP_STRAIN,its strain (QUICK=1: 0.3))
 	$(call help_var,PREP_SET,more --set options for the preparations)
 	$(call help_var,INERTIAL_I,the inertial numbers of campaign-inertial[-ladder])
 	$(call help_var,COHESIVE_ETA,cohesion numbers of campaign-cohesive)
@@ -103,7 +109,7 @@ help:
 	$(call help_var,WINDOW,steady window of the fits: a:b (strain) or a%:b%; empty: detected)
 	$(call help_var,CAMPAIGN,campaign of make campaign-list (inertial cohesive angularity ...))
 	$(call help_var,RUN,run folder of make campaign-prep-of)
-	$(call help_var,QUICK,1: the short version of accuracy-cost and tensile)
+	$(call help_var,QUICK,1: the short version of accuracy-cost, tensile and compare-liggghts-shear)
 	$(call help_var,BIG,1: make bench's 3D sizes up to 1e5)
 	$(call help_var,PO_N,grains of make prep-overlap)
 	$(call help_var,PO_DIR,its output folder)
@@ -599,3 +605,34 @@ mutants: deps
 
 clean:
 	rm -rf $(BUILD)
+
+# ---- Dense shear side by side with LIGGGHTS (issue 30; docs/accuracy.md) -----
+# make compare-liggghts-shear [QUICK=1] [CMP_STRAIN=2] [CMP_I=0.01] [SHEAR_TOL=...]
+# One 1000-grain mu(I) point by both codes in one sitting, one thread each:
+# LIGGGHTS 3.8 (Debian's, installed here if missing) shearing 1000 spheres
+# between rough walls at imposed p, E/p = 1e5 (cd/bench/peers/liggghts-shear/),
+# and cdsim's 3D campaign point (make campaign-inertial DIM=3 N=1000: the
+# preparation and shear scenes), run at the same time, then the table of
+# cd/bench/peers/shear_table.py (CPU s per unit strain, steps, sweeps a step,
+# mu, phi, z, the ratio; the load). Everything is redone on each call into
+# CMP_DIR. QUICK=1: strain 0.3 (a try, not a steady state; ~5 CPU min).
+# LIGGGHTS' recommended packages pull python3-paraview, which removes
+# libvtk9-dev (the build's): installed without them, and repaired at once if
+# it happened anyway.
+CMP_DIR ?= outputs/compare-liggghts
+CMP_I ?= 0.01
+CMP_STRAIN ?= $(if $(QUICK),0.3,2)
+.PHONY: compare-liggghts-shear
+compare-liggghts-shear: build
+	$(call install_missing,compare-liggghts-shear,liggghts time python3-numpy)
+	@dpkg-query -W -f='$${Status}\n' libvtk9-dev 2>/dev/null | grep -q '^install ok installed' || \
+	  { echo "compare-liggghts-shear: libvtk9-dev was removed: reinstalling it"; \
+	    DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y --no-install-recommends libvtk9-dev python3-paraview-; }
+	rm -rf $(CMP_DIR) && mkdir -p $(CMP_DIR)
+	@echo "compare-liggghts-shear: load average at the start $$(cut -d' ' -f1-3 /proc/loadavg)"
+	/usr/bin/python3 cd/bench/peers/liggghts-shear/run.py $(CMP_DIR)/liggghts I=$(CMP_I) Ep=1e5 \
+	  strain=$(CMP_STRAIN) > $(CMP_DIR)/liggghts.log 2>&1 & lig=$$!; \
+	$(MAKE) --no-print-directory campaign-inertial DIM=3 N=1000 INERTIAL_I=$(CMP_I) THREADS=1 \
+	  STRAIN=$(CMP_STRAIN) CAMPAIGNS=$(CMP_DIR)/cdsim; cd=$$?; \
+	wait $$lig || { tail -5 $(CMP_DIR)/liggghts.log; exit 1; }; [ $$cd = 0 ]
+	/usr/bin/python3 cd/bench/peers/shear_table.py $(CMP_DIR)
