@@ -367,7 +367,10 @@ shear_solver = $(if $(SHEAR_TOL),--set solver.tol=$(SHEAR_TOL) --set solver.resi
 shear_cmd = $(CDSIM) $(SHEAR_SCENE) --out $(@D) $(CAMPAIGN_SET) $(shear_solver) \
 	  --set shear.start='"$(2)/checkpoint.bin"' --set shear.pressure=$(3) \
 	  --set shear.inertial_number=$(1) --set shear.strain=$(4) \
-	  --set output.series_interval=$(call series_dt,$(1),$(3)) --set output.snapshot_interval=$(call snapshot_dt,$(1),$(3))
+	  --set output.series_interval=$(call series_dt,$(1),$(3)) --set output.snapshot_interval=$(call snapshot_dt,$(1),$(3)) \
+	  $(SHEAR_SET)
+# SHEAR_SET: more --set options for every shear run (e.g. --set solver.anderson=5).
+SHEAR_SET ?=
 # A fresh run: $(1) I, $(2) the shape (its compacted sample).
 shear_run = $(call shear_cmd,$(1),$(CAMPAIGNS)/prep/ns_$(2),$(P),$(STRAIN)) --set particles.nsides=[$(2)]
 
@@ -607,7 +610,7 @@ clean:
 	rm -rf $(BUILD)
 
 # ---- Dense shear side by side with LIGGGHTS (issue 30; docs/accuracy.md) -----
-# make compare-liggghts-shear [QUICK=1] [CMP_STRAIN=2] [CMP_I=0.01] [SHEAR_TOL=...]
+# make compare-liggghts-shear [QUICK=1] [CMP_STRAIN=2] [CMP_I=0.01] [SHEAR_TOL=...] [SHEAR_SET=...]
 # One 1000-grain mu(I) point by both codes in one sitting, one thread each:
 # LIGGGHTS 3.8 (Debian's, installed here if missing) shearing 1000 spheres
 # between rough walls at imposed p, E/p = 1e5 (cd/bench/peers/liggghts-shear/),

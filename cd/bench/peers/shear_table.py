@@ -35,7 +35,19 @@ def toml_values(path):
     return out
 
 
-def window_stats(series, blocks=5):
+def toml_scene_pressure(path):
+    """shear.pressure of a resolved scene.toml."""
+    section = ""
+    for line in open(path):
+        line = line.split("#", 1)[0].strip()
+        if line.startswith("["):
+            section = line.strip("[]")
+        elif section == "shear" and line.startswith("pressure"):
+            return float(line.split("=", 1)[1])
+    sys.exit("shear_table.py: no shear.pressure in " + path)
+
+
+def window_stats(series, P, blocks=5):
     rows = list(csv.DictReader(open(series)))
     g = [float(r["strain"]) for r in rows]
     S = g[-1]
@@ -54,7 +66,8 @@ def window_stats(series, blocks=5):
     mean_b = sum(mub) / blocks
     se = math.sqrt(sum((x - mean_b) ** 2 for x in mub) / (blocks - 1) / blocks)
     mean = lambda key: sum(float(r[key]) for r in sel) / n
-    return dict(strain=S, mu=mu_of(sel), mu_se=se, phi=mean("packing_fraction"), z=mean("z"))
+    return dict(strain=S, mu=mu_of(sel), mu_se=se, phi=mean("packing_fraction"), z=mean("z"),
+                syy=mean("syy") / P)
 
 
 def main():
@@ -65,23 +78,26 @@ def main():
         sys.exit("shear_table.py: expected one cdsim run in %s/cdsim/inertial, found %d" % (top, len(runs)))
     shear = toml_values(os.path.join(runs[0], "summary.toml"))
     prep = toml_values(os.path.join(top, "cdsim", "prep", "ns_0", "summary.toml"))
-    st = window_stats(os.path.join(runs[0], "series.csv"))
+    P = toml_scene_pressure(os.path.join(runs[0], "scene.toml"))
+    st = window_stats(os.path.join(runs[0], "series.csv"), P)
 
     S_l, S_c = float(lig["strain"]), st["strain"]
     cpu_l, cpu_c = float(lig["cpu_shear"]), shear["cpu_time"]
     per_l, per_c = cpu_l / S_l, cpu_c / S_c
-    hdr = ("| run | CPU s | CPU s per unit strain | ratio | steps | sweeps a step | mu | phi | z | "
-           "largest overlap |\n|---|---|---|---|---|---|---|---|---|---|\n")
+    hdr = ("| run | CPU s | CPU s per unit strain | ratio | steps | sweeps a step | mu | phi | z | s_yy/p | "
+           "largest overlap |\n|---|---|---|---|---|---|---|---|---|---|---|\n")
     rows = [
         "| LIGGGHTS shear, E/p = %.3g, to gamma = %.2f | %.1f | %.2f | 1 | %s | - | %.3f +- %.3f | %.4f | %.2f "
-        "(rattlers in) | - |" % (float(lig["Ep"]) if "Ep" in lig else 1e5, S_l, cpu_l, per_l, lig["steps"],
-                                 float(lig["mu"]), float(lig["mu_se"]), float(lig["phi"]), float(lig["z"])),
+        "(rattlers in) | %.3f | - |" % (float(lig["Ep"]), S_l, cpu_l, per_l, lig["steps"], float(lig["mu"]),
+                                       float(lig["mu_se"]), float(lig["phi"]), float(lig["z"]),
+                                       float(lig["p_over_set"])),
         "| cdsim 3D shear, to gamma = %.2f | %.1f | %.2f | **%.1f** | %d | %.0f (%.1f %% at the cap) | "
-        "%.3f +- %.3f | %.4f | %.2f | %.2g d |" % (S_c, cpu_c, per_c, per_c / per_l, shear["steps"],
-                                                  shear["sweeps_mean"], 100 * shear["cap_share"], st["mu"],
-                                                  st["mu_se"], st["phi"], st["z"], shear["overlap_max"]),
-        "| LIGGGHTS preparation | %.1f | | 1 | | | | | | |" % float(lig["cpu_prep"]),
-        "| cdsim preparation | %.1f | | **%.1f** | %d | %.0f (%.1f %% at the cap) | | | | %.2g d |" %
+        "%.3f +- %.3f | %.4f | %.2f | %.3f | %.2g d |" % (S_c, cpu_c, per_c, per_c / per_l, shear["steps"],
+                                                         shear["sweeps_mean"], 100 * shear["cap_share"], st["mu"],
+                                                         st["mu_se"], st["phi"], st["z"], st["syy"],
+                                                         shear["overlap_max"]),
+        "| LIGGGHTS preparation | %.1f | | 1 | | | | | | | |" % float(lig["cpu_prep"]),
+        "| cdsim preparation | %.1f | | **%.1f** | %d | %.0f (%.1f %% at the cap) | | | | | %.2g d |" %
         (prep["cpu_time"], prep["cpu_time"] / float(lig["cpu_prep"]), prep["steps"], prep["sweeps_mean"],
          100 * prep["cap_share"], prep["overlap_max"]),
     ]

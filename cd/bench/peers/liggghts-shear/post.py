@@ -86,9 +86,11 @@ def main():
         rates.append(np.polyfit(y[inside], grains[inside, 5], 1)[0] / rate)
     if not phis:
         sys.exit("post.py: no dump frame in the window [%g, %g]" % (g0, g1))
+    # The strain of the whole run (the last record is a mean over its interval).
+    strain = shear_steps * dt * rate
     print("code=liggghts I_set=%s Ep=%s strain=%.3f window=%.3g:%.3g steps=%d mu=%.4f mu_se=%.4f phi=%.4f z=%.3f "
-          "p=%.2f bulk_rate=%.3f frames=%d I_nom=%.4g" %
-          (par["I"], par["Ep"], gam[-1], g0, g1, shear_steps, mu, mu_se, np.mean(phis), np.mean(zs), p_mean, np.mean(rates),
+          "p=%.4g p_over_set=%.3f bulk_rate=%.3f frames=%d I_nom=%.4g" %
+          (par["I"], par["Ep"], strain, g0, g1, shear_steps, mu, mu_se, np.mean(phis), np.mean(zs), p_mean, p_mean / float(par["p"]), np.mean(rates),
            len(phis), rate * d * math.sqrt(rho / p_mean)))
 
 
