@@ -28,6 +28,32 @@ template <bool Rot>
 struct BodyCoupling {
   BodyVel* vel;
 
+  // For the sweep's Anderson acceleration (core/sweep.hpp): a row's impulse
+  // as (p_n, p_t), and r += dx with its bodies' velocities following (one
+  // thread; a driven body has zero inverse mass and inertia, so it is not
+  // moved).
+  static constexpr int kImpulseDim = 2;
+  void read_impulse(const ContactRow& r, double* x) const {
+    x[0] = r.pn;
+    x[1] = r.pt;
+  }
+  void add_impulse(ContactRow& r, const double* dx) const {
+    const double dpn = dx[0], dpt = dx[1];
+    r.pn += dpn;
+    r.pt += dpt;
+    BodyVel& A = vel[r.b1];
+    BodyVel& B = vel[r.b2];
+    const double px = r.nx * dpn - r.ny * dpt, py = r.ny * dpn + r.nx * dpt;
+    B.vx += B.inv_m * px;
+    B.vy += B.inv_m * py;
+    A.vx -= A.inv_m * px;
+    A.vy -= A.inv_m * py;
+    if constexpr (Rot) {
+      B.w += B.inv_I * (r.c2n * dpt - r.c2t * dpn);
+      A.w -= A.inv_I * (r.c1n * dpt - r.c1t * dpn);
+    }
+  }
+
   // One row update. Write1 = false when body 1 is driven (a wall): it is
   // read, never written, so rows of one colour may share a wall without a
   // data race.

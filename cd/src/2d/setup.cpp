@@ -111,6 +111,7 @@ WorldParams world_params(const Scene& s0) {
   }
   p.solver.tol = s.tol;
   p.solver.residual_tol = s.residual_tol;
+  p.solver.anderson = s.anderson;
   p.solver.max_iter = s.max_iter;
   p.rotation = s.rotation;
   return p;

@@ -114,6 +114,28 @@ struct BodyCoupling3 {
     return u;
   }
 
+  // For the sweep's Anderson acceleration (core/sweep.hpp): a row's impulse
+  // as 3 numbers, and r += dx with its bodies' velocities following (one
+  // thread; a driven body has zero inverse mass and inertia, so it is not
+  // moved).
+  static constexpr int kImpulseDim = 3;
+  void read_impulse(const SphereRow& r, double* x) const {
+    x[0] = r.r[0];
+    x[1] = r.r[1];
+    x[2] = r.r[2];
+  }
+  void add_impulse(SphereRow& r, const double* dx) const {
+    const Vec3 d(dx[0], dx[1], dx[2]);
+    r.r += d;
+    const Vec3 P = r.to_world(d);
+    BodyVel3& A = vel[r.b1];
+    BodyVel3& B = vel[r.b2];
+    B.v += B.inv_m * P;
+    B.w += B.inv_I * r.c2.cross(P);
+    A.v -= A.inv_m * P;
+    A.w -= A.inv_I * r.c1.cross(P);
+  }
+
   // One row update. Write1 = false when body 1 is driven (a wall): read,
   // never written, so rows of one colour may share it without a data race.
   template <class L, bool Write1>

@@ -25,6 +25,11 @@ struct SolverParams {
   // impulses still move (which, in dense shear, can stay above tol long
   // after the laws are met). 0: off, the rms |dp| test alone.
   double residual_tol = defaults::residual_tol;
+  // > 0: Anderson acceleration of the sweep (core/sweep.hpp, Anderson):
+  // the fixed-point map of one symmetric pair of sweeps, mixed over the
+  // last `anderson` pairs, the memory cleared when the pair's change grows.
+  // Needs a coupling that can add an impulse to a row (AddsImpulse); 0: off.
+  int anderson = defaults::anderson;
 };
 
 struct SolveStats {

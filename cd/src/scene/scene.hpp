@@ -83,6 +83,7 @@ struct Scene {
   double tol = defaults::tol;                // NLGS tolerance eps_f (relative)
   int max_iter = defaults::max_iter;         // iteration cap per step
   double residual_tol = defaults::residual_tol;  // > 0: also stop on the law residual
+  int anderson = defaults::anderson;         // > 0: Anderson acceleration memory
   int threads = 0;           // 0: OpenMP default
 
   // [particles]: random generation (n = 0 for none)
