@@ -53,15 +53,7 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
 }
 
 void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& vel) {
-  for (const SphereRow& r : rows) {
-    const Vec3 P = r.to_world(r.r);
-    BodyVel3& A = vel[r.b1];
-    BodyVel3& B = vel[r.b2];
-    B.v += B.inv_m * P;
-    B.w += B.inv_I * r.c2.cross(P);
-    A.v -= A.inv_m * P;
-    A.w -= A.inv_I * r.c1.cross(P);
-  }
+  for (const SphereRow& r : rows) push_impulse(r, r.r, vel.data());
 }
 
 // ---- .cdp3 files -----------------------------------------------------------

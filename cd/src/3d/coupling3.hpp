@@ -91,6 +91,18 @@ inline std::string law_name3(const LocalLaw3& l) {
 
 inline double impulse_norm(const SphereRow& r) { return r.r.norm(); }
 
+// The velocity change of a row's bodies under an impulse dr (frame
+// components) on body 2 and -dr on body 1 (the warm start, Anderson's mix).
+inline void push_impulse(const SphereRow& r, const Vec3& dr, BodyVel3* vel) {
+  const Vec3 P = r.to_world(dr);
+  BodyVel3& A = vel[r.b1];
+  BodyVel3& B = vel[r.b2];
+  B.v += B.inv_m * P;
+  B.w += B.inv_I * r.c2.cross(P);
+  A.v -= A.inv_m * P;
+  A.w -= A.inv_I * r.c1.cross(P);
+}
+
 namespace sweep {
 
 // Rows coupled through the velocities of their bodies (the 3D simulator).
@@ -127,13 +139,7 @@ struct BodyCoupling3 {
   void add_impulse(SphereRow& r, const double* dx) const {
     const Vec3 d(dx[0], dx[1], dx[2]);
     r.r += d;
-    const Vec3 P = r.to_world(d);
-    BodyVel3& A = vel[r.b1];
-    BodyVel3& B = vel[r.b2];
-    B.v += B.inv_m * P;
-    B.w += B.inv_I * r.c2.cross(P);
-    A.v -= A.inv_m * P;
-    A.w -= A.inv_I * r.c1.cross(P);
+    push_impulse(r, d, vel);
   }
 
   // One row update. Write1 = false when body 1 is driven (a wall): read,
