@@ -182,8 +182,9 @@ run: deps $(BUILD)/CMakeCache.txt
 # After the suite, the tree is checked again (tests/check_tree.cmake): no
 # test may leave a file in the sources (they write into the build folder).
 test: build
+	@git ls-files --others --exclude-standard > $(BUILD)/untracked-before.txt 2>/dev/null || : > $(BUILD)/untracked-before.txt
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 900
-	cmake -DROOT=$(CURDIR) -P tests/check_tree.cmake
+	cmake -DROOT=$(CURDIR) -DBEFORE=$(BUILD)/untracked-before.txt -P tests/check_tree.cmake
 
 # docs/scene-parameters.md is generated: a fixed header, then exactly what
 # `cdsim --help-scene` prints (tests/test_help_scene.cpp fails when they differ).

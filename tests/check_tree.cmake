@@ -5,12 +5,16 @@
 # ignores). Run by ctest (Hygiene.Tree) and by `make test` after the suite,
 # so that files the tests themselves leave are caught too.
 #
-#   cmake -DROOT=<source tree> -P check_tree.cmake
+#   cmake -DROOT=<source tree> [-DBEFORE=<file>] -P check_tree.cmake
 #   cmake -DSELFTEST=<empty folder> -P check_tree.cmake
 #
+# BEFORE names a file listing the untracked files that were already there
+# before the suite ran (`make test` writes it): a user's own scene or notes
+# are theirs, not a fault of the tests; only what appeared since is reported.
 # Outside a git clone (a source archive) only the root's entries are checked.
-# SELFTEST makes a small git tree there with a stray file at the root and an
-# untracked one below, and passes only if exactly those two are reported
+# SELFTEST makes a small git tree there with a stray file at the root, an
+# untracked one below, and an untracked one listed as there before (excused),
+# and passes only if exactly the first two are reported
 # (ctest Hygiene.TreeCheckCatches).
 cmake_minimum_required(VERSION 3.20)
 set(allowed .ci .git .gitignore CMakeLists.txt Makefile README.md analysis cd configs docs outputs tests)
@@ -33,8 +37,12 @@ function(tree_problems root out)
         list(APPEND problems "tracked at the root: ${f}")
       endif()
     endforeach()
+    set(before "")
+    if(BEFORE AND EXISTS ${BEFORE})
+      file(STRINGS ${BEFORE} before)
+    endif()
     foreach(f IN LISTS untracked)
-      if(f)
+      if(f AND NOT f IN_LIST before)
         list(APPEND problems "untracked (written by a run or a test, or not yet added): ${f}")
       endif()
     endforeach()
@@ -63,6 +71,10 @@ if(SELFTEST)
   file(WRITE ${SELFTEST}/stray.txt "a record of a failed command\n")
   execute_process(COMMAND ${GIT} -C ${SELFTEST} add Makefile .gitignore cd/a.cpp stray.txt RESULT_VARIABLE rc2)
   file(WRITE ${SELFTEST}/cd/left.txt "")
+  # A user's own untracked file, there before the suite: excused.
+  file(WRITE ${SELFTEST}/cd/mine.toml "")
+  file(WRITE ${SELFTEST}.before "cd/mine.toml\n")
+  set(BEFORE ${SELFTEST}.before)
   file(WRITE ${SELFTEST}/outputs/run.csv "")
   if(NOT rc EQUAL 0 OR NOT rc2 EQUAL 0)
     message(FATAL_ERROR "check_tree.cmake: could not make the self-test tree in ${SELFTEST}")
