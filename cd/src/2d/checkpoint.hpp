@@ -25,7 +25,9 @@ void save_checkpoint(const std::string& path, const World& w, std::uint64_t scen
                      const RunTotals& totals = {});
 
 // Reads a checkpoint into w (its parameters are kept) and returns the stored
-// scene key; with `totals`, also the run's totals. w (and *totals) are
+// scene key. Every array is checked as a scene is (lengths, shape tags,
+// sides, signs, finiteness) and, if w already holds bodies (a resume into
+// the world built from the scene), their count must be w's; with `totals`, also the run's totals. w (and *totals) are
 // changed only if the whole file is valid; otherwise throws CheckpointError
 // naming the file and what is wrong. Without `totals` (a start sample,
 // shear.start) a version 3 file is read too: it differs only by having no

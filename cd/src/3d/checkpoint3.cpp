@@ -30,6 +30,44 @@ static_assert(sizeof(Bodies3) ==
                   std::tuple_size_v<decltype(kBodies3Arrays)> * sizeof(std::vector<char>),
               "a Bodies3 member is missing from kBodies3Arrays (checkpoint3.cpp)");
 
+// Every body's arrays, checked as a scene's bodies are: the shape tag,
+// planes driven with a unit normal, spheres of positive radius, masses and
+// inertias of the right sign, orientations unit quaternions, every number
+// finite.
+void check_bodies3(const ckpt::Reader& in, const Bodies3& b) {
+  const std::size_t n = ckpt::same_lengths(kBodies3Arrays, b, in);
+  const auto vec = [&](std::string_view array, std::size_t i, const Vec3& v) {
+    for (int c = 0; c < 3; ++c) in.finite(array, i, std::string(1, "xyz"[c]), v[c]);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto shape = static_cast<unsigned>(b.shape[i]);
+    if (shape > static_cast<unsigned>(Shape3::Plane))
+      in.bad("3d.shape", i, "", fmt::format("is {} (0 sphere, 1 plane)", shape));
+    if (b.driven[i] > 1) in.bad("3d.driven", i, "", fmt::format("is {} (0 or 1)", b.driven[i]));
+    const bool plane = b.shape[i] == Shape3::Plane;
+    if (plane && !b.driven[i]) in.bad("3d.driven", i, "", "is 0 for a plane (planes are driven)");
+    in.non_negative("3d.radius", i, "", b.radius[i], !plane);
+    in.non_negative("3d.mass", i, "", b.mass[i], !b.driven[i]);
+    in.non_negative("3d.inertia", i, "", b.inertia[i], !b.driven[i]);
+    vec("3d.normal", i, b.normal[i]);
+    if (plane && !(std::abs(b.normal[i].norm() - 1) < 1e-9))
+      in.bad("3d.normal", i, "", fmt::format("has norm {:.6g} (a plane's normal is a unit vector)", b.normal[i].norm()));
+    const BodyVel3& v = b.vel[i];
+    vec("3d.vel", i, v.v);
+    vec("3d.vel", i, v.w);
+    in.non_negative("3d.vel", i, "inv_m", v.inv_m, !b.driven[i]);
+    in.non_negative("3d.vel", i, "inv_I", v.inv_I, !b.driven[i]);
+    if (b.driven[i] && (v.inv_m != 0 || v.inv_I != 0))
+      in.bad("3d.vel", i, "inv_m", "is not 0 for a driven body");
+    vec("3d.pos", i, b.pos[i]);
+    const Quat& q = b.orient[i];
+    for (int c = 0; c < 4; ++c) in.finite("3d.orient", i, std::string(1, "xyzw"[c]), q.coeffs()[c]);
+    // Renormalised every step (world3.cpp): round-off away from 1 only.
+    if (!(std::abs(q.norm() - 1) < 1e-9))
+      in.bad("3d.orient", i, "", fmt::format("has norm {:.6g} (an orientation is a unit quaternion)", q.norm()));
+  }
+}
+
 }  // namespace
 
 void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
@@ -52,20 +90,17 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
   const ckpt::Header h = ckpt::open(path, data, in, 3, totals != nullptr);
   Bodies3 b;
   ckpt::for_each_array(kBodies3Arrays, b, [&](std::string_view name, auto& v) { in.array(name, v); });
-  const std::size_t n = b.pos.size();
-  bool same = true;
-  ckpt::for_each_array(kBodies3Arrays, b, [&](std::string_view, const auto& v) { same = same && v.size() == n; });
-  if (!same) in.fail("is corrupt (body arrays of different lengths)");
+  check_bodies3(in, b);
   World3::WarmStart warm;
   in.array("3d.warm.keys", warm.keys);
   in.array("3d.warm.p", warm.p);
-  if (warm.keys.size() != warm.p.size()) in.fail("is corrupt (warm-start sizes differ)");
+  ckpt::check_warm(in, "3d.warm.keys", warm.keys, "3d.warm.p", warm.p);
   std::vector<double> cell;
   in.array("3d.cell", cell);
   // 7 numbers: written before the cell had rates and a strain (both 0).
-  if (cell.size() != 7 && cell.size() != 11) in.fail("is corrupt (the cell's state is not 7 or 11 numbers)");
-  for (const double x : cell)
-    if (!std::isfinite(x)) in.fail("is corrupt (a non-finite number in the cell's state)");
+  if (cell.size() != 7 && cell.size() != 11)
+    in.fail(fmt::format("is corrupt: '3d.cell' holds {} numbers (must be 7 or 11)", cell.size()));
+  for (std::size_t c = 0; c < cell.size(); ++c) in.finite("3d.cell", c, "", cell[c]);
   WorldParams3 p = w.params();
   for (int a = 0; a < 3; ++a)
     if ((cell[4 + a] != 0.0) != p.periodic[a])
@@ -73,6 +108,7 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
                           "{:d}, {:d})", cell[4] != 0.0, cell[5] != 0.0, cell[6] != 0.0, p.periodic[0],
                           p.periodic[1], p.periodic[2]));
   const RunTotals tot = ckpt::close(in, h);
+  ckpt::check_count(in, b.size(), w.bodies.size());
 
   p.cell = Vec3(cell[0], cell[1], cell[2]);
   p.le_offset = cell[3];

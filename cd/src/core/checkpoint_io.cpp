@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -101,9 +102,14 @@ Header open(const std::string& path, std::string& data, Reader& in, int dimensio
   h.key = in.get<std::uint64_t>("the header");
   h.steps = in.get<std::int64_t>("the header");
   h.time = in.get<double>("the header");
+  if (h.steps < 0) in.fail(fmt::format("is corrupt: its step count 'steps' is {} (must be >= 0)", h.steps));
+  if (!(std::isfinite(h.time) && h.time >= 0))
+    in.fail(fmt::format("is corrupt: its 'time' is {} (must be finite and >= 0)", h.time));
   std::vector<double> t;
   in.array(timers_name(), t);
-  if (t.size() != h.times.t.size()) in.fail("is corrupt (stage timers)");
+  if (t.size() != h.times.t.size())
+    in.fail(fmt::format("is corrupt: 'times' holds {} stage timers, this build has {}", t.size(), h.times.t.size()));
+  for (std::size_t s = 0; s < t.size(); ++s) in.non_negative("times", s, kStageNames[s], t[s]);
   std::copy(t.begin(), t.end(), h.times.t.begin());
   return h;
 }
@@ -113,7 +119,9 @@ RunTotals close(Reader& in, const Header& h) {
   if (h.version >= 4) {
     std::vector<double> t;
     in.array(totals_name(), t);
-    if (t.size() != std::size(kTotalsNames)) in.fail("is corrupt (run totals)");
+    if (t.size() != std::size(kTotalsNames))
+      in.fail(fmt::format("is corrupt: 'totals' holds {} run totals, this build has {}", t.size(), std::size(kTotalsNames)));
+    for (std::size_t k = 0; k < t.size(); ++k) in.non_negative("totals", k, kTotalsNames[k], t[k]);
     std::memcpy(static_cast<void*>(&tot), t.data(), sizeof tot);
   }
   if (!in.rest.empty()) in.fail("has unexpected data after the last array");

@@ -18,6 +18,7 @@
 // A reader checks every size against the file and the checksum, and names the
 // file in any error.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
@@ -119,6 +120,25 @@ struct Reader {
     std::memcpy(static_cast<void*>(v.data()), rest.data(), n * sizeof(T));
     rest.remove_prefix(n * sizeof(T));
   }
+
+  // A checkpoint is input like a scene: a matching checksum only says the
+  // file is as written, not that what was written is a state. The engines'
+  // readers check every element with these, naming the array, the element
+  // and the field, before the state is used.
+  [[noreturn]] void bad(std::string_view array, std::size_t i, std::string_view field,
+                        const std::string& why) const {
+    fail(fmt::format("is corrupt: '{}' element {}{}{} {}", array, i, field.empty() ? "" : " ", field, why));
+  }
+  void finite(std::string_view array, std::size_t i, std::string_view field, double x) const {
+    if (!std::isfinite(x)) bad(array, i, field, fmt::format("is {} (must be finite)", x));
+  }
+  // Finite and >= 0 (> 0 if `positive`).
+  void non_negative(std::string_view array, std::size_t i, std::string_view field, double x,
+                    bool positive = false) const {
+    finite(array, i, field, x);
+    if (positive ? !(x > 0) : !(x >= 0))
+      bad(array, i, field, fmt::format("is {:.6g} (must be {} 0)", x, positive ? ">" : ">="));
+  }
 };
 
 struct Header {
@@ -153,6 +173,43 @@ RunTotals close(Reader& in, const Header& h);
 template <class Table, class B, class F>
 void for_each_array(const Table& table, B& b, F&& f) {
   std::apply([&](const auto&... a) { (f(a.first, b.*(a.second)), ...); }, table);
+}
+
+// Every array of the table holds as many elements as the first. Returns the count.
+template <class Table, class B>
+std::size_t same_lengths(const Table& table, const B& b, const Reader& in) {
+  const auto& first = std::get<0>(table);
+  const std::size_t n = (b.*(first.second)).size();
+  for_each_array(table, b, [&](std::string_view name, const auto& v) {
+    if (v.size() != n)
+      in.fail(fmt::format("is corrupt: '{}' holds {} elements, '{}' {}", name, v.size(), first.first, n));
+  });
+  return n;
+}
+
+// A resume reads into the world built from the scene (`expected` > 0 bodies):
+// the file must hold as many. Checked last, after the checks that say more.
+inline void check_count(const Reader& in, std::size_t n, std::size_t expected) {
+  if (expected > 0 && n != expected)
+    in.fail(fmt::format("holds {} bodies; this scene has {} (a damaged file, or another scene's)", n, expected));
+}
+
+// The warm-start memory: keys strictly increasing (it is searched by
+// bisection), as many impulses as keys, every impulse component finite.
+template <class P>
+void check_warm(const Reader& in, std::string_view keys_name, const std::vector<std::uint64_t>& keys,
+                std::string_view p_name, const std::vector<P>& p) {
+  if (keys.size() != p.size())
+    in.fail(fmt::format("is corrupt: '{}' holds {} elements, '{}' {}", p_name, p.size(), keys_name, keys.size()));
+  for (std::size_t k = 1; k < keys.size(); ++k)
+    if (!(keys[k - 1] < keys[k])) in.bad(keys_name, k, "", "is not greater than the one before (keys must increase)");
+  static_assert(sizeof(P) % sizeof(double) == 0);
+  for (std::size_t k = 0; k < p.size(); ++k)
+    for (std::size_t c = 0; c < sizeof(P) / sizeof(double); ++c) {
+      double x;
+      std::memcpy(&x, reinterpret_cast<const char*>(&p[k]) + c * sizeof(double), sizeof x);
+      in.finite(p_name, k, fmt::format("component {}", c), x);
+    }
 }
 
 }  // namespace ckpt
