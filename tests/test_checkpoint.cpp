@@ -352,9 +352,8 @@ TEST(CdsimRestart, KilledRunResumesBitIdentical) {
 
 // ---- a campaign run killed at half its length ---------------------------------
 
-// Spawns `args` (output to /dev/null) and kills it with SIGKILL as soon as
-// `ready()` holds. Returns false if the run ended first.
-bool run_and_kill_when(std::vector<std::string> args, const std::function<bool()>& ready) {
+// Spawns `args` (output to /dev/null); returns its pid, or -1.
+pid_t spawn(std::vector<std::string> args) {
   std::vector<char*> argv;
   for (auto& s : args) argv.push_back(s.data());
   argv.push_back(nullptr);
@@ -365,17 +364,31 @@ bool run_and_kill_when(std::vector<std::string> args, const std::function<bool()
   pid_t pid;
   const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) return false;
+  return rc == 0 ? pid : -1;
+}
+
+// Spawns `args` and sends it `sig` as soon as `ready()` holds; returns its
+// wait status, or -1 if it ended first.
+int run_and_signal_when(std::vector<std::string> args, const std::function<bool()>& ready, int sig) {
+  const pid_t pid = spawn(std::move(args));
+  if (pid < 0) return -1;
   const auto t0 = std::chrono::steady_clock::now();
   int status = 0;
   while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(300)) {
-    if (waitpid(pid, &status, WNOHANG) == pid) return false;
+    if (waitpid(pid, &status, WNOHANG) == pid) return -1;
     if (ready()) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  kill(pid, SIGKILL);
+  kill(pid, sig);
   waitpid(pid, &status, 0);
-  return WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL;
+  return status;
+}
+
+// Spawns `args` and kills it with SIGKILL as soon as `ready()` holds.
+// Returns false if the run ended first.
+bool run_and_kill_when(std::vector<std::string> args, const std::function<bool()>& ready) {
+  const int status = run_and_signal_when(std::move(args), ready, SIGKILL);
+  return status != -1 && WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL;
 }
 
 // summary.toml as key -> value text.
@@ -645,3 +658,172 @@ TEST(CdsimRestart, ZeroIntervalWritesNoCheckpoint) {
 }
 
 }  // namespace
+
+// ---- signals, one writer, write failures (issue 28) ----------------------------
+
+// What summary.toml says of the run's physics (not of its sessions' cost).
+std::map<std::string, std::string> summary_physics(const fs::path& run) {
+  auto f = summary_fields(run / "summary.toml");
+  std::map<std::string, std::string> p;
+  for (const char* k : {"status", "steps", "total_steps", "sweeps_mean", "sweeps_max", "cap_steps", "cap_share",
+                        "residual_final", "residual_max", "overlap_max"})
+    p[k] = f[k];
+  return p;
+}
+
+// Every data row of series.csv ends in a newline and has the header's fields.
+void expect_whole_rows(const fs::path& series) {
+  const std::string text = slurp(series);
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n') << series << ": the last row is cut";
+  series_cells(series);  // checks each row's field count
+}
+
+// A run stopped mid-interval by SIGINT, SIGTERM or SIGHUP stops at its next
+// series row with a checkpoint there (exit 128 + signal), and SIGKILL stops
+// it anywhere; the same command then ends with the files of a run never
+// stopped: the same series (timers aside), snapshots, collections and
+// summary physics. (Rows come every 25 steps: a signal lands between rows
+// 24 times in 25.)
+TEST(CdsimRestart, AnySignalThenResumeGivesTheUninterruptedRun) {
+  const fs::path d = temp_dir("signals");
+  const fs::path scene = d / "s.toml";
+  spit(scene, kPile);
+  const Result a = cdsim(scene.string() + " --quiet --threads 1 --out " + (d / "A").string());
+  ASSERT_EQ(a.code, 0) << a.out;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGKILL}) {
+    const fs::path B = d / fmt::format("sig{}", sig);
+    const std::vector<std::string> args = {kCdsim, scene.string(), "--quiet", "--threads", "1", "--out", B.string()};
+    const int status = run_and_signal_when(args, [&] {
+      const auto steps = row_steps(B / "series.csv");
+      return !steps.empty() && steps.back() > 300;  // past the first checkpoint (250)
+    }, sig);
+    ASSERT_NE(status, -1) << "the run ended before signal " << sig << ": make the scene bigger";
+    if (sig == SIGKILL) {
+      EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+    } else {
+      ASSERT_TRUE(WIFEXITED(status)) << sig;
+      EXPECT_EQ(WEXITSTATUS(status), 128 + sig);
+      const long last = row_steps(B / "series.csv").back();
+      EXPECT_EQ(last % 25, 0) << "signal " << sig << ": a row that is not a whole interval";
+      cd::World w{cd::WorldParams{}};
+      cd::load_checkpoint((B / "checkpoint.bin").string(), w);
+      EXPECT_EQ(w.steps, last) << "signal " << sig << ": the checkpoint is not at the last row";
+      EXPECT_EQ(summary_fields(B / "summary.toml").at("status"), "\"stopped\"");
+    }
+    expect_whole_rows(B / "series.csv");
+    const long stopped_at = row_steps(B / "series.csv").back();
+    const Result b = cdsim(scene.string() + " --quiet --threads 1 --out " + B.string());
+    ASSERT_EQ(b.code, 0) << "signal " << sig << ": " << b.out;
+    EXPECT_NE(b.out.find("resumed from"), std::string::npos) << b.out;
+    expect_same_outputs(d / "A", B);
+    EXPECT_EQ(summary_physics(d / "A"), summary_physics(B)) << "signal " << sig;
+    std::cout << "signal " << sig << ": the series stopped at step " << stopped_at << "\n";
+  }
+  if (!HasFailure()) fs::remove_all(d);
+}
+
+// One writer per output folder: a second cdsim on a folder that a running
+// one holds is refused (exit 6), naming the folder and the other's pid,
+// and writes nothing; once the first is killed with SIGKILL the lock is gone
+// with it, and the same command resumes.
+TEST(CdsimRestart, ASecondCdsimOnAHeldFolderIsRefused) {
+  const fs::path d = temp_dir("lock");
+  const fs::path scene = d / "s.toml", B = d / "B";
+  spit(scene, kPile);
+  const pid_t pid = spawn({kCdsim, scene.string(), "--quiet", "--threads", "1", "--out", B.string()});
+  ASSERT_GT(pid, 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (row_steps(B / "series.csv").size() < 2 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  const Result second = cdsim(scene.string() + " --quiet --threads 1 --out " + B.string());
+  const Result fresh = cdsim(scene.string() + " --quiet --threads 1 --fresh --out " + B.string());
+  int status = 0;
+  const bool running = waitpid(pid, &status, WNOHANG) == 0;
+  kill(pid, SIGKILL);
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(running) << "the first run ended before the second started: make the scene bigger";
+  for (const Result& r : {second, fresh}) {
+    EXPECT_EQ(r.code, 6) << r.out;
+    EXPECT_NE(r.out.find("output folder '" + B.string() + "' is being written by another cdsim (pid " +
+                         std::to_string(pid) + ")"), std::string::npos) << r.out;
+  }
+  expect_whole_rows(B / "series.csv");
+  EXPECT_EQ(slurp(B / "series.csv").find("step,", 1), std::string::npos) << "a second header";
+  // No stale lock after a kill -9.
+  const Result after = cdsim(scene.string() + " --quiet --threads 1 --out " + B.string());
+  EXPECT_EQ(after.code, 0) << after.out;
+  if (!HasFailure()) fs::remove_all(d);
+}
+
+// Two started together: one runs, the other is refused; the series has one
+// header and no step twice.
+TEST(CdsimRestart, TwoCdsimStartedTogetherOneRuns) {
+  const fs::path d = temp_dir("lock2");
+  const fs::path scene = d / "s.toml", B = d / "B";
+  spit(scene, kPile);
+  const std::vector<std::string> args = {kCdsim, scene.string(), "--quiet", "--threads", "1", "--set",
+                                         "time.duration=0.05", "--out", B.string()};
+  const pid_t p1 = spawn(args), p2 = spawn(args);
+  ASSERT_GT(p1, 0);
+  ASSERT_GT(p2, 0);
+  int s1 = 0, s2 = 0;
+  waitpid(p1, &s1, 0);
+  waitpid(p2, &s2, 0);
+  ASSERT_TRUE(WIFEXITED(s1) && WIFEXITED(s2));
+  std::vector<int> codes = {WEXITSTATUS(s1), WEXITSTATUS(s2)};
+  std::sort(codes.begin(), codes.end());
+  EXPECT_EQ(codes, (std::vector<int>{0, 6}));
+  const auto steps = row_steps(B / "series.csv");
+  EXPECT_TRUE(std::is_sorted(steps.begin(), steps.end()) &&
+              std::adjacent_find(steps.begin(), steps.end()) == steps.end());
+  EXPECT_EQ(slurp(B / "series.csv").find("step,", 1), std::string::npos) << "a second header";
+  if (!HasFailure()) fs::remove_all(d);
+}
+
+// A write that fails mid-run (here: series.csv over a file size limit, the
+// way a full disk fails a write) stops the run with exit 4 and "could not
+// write", not "bad input"; series.csv holds whole rows, the last checkpoint
+// is intact, and once the file can be written the same command resumes to
+// the files of a run never stopped. A snapshot that cannot be put in place
+// (a folder in its way) is the same failure.
+TEST(CdsimRestart, AWriteFailureMidRunIsExitFourAndResumable) {
+  const fs::path d = temp_dir("full");
+  const fs::path scene = d / "s.toml", B = d / "B";
+  // A row every step (1000 rows, about 300 kB of series), no snapshots: the
+  // series outgrows a 100 kB limit after the checkpoint of step 250 (about
+  // 60 kB) was written.
+  std::string text = kPile;
+  text.replace(text.find("series_interval = 0.005"), 23, "series_interval = 2e-4");
+  text.replace(text.find("snapshot_interval = 0.025"), 25, "snapshot_interval = 0.0");
+  spit(scene, text);
+  const std::string args = scene.string() + " --quiet --threads 1 --out ";
+  ASSERT_EQ(cdsim(args + (d / "A").string()).code, 0);
+  const Result full = cdtest::run_command("prlimit --fsize=100000 " + kCdsim + " " + args + B.string());
+  EXPECT_EQ(full.code, 4) << full.out;
+  EXPECT_NE(full.out.find("could not write '" + (B / "series.csv").string() + "'"), std::string::npos) << full.out;
+  EXPECT_EQ(full.out.find("bad input"), std::string::npos) << full.out;
+  EXPECT_LE(fs::file_size(B / "series.csv"), 100000u);
+  expect_whole_rows(B / "series.csv");
+  cd::World w{cd::WorldParams{}};
+  cd::load_checkpoint((B / "checkpoint.bin").string(), w);
+  EXPECT_GE(w.steps, 250);
+  EXPECT_LT(w.steps, row_steps(B / "series.csv").back());
+  const Result b = cdsim(args + B.string());
+  ASSERT_EQ(b.code, 0) << b.out;
+  EXPECT_NE(b.out.find("resumed from"), std::string::npos) << b.out;
+  expect_same_outputs(d / "A", B);
+  EXPECT_EQ(summary_physics(d / "A"), summary_physics(B));
+
+  // A snapshot's place taken by a folder: exit 4, one message, no VTK log.
+  const fs::path C = d / "C";
+  ASSERT_EQ(cdsim(scene.string() + " --quiet --threads 1 --set output.snapshot_interval=0.025"
+                  " --max-steps 130 --out " + C.string()).code, 0);
+  fs::create_directories(C / "particles_00002.vtp" / "x");
+  const Result snap = cdsim(scene.string() + " --quiet --threads 1 --set output.snapshot_interval=0.025 --out " + C.string());
+  EXPECT_EQ(snap.code, 4) << snap.out;
+  EXPECT_NE(snap.out.find("could not write '" + (C / "particles_00002.vtp").string() + "'"), std::string::npos) << snap.out;
+  EXPECT_EQ(std::count(snap.out.begin(), snap.out.end(), '\n'), 1) << snap.out;
+  expect_whole_rows(C / "series.csv");
+  if (!HasFailure()) fs::remove_all(d);
+}

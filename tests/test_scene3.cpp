@@ -342,9 +342,8 @@ TEST(Scene3, CheckpointResumesBitIdenticallyOnOneOrTwoThreads) {
 // Killed and resumed through cdsim: --max-steps 35, then the same command
 // finishes the run from its checkpoint (the second session on 2 threads);
 // the final state and every series value but the wall-clock timers equal a
-// run never stopped. (35 is on a series row: a stop between rows adds a row
-// there, and the next row then covers the rest of its interval only; the
-// state is identical either way, as the test above shows at step 60.)
+// run never stopped. (35 is on a series row; a stop asked between rows
+// waits for the next one.)
 TEST(Scene3, CdsimMaxStepsThenResumeIsBitIdentical) {
   const fs::path A = cdtest::scratch_dir("test_scene3", "straight");
   const fs::path B = cdtest::scratch_dir("test_scene3", "resumed");

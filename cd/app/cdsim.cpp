@@ -5,9 +5,13 @@
 // written; any error is one message naming the problem, and exit code 2.
 // Exit codes: 0 done; 2 bad input (usage, scene, start sample, checkpoint,
 // output folder); 3 the run diverged (non-finite state: the watchdog);
-// 128 + signal when stopped by SIGINT/SIGTERM at a step boundary.
+// 4 could not write (disk full, a file made unwritable: the last checkpoint
+// and the whole rows before it are intact); 6 the output folder is being
+// written by another cdsim; 128 + signal when stopped by SIGINT, SIGTERM or
+// SIGHUP (at the next series row, with a checkpoint when checkpoints are on).
 #include <omp.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -18,6 +22,7 @@
 
 #include "cli_errors.hpp"
 #include "config.hpp"
+#include "files.hpp"
 #include "load.hpp"
 #include "parallel.hpp"
 #include "output.hpp"
@@ -59,8 +64,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1e9));
   std::int64_t max_steps = 0;
   app.add_option("--max-steps", max_steps,
-                 "stop after N steps (a series row and, with checkpoints on, a checkpoint the "
-                 "same command resumes from): to try a scene or a campaign's first steps")
+                 "stop at the first series row at or after N steps (with checkpoints on, a "
+                 "checkpoint the same command resumes from): to try a scene or a campaign's first steps")
       ->check(CLI::PositiveNumber);
   try {
     app.parse(argc, argv);
@@ -70,6 +75,8 @@ int main(int argc, char** argv) {
   }
   // Status lines reach a log file as they are printed, even if the run is killed.
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  // A file size limit (ulimit -f) makes a write fail (exit 4), not kill the run.
+  std::signal(SIGXFSZ, SIG_IGN);
 
   if (app.count("--help-scene")) {
     std::cout << (help_scene == "md" ? cd::parameter_table_markdown() : cd::parameter_table_text());
@@ -153,6 +160,14 @@ int main(int argc, char** argv) {
   } catch (const cd::RunDiverged& e) {
     std::cerr << "cdsim: run diverged: " << e.what() << "\n";
     return 3;
+  } catch (const cd::WriteError& e) {
+    std::cerr << "cdsim: " << e.what()
+              << "; the run stopped there: series.csv holds whole rows and the last checkpoint (if any) "
+                 "is intact, so the same command resumes once the file can be written\n";
+    return 4;
+  } catch (const cd::FolderBusy& e) {
+    std::cerr << "cdsim: " << e.what() << "\n";
+    return 6;
   } catch (const std::exception& e) {
     std::cerr << "cdsim: error: " << e.what() << "\n";
     return 2;

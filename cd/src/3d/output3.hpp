@@ -12,7 +12,7 @@ namespace cd {
 // Writes path (.vtp): points at the sphere centres with point data id,
 // radius, velocity (3), omega (3), orientation (unit quaternion w, x, y, z)
 // and mass. Written to a temporary name and renamed into place; throws
-// OutputError if it cannot be written.
+// WriteError if it cannot be written.
 void write_spheres_vtp(const World3& w, const std::string& path);
 
 // Writes path (.vtp): the last step's contacts as lines, one cell each,

@@ -1,5 +1,6 @@
 #include "checkpoint_io.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -132,20 +133,31 @@ RunTotals close(Reader& in, const Header& h) {
 
 std::vector<std::string> truncate_series(const std::string& path, std::int64_t step) {
   std::ifstream f(path, std::ios::binary);
-  std::string header, line, kept;
-  std::getline(f, header);
+  std::ostringstream all;
+  all << f.rdbuf();
+  const std::string text = std::move(all).str();
+  const auto fields = [](std::string_view l) { return std::count(l.begin(), l.end(), ',') + 1; };
+  std::size_t at = text.find('\n');
+  const std::string header = text.substr(0, at);
+  std::string kept;
   std::int64_t last = 0;  // step of the last row kept
-  while (std::getline(f, line)) {
+  // Whole rows only: a row ends in a newline and has the header's fields. A
+  // row after the checkpoint, or one cut short by a kill or a full disk
+  // (whose step may read small), ends what is kept: steps only grow.
+  while (at != std::string::npos && at + 1 < text.size()) {
+    const std::size_t end = text.find('\n', at + 1);
+    if (end == std::string::npos) break;
+    const std::string_view line = std::string_view(text).substr(at + 1, end - at - 1);
     std::int64_t k = -1;
-    std::from_chars(line.data(), line.data() + line.size(), k);  // "step" is the first column
-    // Rows after the checkpoint, including one cut short by the kill (whose
-    // step may read small): steps only grow.
-    if (k <= last || k > step) break;
-    kept += line + '\n';
+    const auto [ptr, ec] = std::from_chars(line.data(), line.data() + line.size(), k);  // "step" first
+    if (ec != std::errc() || *ptr != ',' || fields(line) != fields(header) || k <= last || k > step) break;
+    kept.append(line).push_back('\n');
     last = k;
+    at = end;
   }
   if (!header.starts_with("step,") || last != step)
-    throw CheckpointError(fmt::format("'{}' does not reach the checkpoint's step {}", path, step));
+    throw CheckpointError(fmt::format("'{}' does not reach the checkpoint's step {} with a whole row "
+                                      "(its last whole row is step {})", path, step, last));
   std::vector<std::string> names;
   for (std::size_t a = 0, b; a <= header.size(); a = b + 1) {
     b = std::min(header.find(',', a), header.size());

@@ -1,8 +1,13 @@
 #include "files.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -13,6 +18,28 @@ namespace cd {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+[[noreturn]] void write_failed(const std::string& path, int err) {
+  throw WriteError(fmt::format("could not write '{}': {}", path, std::strerror(err)));
+}
+
+// Writes all of `text` to fd (write may write less than asked); false with
+// errno set on failure.
+bool write_all(int fd, std::string_view text) {
+  while (!text.empty()) {
+    const ssize_t n = ::write(fd, text.data(), text.size());
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    text.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+}  // namespace
+
 // Unique per process, so two runs writing into one folder do not collide.
 std::string tmp_name(const std::string& path) {
   return path + ".tmp." + std::to_string(::getpid());
@@ -22,8 +49,9 @@ void rename_into_place(const std::string& tmp, const std::string& path) {
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
-    fs::remove(tmp, ec);
-    throw OutputError(fmt::format("cannot write '{}': {}", path, ec.message()));
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw WriteError(fmt::format("could not write '{}': {}", path, ec.message()));
   }
 }
 
@@ -50,17 +78,45 @@ void check_output_dir(const std::string& dir) {
 
 void write_file_atomic(const std::string& path, const std::string& text) {
   const std::string tmp = tmp_name(path);
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << text;
-    f.close();
-    if (!f) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw OutputError(fmt::format("cannot write '{}'", path));
-    }
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) write_failed(path, errno);
+  const bool ok = write_all(fd, text);
+  const int err = errno;
+  if (::close(fd) != 0 || !ok) {
+    const int e = ok ? errno : err;
+    ::unlink(tmp.c_str());
+    write_failed(path, e);
   }
   rename_into_place(tmp, path);
+}
+
+FolderLock::FolderLock(const std::string& dir) {
+  const std::string path = (fs::path(dir) / ".cdsim.lock").string();
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) write_failed(path, errno);
+  struct flock l {};
+  l.l_type = F_WRLCK;
+  l.l_whence = SEEK_SET;  // the whole file (l_start = l_len = 0)
+  if (::fcntl(fd_, F_SETLK, &l) == 0) return;
+  const int err = errno;
+  if (err == EACCES || err == EAGAIN) {
+    struct flock q {};
+    q.l_type = F_WRLCK;
+    q.l_whence = SEEK_SET;
+    std::string who = "another cdsim";
+    if (::fcntl(fd_, F_GETLK, &q) == 0 && q.l_type != F_UNLCK && q.l_pid > 0)
+      who += fmt::format(" (pid {})", q.l_pid);
+    ::close(fd_);
+    fd_ = -1;
+    throw FolderBusy(fmt::format("output folder '{}' is being written by {}, which holds its lock '{}'; "
+                                 "wait for it to end, or choose another --out", dir, who, path));
+  }
+  std::fprintf(stderr, "cdsim: warning: cannot lock '%s' (%s): nothing stops a second cdsim from writing "
+               "into this folder\n", path.c_str(), std::strerror(err));
+}
+
+FolderLock::~FolderLock() {
+  if (fd_ >= 0) ::close(fd_);  // releases the lock
 }
 
 // ---------------------------------------------------------------------------
@@ -69,8 +125,9 @@ void write_file_atomic(const std::string& path, const std::string& text) {
 // The file is truncated here, so a rerun into the same folder does not append
 // to an old series; the header goes out with the first flush.
 Series::Series(const std::string& path) : path_(path) {
-  std::ofstream f(path_, std::ios::trunc);
-  if (!f) throw OutputError(fmt::format("cannot write '{}'", path_));
+  const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) write_failed(path_, errno);
+  ::close(fd);
 }
 
 void Series::row(const std::vector<std::pair<std::string, double>>& cols) {
@@ -101,10 +158,21 @@ void Series::row(const std::vector<std::pair<std::string, double>>& cols) {
 
 void Series::flush() {
   if (buf_.empty()) return;
-  std::ofstream f(path_, std::ios::app);
-  f << buf_;
-  f.close();
-  if (!f) throw OutputError(fmt::format("cannot write '{}'", path_));
+  const int fd = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  if (fd < 0) write_failed(path_, errno);
+  struct stat st {};
+  const bool sized = ::fstat(fd, &st) == 0;
+  if (!write_all(fd, buf_)) {
+    // No half row: the file goes back to its last whole row.
+    const int err = errno;
+    if (sized) {
+      const int r = ::ftruncate(fd, st.st_size);  // if this fails too, a resume cuts the row off
+      (void)r;
+    }
+    ::close(fd);
+    write_failed(path_, err);
+  }
+  if (::close(fd) != 0) write_failed(path_, errno);
   buf_.clear();
 }
 

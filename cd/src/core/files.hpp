@@ -14,6 +14,37 @@ struct OutputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A write that failed while the run went on (disk full, a file made
+// unwritable, an I/O error): not bad input, and reported as such (cdsim
+// exits 4). The message says "could not write" and names the file and the
+// system's reason.
+struct WriteError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Another process holds the output folder (cdsim exits 6): the message names
+// the folder and the other process.
+struct FolderBusy : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// One writer per output folder: an advisory write lock (fcntl) on
+// DIR/.cdsim.lock, an empty file created once and left in place, held while
+// this object lives. The kernel drops it when the process ends, however it
+// ends (kill -9 too), so no stale lock survives a crash. A second cdsim on
+// the folder throws FolderBusy naming it and the holder's pid. On a file
+// system without locks (some network mounts) it warns and runs unguarded.
+class FolderLock {
+ public:
+  explicit FolderLock(const std::string& dir);
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+  ~FolderLock();
+
+ private:
+  int fd_ = -1;
+};
+
 // Throws OutputError naming the folder if it cannot be created or written.
 // Creates nothing: it checks the nearest existing ancestor.
 void check_output_dir(const std::string& dir);
@@ -24,10 +55,14 @@ void check_output_dir(const std::string& dir);
 std::string tmp_name(const std::string& path);
 void rename_into_place(const std::string& tmp, const std::string& path);
 
-// Writes `text` to `path` atomically (temporary file, then rename).
+// Writes `text` to `path` atomically (temporary file, then rename). Throws
+// WriteError if any part fails, removing the temporary file: `path` is
+// then as it was.
 void write_file_atomic(const std::string& path, const std::string& text);
 
 // series.csv: one row per output interval, columns named by the first row.
+// Rows are written whole: a flush that fails part-way (disk full) cuts the
+// file back to its length before it and throws WriteError.
 class Series {
  public:
   explicit Series(const std::string& path);

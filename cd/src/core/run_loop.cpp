@@ -42,8 +42,19 @@ std::string toml_float(double x) {
   return t;
 }
 
+// The first SIGINT, SIGTERM or SIGHUP asks the run to stop at its next series
+// row, where a checkpoint falls as it always does, so that the resumed run is
+// the one never stopped; a second one of them ends the process at once, as a
+// kill would (the resume then starts from the last checkpoint).
 volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_stop(int sig) { g_stop = sig; }
+extern "C" void on_stop(int sig) {
+  if (g_stop != 0) {
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+    return;
+  }
+  g_stop = sig;
+}
 
 // Removes the files an earlier run wrote in the folder, so that a shorter
 // run does not leave stale snapshots behind.
@@ -125,6 +136,7 @@ std::string summary_toml(const RunSummary& s) {
 void install_stop_handlers() {
   std::signal(SIGINT, on_stop);
   std::signal(SIGTERM, on_stop);
+  std::signal(SIGHUP, on_stop);
 }
 
 
@@ -146,6 +158,10 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
 
   // Resume from a checkpoint of this scene; checked before anything is written.
   const std::uint64_t key = plan.key;
+  // One writer per folder: locked before the checkpoint is read (an existing
+  // folder) or as soon as the folder is made.
+  std::optional<FolderLock> lock;
+  if (fs::is_directory(dir)) lock.emplace(opt.out);
   const bool resume = !opt.fresh && fs::exists(ckpt);
   std::vector<std::string> columns;  // of series.csv, cut back to the checkpoint
   std::vector<std::string> timing_columns;  // of timings.csv, likewise
@@ -184,6 +200,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   warn_long(every_ckpt_strain, fmt::format("output.checkpoint_strain = {}", plan.checkpoint_strain));
 
   fs::create_directories(opt.out);
+  if (!lock) lock.emplace(opt.out);
   if (!resume) clear_previous(opt.out);
   write_file_atomic((dir / "scene.toml").string(), opt.scene_toml);
   // On resume, the snapshots up to the checkpoint are known by their steps
@@ -240,6 +257,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   if (every_snap && !resume) timed_output([&] { w.write_snapshot(); });
 
   std::int64_t k_end = nsteps;  // the last step taken (earlier if stopped by a signal)
+  bool stop_seen = false;       // a signal's stop was announced
   for (std::int64_t k = k0 + 1; k <= nsteps; ++k) {
     try {
       w.step();
@@ -254,8 +272,18 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): non-finite state: {}; series.csv "
                                     "holds the rows before it{}", k, w.time(), bad,
                                     checkpoints ? ", checkpoint.bin (if written) the last good state" : ""));
-    const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps;
-    const bool stopping = g_stop != 0 || at_limit;
+    // A stop (signal or --max-steps) waits for the next series row: rows are
+    // whole intervals, and a checkpoint there resumes to the same series.
+    const bool row_due = k % every_row == 0 || k == nsteps;
+    if (g_stop != 0 && !stop_seen) {
+      stop_seen = true;
+      if (!row_due)
+        std::fprintf(stderr, "%scdsim: signal %d: stopping at the next series row (step %lld); a second "
+                     "signal stops at once\n", progress ? "\n" : "", int(g_stop),
+                     static_cast<long long>(std::min(nsteps, (k / every_row + 1) * every_row)));
+    }
+    const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps && row_due;
+    const bool stopping = (g_stop != 0 && row_due && k < nsteps) || at_limit;
     if (stopping) k_end = k;
     w.after_step(k);
     iv.add(st);
@@ -272,7 +300,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     tot.residual_last = st.solve.residual_max;
     tot.overlap_max = std::max(tot.overlap_max, st.max_overlap);
 
-    if (k % every_row == 0 || k == nsteps || stopping) {
+    if (row_due) {
       timed_output([&] {
         const StageTimes& t = w.times();
         Columns cols = {{"step", double(k)},

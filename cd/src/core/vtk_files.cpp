@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include <fmt/format.h>
+#include <vtkErrorCode.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataWriter.h>
@@ -21,10 +22,21 @@ void write_vtp(vtkPolyData* pd, const std::string& path) {
   w->EncodeAppendedDataOff();  // raw binary, not base64
   w->SetCompressorTypeToZLib();
   w->SetHeaderTypeToUInt64();  // no 4 GB limit on a data block
-  if (w->Write() != 1 || w->GetErrorCode() != 0) {
+  // A failure (disk full) is one message, not VTK's log on stderr.
+  const int shown = vtkObject::GetGlobalWarningDisplay();
+  vtkObject::GlobalWarningDisplayOff();
+  const bool ok = w->Write() == 1 && w->GetErrorCode() == 0;
+  vtkObject::SetGlobalWarningDisplay(shown);
+  if (!ok) {
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
-    throw OutputError(fmt::format("cannot write '{}'", path));
+    const unsigned long code = w->GetErrorCode();
+    throw WriteError(fmt::format("could not write '{}': {}", path,
+                                 code == vtkErrorCode::OutOfDiskSpaceError
+                                     ? "no space left on the device (or over the file size limit)"
+                                 : code == vtkErrorCode::CannotOpenFileError
+                                     ? "the file cannot be created"
+                                     : fmt::format("VTK's writer failed (error code {})", code)));
   }
   rename_into_place(tmp, path);
 }

@@ -11,7 +11,7 @@ class vtkPolyData;
 namespace cd {
 
 // Appended raw binary, zlib-compressed, 64-bit headers (no 4 GB limit on a
-// data block). Throws OutputError naming `path` when it cannot be written.
+// data block). Throws WriteError naming `path` when it cannot be written.
 void write_vtp(vtkPolyData* pd, const std::string& path);
 
 // The .pvd text listing <stem>_<num>.vtp for every (time, num) of `frames`.
