@@ -278,6 +278,107 @@ TEST(BadInput, CdproblemRefusesBadOptionsAndTrailingText) {
   }
 }
 
+// The .cdp reader (issue 28 item 4) refuses what no step can hold: a
+// negative mu, adhesion or inverse mass, a contact of a body with itself, a
+// tolerance outside (0, 1], a residual tolerance <= 0, and counts the rest
+// of the file cannot hold (refused before anything is allocated); each
+// names the file, the line and the quantity.
+TEST(BadInput, CdpReaderRefusesWhatNoStepCanHold) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "cdp");
+  const fs::path sc = write(dir, "s.toml", kScene);
+  ASSERT_EQ(cdsim(sc.string() + " -q --dump-problem 3 --out " + (dir / "run").string()).code, 0);
+  const fs::path cdp = dir / "run" / "problem_3.cdp";
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(cdp);
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+  }
+  const auto at = [&](const std::string& head) {
+    for (std::size_t i = 0; i < lines.size(); ++i)
+      if (lines[i].rfind(head, 0) == 0) return i;
+    return lines.size();
+  };
+  const std::size_t tol = at("tol "), bodies = at("bodies "), rows = at("rows ");
+  ASSERT_LT(rows + 1, lines.size());
+  ASSERT_EQ(std::count(lines[rows + 1].begin(), lines[rows + 1].end(), ' '), 16) << lines[rows + 1];
+  // A line's tokens, one replaced.
+  const auto with_token = [](std::string line, int k, const std::string& v) {
+    std::vector<std::string> t;
+    std::stringstream ss(line);
+    for (std::string x; ss >> x;) t.push_back(x);
+    t.at(k) = v;
+    std::string out;
+    for (std::size_t i = 0; i < t.size(); ++i) out += (i ? " " : "") + t[i];
+    return out;
+  };
+  const cdtest::CmdResult good = cdtest::run_command(kCdproblem + " solve " + cdp.string());
+  ASSERT_EQ(good.code, 0) << good.out;
+  struct Case {
+    std::size_t line;
+    std::string text, named;
+  };
+  const std::vector<Case> cases = {
+      {tol, "tol 0x0p+0", "the tolerance is 0"},
+      {tol, "tol -0x1p-10", "the tolerance is"},
+      {tol, "tol 0x1p+1", "the tolerance is 2, expected in (0, 1]"},
+      {0, "", ""},  // residual_tol 0: inserted below
+      {bodies, "bodies 2000000000", "the number of bodies is 2000000000, but the rest of the file holds only"},
+      {bodies + 1, with_token(lines[bodies + 1], 3, "-0x1p+0"), "inv_m of body 0 is -1"},
+      {bodies + 1, with_token(lines[bodies + 1], 4, "-0x1p+0"), "inv_I of body 0 is -1"},
+      {rows, "rows 2000000000", "the number of rows is 2000000000, but the rest of the file holds only"},
+      {rows + 1, with_token(with_token(lines[rows + 1], 0, "1"), 1, "1"), "the contact of row 0 joins body 1 to itself"},
+      {rows + 1, with_token(lines[rows + 1], 15, "-0x1p-2"), "the friction coefficient mu of row 0 is -0.25"},
+      {rows + 1, with_token(lines[rows + 1], 16, "-0x1p-2"), "the adhesion impulse of row 0 is -0.25"},
+  };
+  for (Case c : cases) {
+    std::vector<std::string> bad = lines;
+    if (c.named.empty()) {  // residual_tol 0, inserted where the reader looks for it
+      const std::size_t mp = at("min_parallel ");
+      bad.insert(bad.begin() + static_cast<long>(mp) + 1, "residual_tol 0x0p+0");
+      c.named = "the residual tolerance is 0";
+      c.line = mp + 1;
+    } else {
+      bad[c.line] = c.text;
+    }
+    std::string text;
+    for (const std::string& l : bad) text += l + "\n";
+    const fs::path p = write(dir, "bad.cdp", text);
+    const cdtest::CmdResult r = cdtest::run_command(kCdproblem + " solve " + p.string());
+    EXPECT_EQ(r.code, 2) << c.named << "\n" << r.out;
+    EXPECT_NE(r.out.find(p.string() + ":" + std::to_string(c.line + 1) + ": " + c.named), std::string::npos)
+        << c.named << "\n" << r.out;
+  }
+}
+
+// Options refused by name, NaN included (CLI11's ranges let NaN through, and
+// it then meant "not given"), and --threads, which the run's scene.toml
+// records, in solver.threads' range; a dump past the run's end is refused
+// before anything is written.
+TEST(BadInput, NanAndOutOfRangeOptionsAreRefusedByName) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "options");
+  const std::string ok = "2\n1\n0\n2 2\n2 2\n1 0\n0 1\n-1 0\n0.5\n";
+  const fs::path good = write(dir, "ok.dat", ok);
+  for (const std::string opt : {"--residual-tol nan", "--residual-tol -1", "--residual-tol inf", "--tol inf",
+                                "--tol nan"}) {
+    const cdtest::CmdResult r = cdtest::run_command(kCdproblem + " solve " + good.string() + " " + opt);
+    EXPECT_EQ(r.code, 2) << opt << "\n" << r.out;
+    EXPECT_NE(r.out.find(opt.substr(0, opt.find(' '))), std::string::npos) << opt << "\n" << r.out;
+  }
+  const fs::path sc = write(dir, "s.toml", kScene);
+  for (const std::string opt : {"--threads -1", "--threads 100000", "--threads nan", "--dump-problem 11"}) {
+    const fs::path out = dir / "out";
+    const cdtest::CmdResult r = cdsim(sc.string() + " -q " + opt + " --out " + out.string());
+    EXPECT_EQ(r.code, 2) << opt << "\n" << r.out;
+    EXPECT_NE(r.out.find(opt.substr(0, opt.find(' '))), std::string::npos) << opt << "\n" << r.out;
+    EXPECT_FALSE(fs::exists(out)) << opt;
+  }
+  const cdtest::CmdResult r = cdsim(sc.string() + " -q --dump-problem 11 --out " + (dir / "out").string());
+  EXPECT_NE(r.out.find("the run's last step is 10"), std::string::npos) << r.out;
+  // In range: the run's scene.toml records it and reads back.
+  ASSERT_EQ(cdsim(sc.string() + " -q --threads 1024 --out " + (dir / "t").string()).code, 0);
+  EXPECT_EQ(cdsim((dir / "t" / "scene.toml").string() + " -q --out " + (dir / "t2").string()).code, 0);
+}
+
 // Continuation (issue 19): a run may start from a sheared run's checkpoint.
 // The Lees-Edwards offset and the cell rates are carried, the mean flow is
 // replaced by the new rate's profile, and the first rows overlap no more than

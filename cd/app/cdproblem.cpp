@@ -24,6 +24,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "cli_checks.hpp"
 #include "cli_errors.hpp"
 #include "contact_problem3.hpp"
 #include "lemke.hpp"
@@ -218,13 +219,7 @@ int main(int argc, char** argv) {
   bool lemke = false;
   cmd->add_option("file", path, "problem file (.dat: Siconos matrix form, 2D or 3D; .cdp, .cdp3: a 2D or 3D step dumped by cdsim; .hdf5: FCLib 3D)")->required();
   cmd->add_option("--tol", opt.tol, "tolerance on the sweep's rms |dr|/mean|r| (the production test), in (0, 1]")
-      ->check(CLI::Validator(
-          [](std::string& v) {
-            char* end = nullptr;
-            const double x = std::strtod(v.c_str(), &end);
-            return *end == '\0' && x > 0 && x <= 1 ? std::string() : "must be a number in (0, 1]";
-          },
-          "in (0, 1]"))
+      ->check(cd::finite_range(0.0, 1.0, true))
       ->capture_default_str();
   cmd->add_option("--max-sweeps", opt.max_sweeps, "sweep cap")
       ->check(CLI::Range(1, 100000000))
@@ -243,7 +238,7 @@ int main(int argc, char** argv) {
   cmd->add_option("--residual-tol", residual_tol,
                   "(.cdp, .cdp3) also stop when the largest law residual is below this (checked every 10 "
                   "sweeps; solver.residual_tol); 0: off; default: the step's own")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(cd::finite_range(0.0, 1.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -41,7 +41,8 @@ int main(int argc, char** argv) {
   app.add_option("scene", scene_path, "scene file (TOML)");
   app.add_option("--set", sets, "override a parameter: section.key=value (repeatable)");
   app.add_option("--out", out, "output folder (default: outputs/<scene name>)");
-  app.add_option("--threads", threads, "OpenMP threads (default: solver.threads, 0 = all)");
+  app.add_option("--threads", threads, "OpenMP threads, 0 to 1024 (default: solver.threads, 0 = all)")
+      ->check(CLI::Range(0, 1024));  // solver.threads' range: the resolved scene.toml must read back
   app.add_flag("--quiet,-q", quiet, "no progress line on stderr");
   app.add_flag("--fresh", fresh, "start over, discarding a checkpoint in the output folder");
   app.add_option("--help-scene", help_scene,

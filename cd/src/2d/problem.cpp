@@ -167,7 +167,7 @@ ContactProblem read_contact_problem(std::istream& in, const std::string& name, S
   p.rotation = rd.integer("rotation (0 or 1)", 0, 1) == 1;
   problem_file::read_solver(rd, prm, "after rotation");
   rd.expect("bodies", "after the solver's parameters");
-  const long long nb = rd.integer("the number of bodies", 0, INT_MAX);
+  const long long nb = rd.count("the number of bodies", INT_MAX, 5);
   p.vel.resize(nb);
   for (long long i = 0; i < nb; ++i) {
     BodyVel& v = p.vel[i];
@@ -175,29 +175,31 @@ ContactProblem read_contact_problem(std::istream& in, const std::string& name, S
     v.vx = rd.number("vx" + w);
     v.vy = rd.number("vy" + w);
     v.w = rd.number("w" + w);
-    v.inv_m = rd.number("inv_m" + w);
-    v.inv_I = rd.number("inv_I" + w);
+    v.inv_m = rd.non_negative("inv_m" + w);
+    v.inv_I = rd.non_negative("inv_I" + w);
   }
   p.colouring = problem_file::read_colouring(rd, 64, "after the bodies");
-  const long long nr = problem_file::read_row_count(rd, p.colouring);
+  const long long nr = problem_file::read_row_count(rd, p.colouring, 17);
   p.rows.resize(nr);
   for (long long k = 0; k < nr; ++k) {
     ContactRow& r = p.rows[k];
     const std::string w = fmt::format(" of row {}", k);
     problem_file::read_row_bodies(rd, r, nb, w);
     for (double* f : {&r.nx, &r.ny, &r.c1n, &r.c1t, &r.c2n, &r.c2t, &r.wnn, &r.wnt, &r.wtt,
-                      &r.bn, &r.bt, &r.pn, &r.pt, &r.mu, &r.adh})
+                      &r.bn, &r.bt, &r.pn, &r.pt})
       *f = rd.number("a number" + w);
+    r.mu = rd.non_negative("the friction coefficient mu" + w);
+    r.adh = rd.non_negative("the adhesion impulse" + w);
     if (!(r.wnn > 0)) rd.fail(fmt::format("W_nn{} is {}, not positive", w, r.wnn));
   }
   rd.expect("dofs", "after the rows");
-  const long long nd = rd.integer("the number of dofs", 0, 16);
+  const long long nd = rd.count("the number of dofs", 16, 5);
   p.dofs.resize(nd);
   for (long long d = 0; d < nd; ++d) {
     BoundaryDof& D = p.dofs[d];
     const std::string w = fmt::format(" of dof {}", d);
     problem_file::read_dof_scalars(rd, D, w);
-    const long long m = rd.integer("the number of rows" + w, 0, nr);
+    const long long m = rd.count("the number of rows" + w, nr, 3);
     D.rows.resize(m);
     D.an.resize(m);
     D.at.resize(m);

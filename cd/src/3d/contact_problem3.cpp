@@ -113,7 +113,7 @@ ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name,
     if (v.inv_m < 0 || v.inv_I < 0) rd.fail(fmt::format("negative inverse mass or inertia{}", w));
   }
   p.colouring = problem_file::read_colouring(rd, 1 << 16, "after the bodies");
-  const long long nr = problem_file::read_row_count(rd, p.colouring);
+  const long long nr = problem_file::read_row_count(rd, p.colouring, 3);  // b1, b2 and numbers
   p.rows.resize(nr);
   for (long long k = 0; k < nr; ++k) {
     SphereRow& r = p.rows[k];

@@ -30,14 +30,15 @@ inline void write_solver(std::ostream& out, const SolverParams& prm) {
 
 inline void read_solver(TextReader& rd, SolverParams& prm, const std::string& after) {
   rd.expect("tol", after);
-  prm.tol = rd.number("the tolerance");
+  prm.tol = rd.non_negative("the tolerance", true);
+  if (prm.tol > 1) rd.fail(fmt::format("the tolerance is {}, expected in (0, 1]", prm.tol));
   rd.expect("max_iter", "after tol");
   prm.max_iter = static_cast<int>(rd.integer("the sweep cap", 1, INT_MAX));
   rd.expect("min_parallel", "after max_iter");
   prm.min_parallel = static_cast<int>(rd.integer("the parallel threshold", 0, INT_MAX));
   if (rd.peek() == "residual_tol") {  // optional: written when > 0
     rd.token();
-    prm.residual_tol = rd.number("the residual tolerance");
+    prm.residual_tol = rd.non_negative("the residual tolerance", true);
   }
 }
 
@@ -59,7 +60,8 @@ inline Colouring read_colouring(TextReader& rd, long long max_colours, const std
   col.overflow = rd.integer("overflow (0 or 1)", 0, 1) == 1;
   rd.expect("start", "after the colour count");
   col.start.resize(nc + 1);
-  for (auto& v : col.start) v = static_cast<std::int32_t>(rd.integer("a colour start", 0, INT_MAX));
+  std::int32_t prev = 0;  // starts never decrease
+  for (auto& v : col.start) prev = v = static_cast<std::int32_t>(rd.integer("a colour start", prev, INT_MAX));
   rd.expect("split", "after the colour starts");
   col.split.resize(nc);
   for (long long c = 0; c < nc; ++c)
@@ -67,20 +69,22 @@ inline Colouring read_colouring(TextReader& rd, long long max_colours, const std
   return col;
 }
 
-// "rows R" after the colouring, which must cover the rows [0, R) in order.
-inline long long read_row_count(TextReader& rd, const Colouring& c) {
+// "rows R" after the colouring, which must cover the rows [0, R) in order;
+// a row takes at least `tokens_each` numbers (R is bounded by the file).
+inline long long read_row_count(TextReader& rd, const Colouring& c, long long tokens_each) {
   rd.expect("rows", "after the colouring");
-  const long long nr = rd.integer("the number of rows", 0, INT_MAX);
+  const long long nr = rd.count("the number of rows", INT_MAX, tokens_each);
   if (c.start.front() != 0 || c.start.back() != nr)
     rd.fail(fmt::format("the colours cover rows {} to {}, the problem has {}", c.start.front(), c.start.back(), nr));
   return nr;
 }
 
-// A row's two bodies, each in [0, nb).
+// A row's two bodies, each in [0, nb), and not the same one.
 template <class Row>
 void read_row_bodies(TextReader& rd, Row& r, long long nb, const std::string& w) {
   r.b1 = static_cast<std::int32_t>(rd.integer("body 1" + w, 0, nb - 1));
   r.b2 = static_cast<std::int32_t>(rd.integer("body 2" + w, 0, nb - 1));
+  if (r.b1 == r.b2) rd.fail(fmt::format("the contact{} joins body {} to itself (body 1 = body 2)", w, r.b1));
 }
 
 // "law NAME": the alternative of the law variant V whose name(law) is NAME.
@@ -110,7 +114,7 @@ template <class Dof>
 void read_dof_scalars(TextReader& rd, Dof& d, const std::string& w) {
   d.v0 = rd.number("v0" + w);
   d.v = rd.number("v" + w);
-  d.inv_mass = rd.number("inv_mass" + w);
+  d.inv_mass = rd.non_negative("inv_mass" + w);
   d.scale = rd.number("scale" + w);
 }
 

@@ -158,6 +158,10 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
 
   // Resume from a checkpoint of this scene; checked before anything is written.
   const std::uint64_t key = plan.key;
+  // A dump the run never reaches would be silently missing.
+  for (const std::int64_t k : opt.dump_steps)
+    if (k > nsteps)
+      throw std::invalid_argument(fmt::format("--dump-problem {}: the run's last step is {}", k, nsteps));
   // One writer per folder: locked before the checkpoint is read (an existing
   // folder) or as soon as the folder is made.
   std::optional<FolderLock> lock;

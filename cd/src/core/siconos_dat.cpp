@@ -56,6 +56,8 @@ void read_sparse(TextReader& rd, long long n, Triplets& t) {
   if (m != n || nn != n)
     rd.fail(fmt::format("sparse W says {}x{}, header said {}x{}", m, nn, n, n));
   if (nnz < 0 || nnz > n * n) rd.fail(fmt::format("nnz {} is impossible for {}x{}", nnz, n, n));
+  // An entry is at least "i : v" (3 tokens): the file's own length bounds it.
+  if (nnz > rd.remaining_tokens() / 3) rd.fail(fmt::format("nnz {}: unexpected end of file before its entries", nnz));
   t.reserve(nnz);
   if (triplet) {
     for (long long p = 0; p < nnz; ++p) {

@@ -102,6 +102,40 @@ class TextReader {
     return v;
   }
 
+  // A finite number >= 0 (> 0 if `positive`).
+  double non_negative(const std::string& what, bool positive = false) {
+    const double v = number(what);
+    if (positive ? !(v > 0) : !(v >= 0)) fail(fmt::format("{} is {}, expected {} 0", what, v, positive ? ">" : ">="));
+    return v;
+  }
+
+  // A count of items that take at least `tokens_each` tokens each: bounded
+  // by what the rest of the file holds, so that a damaged header is refused
+  // before anything is allocated for it.
+  long long count(const std::string& what, long long hi, long long tokens_each) {
+    const long long v = integer(what, 0, hi);
+    const long long left = remaining_tokens();
+    if (v > left / tokens_each)
+      fail(fmt::format("{} is {}: unexpected end of file, {} numbers left where {} are needed", what, v, left,
+                       v * tokens_each));
+    return v;
+  }
+
+  // Tokens from the cursor to the end of the file.
+  long long remaining_tokens() const {
+    long long n = 0;
+    for (std::size_t li = li_; li < lines_.size(); ++li) {
+      const std::string& l = lines_[li];
+      bool in = false;
+      for (std::size_t c = li == li_ ? col_ : 0; c < l.size(); ++c) {
+        const bool space = std::isspace(static_cast<unsigned char>(l[c])) != 0;
+        n += !space && !in;
+        in = !space;
+      }
+    }
+    return n;
+  }
+
  private:
   std::string name_;
   std::vector<std::string> lines_;
