@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -377,6 +378,29 @@ TEST(BadInput, NanAndOutOfRangeOptionsAreRefusedByName) {
   // In range: the run's scene.toml records it and reads back.
   ASSERT_EQ(cdsim(sc.string() + " -q --threads 1024 --out " + (dir / "t").string()).code, 0);
   EXPECT_EQ(cdsim((dir / "t" / "scene.toml").string() + " -q --out " + (dir / "t2").string()).code, 0);
+}
+
+// A 3D contact.axis_a whose norm under- or overflows is still the direction
+// it gives (issue 28 item 7): [1e-300, 0, 0] runs as [1, 0, 0] and
+// [1e308, 1e308, 0] as [1, 1, 0], byte for byte, where a plain norm dropped
+// the orthotropic cone; [0, 1, 0] differs, so the axis is seen.
+TEST(BadInput, AxisAOfExtremeLengthIsItsDirection) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "axis_a");
+  const auto series = [&](const std::string& axis) {
+    const fs::path out = dir / "out";
+    fs::remove_all(out);
+    const cdtest::CmdResult r = cdsim(std::string(CDLAB_SOURCE_DIR) + "/configs/pile3d.toml -q --threads 1 "
+                                      "--set particles.n=27 --set time.duration=0.06 --set gravity.g=[0,0,-2000] "
+                                      "--set output.series_interval=0.002 --set contact.mu_b=0.05 "
+                                      "--set contact.axis_a=" + axis + " --out " + out.string());
+    EXPECT_EQ(r.code, 0) << axis << "\n" << r.out;
+    std::ifstream in(out / "series.csv");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string x = series("[1,0,0]"), xy = series("[1,1,0]");
+  EXPECT_EQ(series("[1e-300,0,0]"), x);
+  EXPECT_EQ(series("[1e308,1e308,0]"), xy);
+  EXPECT_NE(series("[0,1,0]"), x);
 }
 
 // Continuation (issue 19): a run may start from a sheared run's checkpoint.

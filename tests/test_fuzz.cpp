@@ -188,6 +188,12 @@ TEST(Fuzz, MutatedScenesRunCleanlyOrAreRefusedCleanly) {
     const cdtest::CmdResult r = cdtest::run_command(kTimeout + kBin + "/cd/cdsim " + sc.string() +
                                                     " --max-steps 8 -q --threads 1 --out " + out.string());
     const std::string id = "case " + std::to_string(c) + " (" + what + ")\n" + scene + "\n" + r.out;
+    // summary.toml never holds inf or nan, whether the run ended or diverged.
+    if (fs::exists(out / "summary.toml")) {
+      const std::string sum = slurp(out / "summary.toml");
+      EXPECT_EQ(sum.find(" = nan"), std::string::npos) << sum << id;
+      EXPECT_EQ(sum.find("inf"), std::string::npos) << sum << id;
+    }
     if (r.code == 0) {
       ++ran;
       std::string bad;
@@ -430,7 +436,9 @@ void corrupt_systematically(const std::string& label, const std::string& cmd, co
   const std::vector<CkptArray> arrays = ckpt_arrays(good);
   ASSERT_GE(arrays.size(), 12u);
   for (const CkptArray& a : arrays) {
-    if (a.name.find("warm.p") != std::string::npos) ASSERT_GT(a.count, 0u) << "no contacts: warm start untested";
+    if (a.name.find("warm.p") != std::string::npos) {
+      ASSERT_GT(a.count, 0u) << "no contacts: warm start untested";
+    }
   }
   const std::map<std::string, std::string> before = folder(out);
   const std::vector<Mutant> ms = mutants(good);

@@ -184,7 +184,9 @@ WorldParams3 world_params3(const Scene& s0) {
   // Orthotropic Coulomb: on when mu_b or mu_wall_b is set (>= 0).
   if (s.mu_b >= 0 || s.mu_wall_b >= 0) {
     p.orthotropic = true;
-    p.axis_a = Vec3(s.axis_a[0], s.axis_a[1], s.axis_a[2]).normalized();
+    // Scaled first: a direction given as [1e-300, 0, 0] or [1e308, 1e308, 0]
+    // is a direction (a plain norm under- or overflows and drops it).
+    p.axis_a = Vec3(s.axis_a[0], s.axis_a[1], s.axis_a[2]).stableNormalized();
     p.mu_b = s.mu_b >= 0 ? s.mu_b : s.mu;
     p.mu_wall_b = s.mu_wall_b >= 0 ? s.mu_wall_b : (s.mu_wall < 0 ? p.mu_b : s.mu_wall);
   }

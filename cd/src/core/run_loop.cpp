@@ -276,6 +276,16 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): non-finite state: {}; series.csv "
                                     "holds the rows before it{}", k, w.time(), bad,
                                     checkpoints ? ", checkpoint.bin (if written) the last good state" : ""));
+    // The step's statistics go into the run's totals (summary.toml, which
+    // must never hold inf or nan): a non-finite one is a divergence, caught
+    // before it is counted.
+    for (const auto& [name, x] : {std::pair{"law residual", st.solve.residual_max},
+                                  std::pair{"mean law residual", st.solve.residual_mean},
+                                  std::pair{"largest overlap", st.max_overlap},
+                                  std::pair{"largest overlap of the smaller grain", st.max_overlap_small}})
+      if (!std::isfinite(x))
+        throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): the step's {} is {}; series.csv holds the "
+                                          "rows before it", k, w.time(), name, x));
     // A stop (signal or --max-steps) waits for the next series row: rows are
     // whole intervals, and a checkpoint there resumes to the same series.
     const bool row_due = k % every_row == 0 || k == nsteps;
