@@ -380,6 +380,41 @@ TEST(BadInput, NanAndOutOfRangeOptionsAreRefusedByName) {
   EXPECT_EQ(cdsim((dir / "t" / "scene.toml").string() + " -q --out " + (dir / "t2").string()).code, 0);
 }
 
+// Finite but absurd values (issue 28 items 8, 9, 12, 16): every scene
+// number is 0 or between 1e-100 and 1e100 in magnitude (docs/errors.md
+// says why); a grain whose mass or inertia under- or overflows is refused
+// in 2D as in 3D; a body outside the box, which would fall for ever, is
+// refused; a name that would write outside outputs/ is refused; a region of
+// more lattice sites than an int holds is no overflow in a message.
+TEST(BadInput, AbsurdValuesAndBodiesOutsideTheBoxAreRefused) {
+  const std::string box = "name = \"box\"\n[time]\ndt = 1e-3\nduration = 0.01\n[box]\nwidth = 4.0\nheight = 4.0\n";
+  const std::string range = "between 1e-100 and 1e+100 in magnitude";
+  expect_refused("--set gravity.g=[0,-1e308]", {"gravity.g: element 1 is -1e+308", range});
+  expect_refused("--set contact.mu=1e300", {"contact.mu = 1e+300", range});
+  expect_refused("--set particles.density=1e-300", {"particles.density = 1e-300", range});
+  expect_refused("--set particles.density=1e300", {"particles.density = 1e+300", range});
+  expect_refused("", {"disk[0].omega = 1e+308", range}, box + "[[disk]]\npos = [1.0, 1.0]\nradius = 0.5\nomega = 1e308\n");
+  expect_refused("--set particles.d_mean=1e-300 --set particles.n=10 --set particles.region=[0,0,1,1]",
+                 {"particles.d_mean = 1e-300", range});
+  // Within the range, but a grain of zero moment of inertia (1e-160 x 1e-160).
+  expect_refused("", {"disk[0] of diameter 2e-80 m", "moment of inertia 1.5706e-320"},
+                 box + "[[disk]]\npos = [1.0, 1.0]\nradius = 1e-80\ndensity = 1.0\n");
+  expect_refused("", {"disk[0].pos = [5, 1] is outside the box [0, 4] x [0, 4]"},
+                 box + "[[disk]]\npos = [5.0, 1.0]\nradius = 0.5\n");
+  expect_refused("", {"particles.region = [0, 0, 5, 2] reaches outside the box [0, 4] x [0, 4]"},
+                 box + "[particles]\nn = 4\nregion = [0.0, 0.0, 5.0, 2.0]\n");
+  expect_refused("--set name=\"../x\"", {"name = \"../x\": must be a folder name"});
+  expect_refused("--set name=\"/tmp/x\"", {"must be a folder name"});
+  // 1e60 lattice sites: placed, not an int overflow.
+  const fs::path dir = cdtest::scratch_dir("bad_input", "absurd");
+  const fs::path sc = write(dir, "s.toml", box + "[particles]\nn = 10\nd_mean = 1e-60\n");
+  EXPECT_EQ(cdsim(sc.string() + " -q --max-steps 1 --out " + (dir / "out").string()).code, 0);
+  const fs::path full = write(dir, "f.toml", box + "[particles]\nn = 100000\nd_mean = 0.1\n");
+  const cdtest::CmdResult r = cdsim(full.string() + " -q --out " + (dir / "out2").string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("room for 729 disks"), std::string::npos) << r.out;
+}
+
 // A 3D contact.axis_a whose norm under- or overflows is still the direction
 // it gives (issue 28 item 7): [1e-300, 0, 0] runs as [1, 0, 0] and
 // [1e308, 1e308, 0] as [1, 1, 0], byte for byte, where a plain norm dropped

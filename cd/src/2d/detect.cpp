@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/format.h>
 #include <omp.h>
 
 #include "parallel.hpp"
@@ -402,6 +403,9 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
     const double h = 2 * rmax + alert;
     const bool px = cell && cell->x, py = cell && cell->y;
     const double wx = cell ? cell->width : 0, wy = cell ? cell->height : 0;
+    if (!std::isfinite(wx) || !std::isfinite(wy) || !std::isfinite(h))
+      throw std::runtime_error(fmt::format("the periodic cell ({} x {}) or the largest grain plus the alert "
+                                           "distance ({}) is not finite", wx, wy, h));
     // Bound the cell count by ~4 cells a particle, so that a runaway particle
     // cannot blow up memory: the grid coarsens instead. A periodic axis has
     // its own bounded length and never coarsens below the 4 x 3 cells its

@@ -199,6 +199,21 @@ World build_world(const Scene& s0) {
                                    "preparation's", nd ? dsum / nd : 0.0, wp.d_ref));
   }
 
+  // In a box, every body starts inside it: one outside would fall for ever
+  // (one across a wall is refused as an overlap below).
+  if (s.box_width > 0) {
+    const double W = s.box_width, H = s.box_height;
+    for (std::size_t i = 0; i < s.disks.size(); ++i) {
+      const auto& x = s.disks[i].pos;
+      if (!(x[0] > 0 && x[0] < W && x[1] > 0 && x[1] < H))
+        throw SceneError(fmt::format("disk[{}].pos = [{}, {}] is outside the box [0, {}] x [0, {}]: it would "
+                                     "never meet the walls", i, x[0], x[1], W, H));
+    }
+    const std::vector<double>& r = s.region;
+    if (r.size() == 4 && !(r[0] >= 0 && r[1] >= 0 && r[2] <= W && r[3] <= H))
+      throw SceneError(fmt::format("particles.region = [{}, {}, {}, {}] reaches outside the box [0, {}] x [0, {}]: "
+                                   "grains placed there would never meet the walls", r[0], r[1], r[2], r[3], W, H));
+  }
   for (const DiskSpec& d : s.disks) {
     const double rho = d.density > 0 ? d.density : s.density;
     const int i = d.nsides > 0 ? B.add_polygon({d.pos[0], d.pos[1]}, d.radius, d.nsides, d.angle,
@@ -226,13 +241,15 @@ World build_world(const Scene& s0) {
     const std::vector<double> d = generated_diameters(s);
     const double dmax = *std::max_element(d.begin(), d.end());
     const double pitch = 1.02 * dmax;
-    const int nx = static_cast<int>((region[2] - region[0]) / pitch);
-    const int ny = static_cast<int>((region[3] - region[1]) / pitch);
-    if (static_cast<long>(nx) * ny < s.n)
+    // Counted in doubles (a region of 1e10 pitches overflows an int), and
+    // no more columns than grains.
+    const double cols = std::floor((region[2] - region[0]) / pitch), rows = std::floor((region[3] - region[1]) / pitch);
+    if (!(cols * rows >= s.n))
       throw SceneError(fmt::format(
-          "particles.n = {} does not fit in the region [{}, {}] x [{}, {}]: room for {} disks "
+          "particles.n = {} does not fit in the region [{}, {}] x [{}, {}]: room for {:.0f} disks "
           "of the largest diameter {:.4g} on a loose lattice; enlarge the region or the box",
-          s.n, region[0], region[2], region[1], region[3], static_cast<long>(nx) * ny, dmax));
+          s.n, region[0], region[2], region[1], region[3], std::max(0.0, cols * rows), dmax));
+    const int nx = static_cast<int>(std::min<double>(cols, s.n));
     std::mt19937_64 g(s.seed + 1);
     std::mt19937_64 gs(s.seed + 2);  // shapes and orientations: their own stream, so a
                                      // disk-only scene places exactly as before

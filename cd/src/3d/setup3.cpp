@@ -75,14 +75,8 @@ void check_cell3(const Scene& s) {
   if (given && !(s.cell_width > 0 && s.cell_height > 0 && s.cell_depth > 0))
     fail3(fmt::format("shear.width = {}, shear.height = {}, shear.depth = {}: all three > 0, or all 0 (the "
                       "cube that holds the spheres)", s.cell_width, s.cell_height, s.cell_depth));
-  const auto [d_min, d_max] = diameter_bounds(s);
-  for (const double d : {d_min, d_max}) {
-    const double m = s.density * std::numbers::pi / 6.0 * d * d * d, I = 0.1 * m * d * d;
-    if (!std::isfinite(m) || !(m > 0) || !std::isfinite(I) || !(I > 0))
-      fail3(fmt::format("a sphere of diameter {} m and density {} kg/m^3 has mass {} kg and inertia {} "
-                        "kg m^2: both must be finite and > 0 (particles.d_mean, particles.diameters, "
-                        "particles.density)", d, s.density, m, I));
-  }
+  // The spheres' masses: check_derived (above).
+  const double d_max = diameter_bounds(s).second;
   if (!given) return;
   // World3's bound: each periodic length >= 2 (2 r_max + alert), so that a
   // pair meets through one image at most.
@@ -154,17 +148,13 @@ void check_scene3(const Scene& s) {
                      s.box_width, s.box_depth));
   check_derived(s);
   if (s.n <= 0) fail("particles.n = 0: a 3D scene needs generated spheres (particles.n or particles.diameters)");
-  const auto [d_min, d_max] = diameter_bounds(s);
-  const double r_max = 0.5 * d_max;
+  const double r_max = 0.5 * diameter_bounds(s).second;
   const int n = lattice_side3(s.n);
   const double side = n * 2.2 * r_max;
-  for (const double d : {d_min, d_max}) {
-    const double m = s.density * std::numbers::pi / 6.0 * d * d * d, I = 0.1 * m * d * d;
-    if (!std::isfinite(side) || !std::isfinite(m) || !(m > 0) || !std::isfinite(I) || !(I > 0))
-      fail(fmt::format("a sphere of diameter {} m and density {} kg/m^3 has mass {} kg and inertia {} "
-                       "kg m^2, lattice side {} m: all must be finite and > 0 (particles.d_mean, "
-                       "particles.diameters, particles.density)", d, s.density, m, I, side));
-  }
+  // The spheres' masses: check_derived (above).
+  if (!std::isfinite(side))
+    fail(fmt::format("the lattice of {} spheres of diameter up to {} m has side {} m: it must be finite "
+                     "(particles.d_mean, particles.diameters)", s.n, 2 * r_max, side));
   if (s.box_width > 0 && s.box_width < side)
     fail(fmt::format("box.width = {}: the {} x {} lattice of {} spheres (pitch 1.1 d_max = {} m) needs >= {} m",
                      s.box_width, n, n, s.n, 2.2 * r_max, side));

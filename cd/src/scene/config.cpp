@@ -55,8 +55,14 @@ Rule vector_of(std::size_t a, std::size_t b) {
             return n == a || n == b;
           }};
 }
-Rule non_empty() {
-  return {"non-empty", [](const Val& v) { return !std::get<std::string>(v).empty(); }};
+// The run's name is its default folder outputs/<name>: one folder name, so
+// that a name cannot write outside outputs/ ("../x", "/tmp/x").
+Rule folder_name() {
+  return {"a folder name: non-empty, no '/', not '.' or '..'", [](const Val& v) {
+            const std::string& n = std::get<std::string>(v);
+            return !n.empty() && n != "." && n != ".." && n.find('/') == std::string::npos &&
+                   n.find('\0') == std::string::npos;
+          }};
 }
 // An enum key (scene.hpp): one of its names. The value is checked when it is
 // read (get below, with this text); the rule carries the text for the
@@ -117,7 +123,7 @@ struct Param {
 
 const std::vector<Param<Scene>>& scene_params() {
   static const std::vector<Param<Scene>> t = {
-      {"", "name", &Scene::name, "", non_empty(), "run name (output folder outputs/<name> unless --out)"},
+      {"", "name", &Scene::name, "", folder_name(), "run name (output folder outputs/<name> unless --out)"},
       {"", "dimension", &Scene::dimension, "", in(2, 3), "2: disks and polygons in the plane; 3: spheres in a box of plane walls (docs/3d.md: which keys apply)"},
       {"time", "dt", &Scene::dt, "s", gt(0), "time step"},
       {"time", "duration", &Scene::duration, "s", ge(0), "simulated time"},
@@ -259,9 +265,24 @@ std::string get_number(const toml::value& v, double& x) {
   return "";
 }
 
+// The magnitudes a scene may give, in any units: 0, or between 1e-100 and
+// 1e100. The engine multiplies a few scene values together (a mass is a
+// density times a size squared or cubed, a kinetic energy a mass times a
+// velocity squared, an impulse a force times a step): products of three
+// such numbers stay within double precision's normal range (1e-308 to
+// 1e308); a value like g = 1e308 or a density of 1e-300 would overflow or
+// underflow there, into a divergence or a grain of zero mass, not physics.
+constexpr double kMagnitudeMin = 1e-100, kMagnitudeMax = 1e100;
+bool absurd(double x) { return x != 0 && !(std::abs(x) >= kMagnitudeMin && std::abs(x) <= kMagnitudeMax); }
+std::string absurd_text() {
+  return fmt::format("must be 0 or between {:g} and {:g} in magnitude (docs/errors.md: values out of double "
+                     "precision's reach)", kMagnitudeMin, kMagnitudeMax);
+}
+
 std::string get(const toml::value& v, double& x) {
   if (std::string e = get_number(v, x); !e.empty()) return e;
   if (!std::isfinite(x)) return fmt::format(" = {}: must be a finite number", x);
+  if (absurd(x)) return fmt::format(" = {:g}: {}", x, absurd_text());
   return "";
 }
 
@@ -309,9 +330,11 @@ std::string get(const toml::value& v, std::vector<double>& x) {
   for (std::size_t i = 0; i < out.size(); ++i)
     if (!get_number(v.as_array()[i], out[i]).empty())
       return ": expected an array of numbers, got an array containing " + type_name(v.as_array()[i]);
-  for (std::size_t i = 0; i < out.size(); ++i)
+  for (std::size_t i = 0; i < out.size(); ++i) {
     if (!std::isfinite(out[i]))
       return fmt::format(": element {} is {}: must be finite numbers", i, out[i]);
+    if (absurd(out[i])) return fmt::format(": element {} is {:g}: {}", i, out[i], absurd_text());
+  }
   x = std::move(out);
   return "";
 }
@@ -514,9 +537,9 @@ Scene read_scene(const toml::value& root, const std::string& path) {
       for (std::string tok; ls >> tok;) {
         char* end = nullptr;
         const double x = std::strtod(tok.c_str(), &end);
-        if (*end != '\0' || !std::isfinite(x) || !(x > 0))
-          throw ConfigError(fmt::format("{}:{}: '{}' is not a diameter (a finite number > 0)",
-                                        f.string(), ln, tok));
+        if (*end != '\0' || !std::isfinite(x) || !(x > 0) || absurd(x))
+          throw ConfigError(fmt::format("{}:{}: '{}' is not a diameter (a finite number between {:g} and {:g})",
+                                        f.string(), ln, tok, kMagnitudeMin, kMagnitudeMax));
         d.push_back(x);
       }
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include <fmt/format.h>
@@ -102,8 +103,51 @@ double run_duration(const Scene& s) {
   return s.strain > 0 && shear_rate(s) > 0 ? s.strain / shear_rate(s) : s.duration;
 }
 
+// Every grain's mass and moment of inertia, and their inverses, must be
+// normal doubles: a radius or density of 1e-300 gives a mass that
+// underflows to 0 and an infinite inverse mass (a grain that cannot be
+// pushed). Checked for the extreme generated sizes and every [[disk]], with
+// the shape's own formulas (2D: a regular n-gon's, Bodies::add_polygon; 3D:
+// a sphere's, Bodies3::add_sphere).
+static void check_grain_masses(const Scene& s) {
+  const auto check = [&](const std::string& what, double d, double rho, int sides) {
+    const double r = 0.5 * d;
+    double m, I;
+    if (s.dimension == 3) {
+      m = rho * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+      I = 0.4 * m * r * r;
+    } else if (sides > 0) {
+      const double a = 2.0 * std::numbers::pi / sides;
+      m = rho * 0.5 * sides * r * r * std::sin(a);
+      I = m * r * r * (2.0 + std::cos(a)) / 6.0;
+    } else {
+      m = rho * std::numbers::pi * r * r;
+      I = 0.5 * m * r * r;
+    }
+    const auto normal = [](double x) { return std::isnormal(x) && x > 0 && std::isnormal(1.0 / x); };
+    if (!normal(m) || !normal(I))
+      throw SceneError(fmt::format("{} of diameter {} m and density {} has mass {} and moment of inertia {}: both "
+                                   "and their inverses must be finite and > 0 (a grain of zero mass cannot be "
+                                   "pushed, one of infinite mass cannot be moved)", what, d, rho, m, I));
+  };
+  const char* grain = s.dimension == 3 ? "a sphere" : "a grain";
+  if (s.n > 0 || !s.diameters.empty()) {
+    const auto [d_min, d_max] = diameter_bounds(s);
+    for (const double d : {d_min, d_max})
+      for (const double n : s.dimension == 3 ? std::vector<double>{0.0} : s.nsides)
+        check(fmt::format("{} (particles.d_mean, size_ratio, diameters, density{})", grain,
+                          s.dimension == 3 ? "" : ", nsides"),
+              d, s.density, static_cast<int>(n));
+  }
+  for (std::size_t i = 0; i < s.disks.size(); ++i) {
+    const DiskSpec& d = s.disks[i];
+    check(fmt::format("disk[{}]", i), 2 * d.radius, d.density > 0 ? d.density : s.density, d.nsides);
+  }
+}
+
 void check_derived(const Scene& s) {
   auto fail = [](const std::string& m) { throw SceneError(m); };
+  check_grain_masses(s);
   const double dt = time_step(s);
   const char* dt_from = s.dt_tp > 0 ? "shear.dt_tp x t_p" : "time.dt";
   if (!std::isfinite(dt) || dt <= 0) fail(fmt::format("the time step ({}) is {}: must be finite and > 0", dt_from, dt));
