@@ -122,6 +122,21 @@ TEST(CdsimCli, MalformedSceneAndBadOverride) {
   EXPECT_NE(r.out.find("missing.toml"), std::string::npos) << r.out;
 }
 
+// A folder or a binary file given as the scene is named as such; the
+// binary's bytes are not echoed to the terminal (issue 28 item 16).
+TEST(CdsimCli, FolderOrBinaryGivenAsTheSceneIsNamed) {
+  const fs::path d = temp_dir("binary");
+  Result r = run(d.string() + " --out " + (d / "out").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("'" + d.string() + "' is a folder, not a scene file"), std::string::npos) << r.out;
+  const fs::path bin = write(d, "b.toml", std::string("name = 1\n\x1b[31m\x01\x02red", 19));
+  r = run(bin.string() + " --out " + (d / "out").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("is not a scene file (TOML text): control byte 0x1b at line 2"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << "echoed an escape sequence";
+  EXPECT_FALSE(fs::exists(d / "out"));
+}
+
 TEST(CdsimCli, GoodRunWritesSeriesSceneAndCollections) {
   const fs::path d = temp_dir("good");
   const fs::path scene = write(d, "s.toml", kScene);

@@ -27,6 +27,7 @@
 #include "cli_checks.hpp"
 #include "cli_errors.hpp"
 #include "contact_problem3.hpp"
+#include "files.hpp"
 #include "lemke.hpp"
 #include "lemke3.hpp"
 #include "nlgs.hpp"
@@ -201,9 +202,7 @@ int solve_step(const std::string& path, double tol, int max_sweeps, double resid
       st.cap_hit ? "NOT converged (sweep cap)" : st.residual_met ? "converged (law residual)" : "converged",
       st.iterations, st.dp_rel, prm.tol, st.residual_max, st.residual_mean, st.p_mean, t);
   if (!out.empty()) {
-    std::ofstream f(out);
-    if (!(f << Step::impulses(p)) || !f.flush())
-      throw std::runtime_error(fmt::format("{}: cannot write the impulses", out));
+    cd::write_file_atomic(out, Step::impulses(p));  // WriteError (exit 4) if it cannot be written
   }
   return st.cap_hit ? 1 : 0;
 }
@@ -254,6 +253,9 @@ int main(int argc, char** argv) {
     }
     if (ends(".hdf5")) return solve_fclib(path, opt, lemke, facets);
     return solve_dat(path, opt, lemke, facets);
+  } catch (const cd::WriteError& e) {
+    std::cerr << "cdproblem: " << e.what() << "\n";
+    return 4;
   } catch (const std::exception& e) {
     std::cerr << "cdproblem: error: " << e.what() << "\n";
     return 2;

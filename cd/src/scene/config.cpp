@@ -664,11 +664,22 @@ Scene parse_scene(const std::string& text, const std::string& path,
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;
-  if (!in || std::filesystem::is_directory(path, ec))
-    throw ConfigError(fmt::format("cannot open scene file '{}'", path));
+  if (std::filesystem::is_directory(path, ec))
+    throw ConfigError(fmt::format("'{}' is a folder, not a scene file", path));
+  if (!in) throw ConfigError(fmt::format("cannot open scene file '{}'", path));
   std::ostringstream text;
   text << in.rdbuf();
-  return parse_scene(text.str(), path, overrides);
+  // A binary file is named as such, not echoed to the terminal by the TOML
+  // parser's message: TOML text has no control bytes but tab and newlines.
+  const std::string t = std::move(text).str();
+  for (std::size_t i = 0, line = 1; i < t.size(); ++i) {
+    const auto c = static_cast<unsigned char>(t[i]);
+    if (c == '\n') ++line;
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f)
+      throw ConfigError(fmt::format("'{}' is not a scene file (TOML text): control byte 0x{:02x} at line {}, "
+                                    "byte {}", path, c, line, i + 1));
+  }
+  return parse_scene(t, path, overrides);
 }
 
 namespace {
