@@ -354,8 +354,10 @@ TEST(Overrides, UnknownKeyOrBadValueIsAnError) {
 
 TEST(Resolved, RoundTripsANonDefaultSceneExactly) {
   Scene s = nondefault();
-  s.gravity = {0.1 + 0.2, -1e-300, 1e300};  // doubles that need 17 digits or an exponent
-  s.disks[0].pos = {1.7976931348623157e308, 4.9406564584124654e-324};
+  // Doubles that need 17 digits or an exponent, at the ends of the range a
+  // scene may give (0 or 1e-100 to 1e100 in magnitude).
+  s.gravity = {0.1 + 0.2, -1e-100, 1e100};
+  s.disks[0].pos = {9.8765432109876543e99, 1.2345678901234567e-99};
   s.disks[1].vel = {-0.0, 2.0 / 3.0};
   s.walls[1].omega = 1e22;
   s.name = "tab\there, newline\nthere";

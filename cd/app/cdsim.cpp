@@ -65,8 +65,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1e9));
   std::int64_t max_steps = 0;
   app.add_option("--max-steps", max_steps,
-                 "stop at the first series row at or after N steps (with checkpoints on, a "
-                 "checkpoint the same command resumes from): to try a scene or a campaign's first steps")
+                 "stop after N steps (a series row and, with checkpoints on, a checkpoint the "
+                 "same command resumes from): to try a scene or a campaign's first steps")
       ->check(CLI::PositiveNumber);
   try {
     app.parse(argc, argv);
@@ -74,6 +74,9 @@ int main(int argc, char** argv) {
     // --help prints and exits 0; every usage error is bad input: exit 2.
     return cd::cli_error(app, e, "cdsim");
   }
+  // A stop asked while the scene is read and built stops the run at its
+  // first series row (not the process at once, with nothing to resume).
+  cd::install_stop_handlers();
   // Status lines reach a log file as they are printed, even if the run is killed.
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   // A file size limit (ulimit -f) makes a write fail (exit 4), not kill the run.
@@ -115,7 +118,6 @@ int main(int argc, char** argv) {
 
     cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps, max_steps};
     opt.progress_every = progress_every;
-    cd::install_stop_handlers();
     const cd::RunSummary s = three ? cd::run3(*world3, scene, opt) : cd::run(*world, scene, opt);
     if (s.first_step > 0)
       fmt::print("cdsim: resumed from {}/checkpoint.bin at step {} of {}\n", out, s.first_step,

@@ -18,8 +18,8 @@ struct OutputError : std::runtime_error {
 // unwritable, an I/O error): not bad input, and reported as such (cdsim
 // exits 4). The message says "could not write" and names the file and the
 // system's reason.
-struct WriteError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct WriteError : OutputError {
+  using OutputError::OutputError;
 };
 
 // Another process holds the output folder (cdsim exits 6): the message names

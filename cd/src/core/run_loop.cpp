@@ -286,8 +286,8 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       if (!std::isfinite(x))
         throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): the step's {} is {}; series.csv holds the "
                                           "rows before it", k, w.time(), name, x));
-    // A stop (signal or --max-steps) waits for the next series row: rows are
-    // whole intervals, and a checkpoint there resumes to the same series.
+    // A signal's stop waits for the next series row: rows are whole
+    // intervals, and a checkpoint there resumes to the same series.
     const bool row_due = k % every_row == 0 || k == nsteps;
     if (g_stop != 0 && !stop_seen) {
       stop_seen = true;
@@ -296,7 +296,9 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
                      "signal stops at once\n", progress ? "\n" : "", int(g_stop),
                      static_cast<long long>(std::min(nsteps, (k / every_row + 1) * every_row)));
     }
-    const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps && row_due;
+    // --max-steps stops after exactly N steps (to try a scene), with a row
+    // for the partial interval there.
+    const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps;
     const bool stopping = (g_stop != 0 && row_due && k < nsteps) || at_limit;
     if (stopping) k_end = k;
     w.after_step(k);
@@ -314,7 +316,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     tot.residual_last = st.solve.residual_max;
     tot.overlap_max = std::max(tot.overlap_max, st.max_overlap);
 
-    if (row_due) {
+    if (row_due || stopping) {
       timed_output([&] {
         const StageTimes& t = w.times();
         Columns cols = {{"step", double(k)},
