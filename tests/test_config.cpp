@@ -258,7 +258,7 @@ TEST(Errors, ValueOutOfRange) {
       {"[output]\ncheckpoint_interval = -1", "x.toml:2:1: output.checkpoint_interval = -1: must be >= 0"},
       {"[output]\ncheckpoint_strain = -0.1", "x.toml:2:1: output.checkpoint_strain = -0.1: must be >= 0"},
       {"[output]\ncheckpoint_wall = -5", "x.toml:2:1: output.checkpoint_wall = -5: must be >= 0"},
-      {"name = \"\"", "x.toml:1:1: name = \"\": must be non-empty"},
+      {"name = \"\"", "x.toml:1:1: name = \"\": must be a folder name: non-empty, no '/', not '.' or '..'"},
       {"[solver]\ntol = 2.0", "x.toml:2:1: solver.tol = 2: must be in (0, 1]"},
       {"[particles]\nn = 200000000", "x.toml:2:1: particles.n = 200000000: must be in [0, 100000000]"},
       {"[box]\nwidth = 1", "x.toml:1:1: box.width = 1, box.height = 0: must be both 0 (no box) or both > 0"},
