@@ -67,7 +67,9 @@ std::vector<std::vector<std::string>> csv(const fs::path& p) {
 // A refused run: exit 2, the message names each of `words`, nothing written.
 void expect_refused(const std::string& sets, const std::vector<std::string>& words,
                     const std::string& scene = kScene) {
-  const fs::path dir = cdtest::scratch_dir("bad_input", "refused");
+  // A folder of the test's own: ctest runs the tests of this file in parallel.
+  const fs::path dir =
+      cdtest::scratch_dir("bad_input", std::string("refused_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
   const fs::path sc = write(dir, "s.toml", scene);
   const cdtest::CmdResult r = cdsim(sc.string() + " " + sets + " -q --out " + (dir / "out").string());
   EXPECT_EQ(r.code, 2) << sets << "\n" << r.out;
