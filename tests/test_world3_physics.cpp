@@ -490,7 +490,13 @@ TEST(Periodic3, DetectionEqualsBruteForceOverImages) {
 // part, keeps its tangential part and conserves the pair's momentum, to
 // round-off. With the images' velocity missing the normal velocity would be
 // off by V n_x.
-TEST(Periodic3, CollisionThroughTheShearedBoundary) {
+// cross_first: A crosses the top and is brought back before the contact
+// (which is then inside the cell: the crossing's velocity shift is what is
+// tested); otherwise A starts 0.6 r_a below the top, meets B's image before
+// it would cross and bounces back: the contact is through the moving image
+// (row with iy != 0), so the image velocity the row adds is what is tested
+// (its sign flipped, u_n would be off by 2 V n_x).
+static void sheared_boundary_impact(bool cross_first) {
   const double ra = 0.01, rb = 0.013, L = 0.1, V = 0.5, u = 1.0;
   WorldParams3 p;
   p.dt = 1e-5;
@@ -505,7 +511,7 @@ TEST(Periodic3, CollisionThroughTheShearedBoundary) {
   // y) is at x_B + (offset, L, 0) and moves at v_B + V e_x; placed at t = 0
   // so that A crosses the top (after 0.1 r_a / u) before the contact (after
   // ~0.25 r_a / u), with a normal having x and z parts.
-  const Vec3 xa(0.05, L - 0.1 * ra, 0.05);
+  const Vec3 xa(0.05, L - (cross_first ? 0.1 : 0.6) * ra, 0.05);
   const Vec3 xb_img = xa + Vec3(0.4 * ra, ra + rb + 0.5 * ra, 0.3 * ra);
   const Vec3 xb = xb_img - Vec3(p.le_offset, L, 0.0);
   const int a = w.bodies.add_sphere(xa, ra, 2600, Vec3(0.1, u, 0.0));
@@ -528,6 +534,7 @@ TEST(Periodic3, CollisionThroughTheShearedBoundary) {
   bool crossed = false;
   int impact = -1;
   Vec3 P0 = Vec3::Zero(), u_pre = Vec3::Zero(), n_pre = Vec3::Zero();
+  int impact_iy = 0;
   for (int k = 0; k < 2000 && impact < 0; ++k) {
     Vec3 nn;
     const Vec3 uk = rel_velocity(nn);
@@ -540,14 +547,18 @@ TEST(Periodic3, CollisionThroughTheShearedBoundary) {
       crossed = true;
       EXPECT_EQ(impact, -1);
     }
-    for (const SphereRow& row : w.rows())
+    for (std::size_t j = 0; j < w.rows().size(); ++j) {
+      const SphereRow& row = w.rows()[j];
       if (row.r[0] > 0.0) {
         impact = k;
         n_pre = row.b1 == a ? row.n : Vec3(-row.n);
+        impact_iy = w.infos()[j].iy;
       }
+    }
   }
-  ASSERT_TRUE(crossed);
+  ASSERT_EQ(crossed, cross_first);
   ASSERT_GE(impact, 0);
+  EXPECT_EQ(impact_iy != 0, !cross_first) << "the contact is through B's image only when A has not crossed";
   Vec3 n1;
   const Vec3 u1 = rel_velocity(n1);
   const double un = u_pre.dot(n_pre);
@@ -558,9 +569,13 @@ TEST(Periodic3, CollisionThroughTheShearedBoundary) {
   EXPECT_LT(((u1 - u1.dot(n_pre) * n_pre) - (u_pre - un * n_pre)).norm(), 1e-13);
   const Vec3 P1 = ma * w.bodies.vel[a].v + mb * w.bodies.vel[b].v;
   EXPECT_LT((P1 - P0).norm(), 1e-14 * (ma + mb) * u);
-  std::printf("sheared-boundary impact at step %d: u_n %.15g -> %.15g, n = (%.3f %.3f %.3f)\n", impact, un,
-              u1.dot(n_pre), n_pre.x(), n_pre.y(), n_pre.z());
+  std::printf("sheared-boundary impact (%s) at step %d: u_n %.15g -> %.15g, n = (%.3f %.3f %.3f)\n",
+              cross_first ? "after the crossing" : "through the image", impact, un, u1.dot(n_pre), n_pre.x(),
+              n_pre.y(), n_pre.z());
 }
+
+TEST(Periodic3, CollisionThroughTheShearedBoundary) { sheared_boundary_impact(true); }
+TEST(Periodic3, CollisionWithTheMovingImage) { sheared_boundary_impact(false); }
 
 // ~1700 spheres on a jittered lattice in a tri-periodic Lees-Edwards cell,
 // random velocities, every loop on the parallel path (min_parallel = 0):
