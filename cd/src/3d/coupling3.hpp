@@ -145,7 +145,7 @@ struct BodyCoupling3 {
   // One row update. Write1 = false when body 1 is driven (a wall): read,
   // never written, so rows of one colour may share it without a data race.
   template <class L, bool Write1>
-  void update(SphereRow& r, double& dp2, double& pabs) const {
+  [[gnu::flatten]] void update(SphereRow& r, double& dp2, double& pabs) const {
     BodyVel3& A = vel[r.b1];
     BodyVel3& B = vel[r.b2];
     const RowExtra3* e = nullptr;
