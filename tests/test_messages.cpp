@@ -21,6 +21,7 @@ namespace {
 
 const std::string kCdsim = CDLAB_BINARY_DIR "/cd/cdsim";
 const std::string kCdproblem = CDLAB_BINARY_DIR "/cd/cdproblem";
+const std::string kCdanalysis = CDLAB_BINARY_DIR "/analysis/cdanalysis";
 const std::string kConfigs = CDLAB_SOURCE_DIR "/configs";
 
 std::vector<std::string> lines_of(const std::string& text) {
@@ -33,7 +34,8 @@ std::vector<std::string> lines_of(const std::string& text) {
 // Every line of a refusal starts with "prog: ", and the exit code is 2.
 void expect_refusal(const std::string& prog, const std::string& args, const std::string& wanted) {
   const cdtest::CmdResult r =
-      cdtest::run_command((prog == "cdsim" ? kCdsim : kCdproblem) + " " + args + " </dev/null");
+      cdtest::run_command((prog == "cdsim" ? kCdsim : prog == "cdproblem" ? kCdproblem : kCdanalysis) + " " + args +
+                          " </dev/null");
   EXPECT_EQ(r.code, 2) << prog << " " << args << "\n" << r.out;
   EXPECT_NE(r.out.find(wanted), std::string::npos) << prog << " " << args << "\n" << r.out;
   ASSERT_FALSE(r.out.empty());
@@ -74,12 +76,24 @@ TEST(Messages, UnknownOptionNamesProgramOptionAndHint) {
 
 TEST(Messages, EveryRefusalCarriesTheProgramsName) {
   expect_refusal("cdsim", "", "no scene file given");
-  expect_refusal("cdsim", kConfigs + "/default.toml --max-steps abc", "--max-steps");
+  // A step count names what it wants, not the range of a double (309 digits).
+  for (const char* bad : {"abc", "0", "1.5", "-3", "99999999999999999999"}) {
+    expect_refusal("cdsim", kConfigs + "/default.toml --max-steps " + bad,
+                   "cdsim: --max-steps: '" + std::string(bad) + "' is not a whole number >= 1");
+    expect_refusal("cdsim", kConfigs + "/default.toml --dump-problem " + bad, "is not a whole number >= 1");
+  }
+  expect_refusal("cdsim", kConfigs + "/default.toml --progress nan", "--progress: must be a finite number");
   expect_refusal("cdsim", "--help-scene=html", "--help-scene");
   expect_refusal("cdsim", "/nonexistent/scene.toml", "cannot open scene file");
   expect_refusal("cdproblem", "", "subcommand");
   expect_refusal("cdproblem", "solve", "file");
   expect_refusal("cdproblem", "solve /nonexistent/x.dat", "/nonexistent/x.dat");
+  // cdanalysis' usage errors (CLI11's) as its other messages, with the commands meant.
+  expect_refusal("cdanalysis", "", "cdanalysis: A subcommand is required (`cdanalysis` takes one of: steady,");
+  expect_refusal("cdanalysis", "fit", "(`cdanalysis fit` takes one of: mu-i,");
+  expect_refusal("cdanalysis", "fit mu", "cdanalysis: unknown command 'mu' (`cdanalysis fit` takes one of: mu-i,");
+  expect_refusal("cdanalysis", "fit mu-i run --bogus", "cdanalysis: see `cdanalysis fit mu-i --help` for the options");
+  expect_refusal("cdanalysis", "draw x --width abc", "--width");
 }
 
 // Run from a folder without outputs/: the shipped shear scenes' samples

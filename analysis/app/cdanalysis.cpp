@@ -7,7 +7,9 @@
 // The subcommands are the tables below, one file each in commands/.
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
+#include <string>
 #include <vector>
 
 #include "analysis/app/command.hpp"
@@ -72,6 +74,46 @@ void declare(CLI::App& parent, const Command& c, std::vector<Declared>& out) {
   out.push_back({sub, c.declare(*sub)});
 }
 
+// A parse error: --help prints and gives 0; any other is bad input (2),
+// told as every other message is, "cdanalysis: ...", with the commands the
+// innermost one given accepts (CLI11's own text names neither the program
+// nor what was wanted: "A subcommand is required").
+int usage_error(CLI::App& app, const CLI::ParseError& e) {
+  if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+  CLI::App* at = &app;
+  std::string path = "cdanalysis";
+  for (bool deeper = true; deeper;) {
+    deeper = false;
+    for (CLI::App* sub : at->get_subcommands())
+      if (sub->parsed()) {
+        at = sub;
+        path += " " + sub->get_name();
+        deeper = true;
+        break;
+      }
+  }
+  std::string what = e.what();
+  if (const auto subs = at->get_subcommands([](const CLI::App*) { return true; });
+      !subs.empty() && at->get_subcommands().empty()) {
+    std::vector<std::string> names;
+    for (const CLI::App* sub : subs) names.push_back(sub->get_name());
+    // A misspelt command is taken for a stray word: named as what it was meant to be.
+    for (const std::string& a : at->remaining(true))
+      if (!a.empty() && a[0] != '-') {
+        what = fmt::format("unknown command '{}'", a);
+        break;
+      }
+    what += fmt::format(" (`{}` takes one of: {})", path, fmt::join(names, ", "));
+  }
+  for (std::size_t b = 0, n; b < what.size(); b = n + 1) {
+    n = what.find('\n', b);
+    if (n == std::string::npos) n = what.size();
+    if (n > b) fmt::print(stderr, "cdanalysis: {}\n", what.substr(b, n - b));
+  }
+  fmt::print(stderr, "cdanalysis: see `{} --help` for the options\n", path);
+  return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -92,7 +134,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;  // --help: 0; every usage error: bad input
+    return usage_error(app, e);
   }
 
   try {

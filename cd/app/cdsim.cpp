@@ -20,6 +20,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "cli_checks.hpp"
 #include "cli_errors.hpp"
 #include "config.hpp"
 #include "files.hpp"
@@ -57,17 +58,17 @@ int main(int argc, char** argv) {
                  "write step STEP's contact problem into the output folder (repeatable): "
                  "problem_STEP.cdp (2D) or .cdp3 (3D), replayed exactly by cdproblem; .dat (2D, Siconos' "
                  "matrix form) or .hdf5 (3D, FCLib); .impulses")
-      ->check(CLI::PositiveNumber);
+      ->check(cd::positive_count());
   double progress_every = 0;
   app.add_option("--progress", progress_every,
                  "a progress line on stdout (folder, step, share done, ETA) every SECONDS of wall "
                  "clock, even with --quiet or into a log (make's campaigns: every 300 s)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(cd::finite_range(0.0, 1e9));
   std::int64_t max_steps = 0;
   app.add_option("--max-steps", max_steps,
                  "stop after N steps (a series row and, with checkpoints on, a checkpoint the "
                  "same command resumes from): to try a scene or a campaign's first steps")
-      ->check(CLI::PositiveNumber);
+      ->check(cd::positive_count());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
