@@ -387,7 +387,7 @@ TEST(Stress3, SnapshotMatchesTheSeriesOfARealRun) {
   cd::run3(w, sc, opt);
   std::ofstream(dir / "scene.toml") << "dimension = 3\n";  // the key the analysis reads
   const auto series = read_series(dir.string());
-  const auto L = w.params().cell;
+  const auto L = w.cell().size;
   const double V = L.x() * L.y() * L.z();
   // Snapshot times from the collection file.
   std::ifstream pvd(dir / "contacts.pvd");

@@ -222,7 +222,7 @@ Scene cell_scene(int n) {
 // Smallest gap between two spheres over all pairs, through the nearest
 // periodic image (brute force).
 double min_gap(const World3& w) {
-  const Vec3 L = w.params().cell;
+  const Vec3 L = w.cell().size;
   double g = INFINITY;
   for (std::size_t i = 0; i < w.bodies.size(); ++i)
     for (std::size_t j = i + 1; j < w.bodies.size(); ++j) {
@@ -280,7 +280,7 @@ TEST(Cell3Scene, PeriodicSceneIsATriPeriodicCellOfLooseSpheres) {
   g.cell_height = 0.07;
   g.cell_depth = 0.09;
   const World3 wg = build_world3(g);
-  EXPECT_EQ(wg.params().cell, Vec3(0.08, 0.07, 0.09));
+  EXPECT_EQ(wg.cell().size, Vec3(0.08, 0.07, 0.09));
   EXPECT_GT(min_gap(wg), 0.0);
 }
 
@@ -400,12 +400,12 @@ TEST(Cell3Checkpoint, ResumesTheLeesEdwardsOffset) {
   const std::string path = (dir / "checkpoint.bin").string();
   save_checkpoint3(path, b, 42);
   World3 c = make();
-  EXPECT_EQ(c.params().le_offset, 0.0);
+  EXPECT_EQ(c.cell().le_offset, 0.0);
   EXPECT_EQ(load_checkpoint3(path, c), 42u);
-  EXPECT_EQ(c.params().le_offset, b.params().le_offset);
-  EXPECT_NE(c.params().le_offset, 0.0);
+  EXPECT_EQ(c.cell().le_offset, b.cell().le_offset);
+  EXPECT_NE(c.cell().le_offset, 0.0);
   for (int k = 0; k < 40; ++k) c.step();
-  EXPECT_EQ(c.params().le_offset, a.params().le_offset);
+  EXPECT_EQ(c.cell().le_offset, a.cell().le_offset);
   bool contacts = false;
   for (std::size_t i = 0; i < a.bodies.size(); ++i) {
     EXPECT_EQ(c.bodies.pos[i], a.bodies.pos[i]) << i;
@@ -413,7 +413,7 @@ TEST(Cell3Checkpoint, ResumesTheLeesEdwardsOffset) {
   }
   for (const SphereRow& r : a.rows()) contacts = contacts || r.r[0] > 0;
   EXPECT_TRUE(contacts);  // the gas collides: the comparison sees the images
-  std::printf("le_offset after 80 steps: %.6g m (cell %.4g m)\n", a.params().le_offset, a.params().cell.x());
+  std::printf("le_offset after 80 steps: %.6g m (cell %.4g m)\n", a.cell().le_offset, a.cell().size.x());
 
   Scene box = s;
   box.shear_mode = cd::ShearMode::None;

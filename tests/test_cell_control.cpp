@@ -83,8 +83,8 @@ TEST(CellControl, DilationWithTheGrainsIsNotKineticStress3D) {
   p.cell_mass = 0.5;
   p.cell_dof = {false, true, false};
   const double eps = 20.0;  // 1/s
-  p.cell_rate = cd::Vec3(0.0, eps * p.cell.y(), 0.0);
   cd::World3 w(p);
+  w.set_cell({p.cell, 0.0, cd::Vec3(0.0, eps * p.cell.y(), 0.0), 0.0});  // dilating at eps
   for (const auto& c : {cd::Vec3(0.005, 0.004, 0.01), cd::Vec3(0.015, 0.016, 0.02), cd::Vec3(0.010, 0.030, 0.005)})
     w.bodies.add_sphere(c, 0.002, 1000, cd::Vec3(0.0, eps * (c.y() - p.cell_origin.y()), 0.0));
   const double A = p.cell.x() * p.cell.z(), a = p.pressure * A / p.cell_mass;
@@ -96,12 +96,12 @@ TEST(CellControl, DilationWithTheGrainsIsNotKineticStress3D) {
   }
   const double t = n * p.dt;
   const Eigen::Matrix3d K = w.kinetic_stress();
-  std::printf("dL_y/dt %.12g (closed form %.12g); L_y %.12g (%.12g); K_yy %.3g\n", w.params().cell_rate.y(),
-              v0 - a * t, w.params().cell.y(), L + v0 * t - 0.5 * a * t * t, K(1, 1));
-  EXPECT_NEAR(w.params().cell_rate.y(), v0 - a * t, 1e-12 * v0);
-  EXPECT_NEAR(w.params().cell.y(), L + v0 * t - 0.5 * a * t * t, 1e-12 * L);
+  std::printf("dL_y/dt %.12g (closed form %.12g); L_y %.12g (%.12g); K_yy %.3g\n", w.cell().rate.y(),
+              v0 - a * t, w.cell().size.y(), L + v0 * t - 0.5 * a * t * t, K(1, 1));
+  EXPECT_NEAR(w.cell().rate.y(), v0 - a * t, 1e-12 * v0);
+  EXPECT_NEAR(w.cell().size.y(), L + v0 * t - 0.5 * a * t * t, 1e-12 * L);
   EXPECT_LT(std::abs(K(1, 1)), 1e-12 * p.pressure);
-  EXPECT_EQ(w.params().cell.x(), p.cell.x());
+  EXPECT_EQ(w.cell().size.x(), p.cell.x());
 }
 
 // ---- steady shear at high I ---------------------------------------------
@@ -252,18 +252,18 @@ TEST(CellControl, ShearAtInertialNumber1HoldsThePressure3D) {
   omp_set_num_threads(1);
 
   cd::World3 w = cd::build_world3(s);
-  const double L0 = w.params().cell.y(), gd = w.shear_rate();
+  const double L0 = w.cell().size.y(), gd = w.shear_rate();
   const long n = std::lround(s.strain / gd / w.params().dt);
   const double steady = 2.0;
   std::vector<double> load;
   double lmax = L0, smin = INFINITY, smax = 0.0;
   for (long k = 0; k < n; ++k) {
     w.step();
-    const double L = w.params().cell.y();
+    const double L = w.cell().size.y();
     ASSERT_TRUE(std::isfinite(L)) << "step " << k;
     ASSERT_GT(L, 0.9 * L0) << "step " << k;  // no collapse
     lmax = std::max(lmax, L);
-    if (w.params().strain < steady) continue;
+    if (w.cell().strain < steady) continue;
     smin = std::min(smin, L);
     smax = std::max(smax, L);
     load.push_back((w.contact_stress()(1, 1) + w.kinetic_stress()(1, 1)) / s.pressure);

@@ -254,8 +254,8 @@ TEST(Cohesion3Shear, CohesiveShearAtImposedPressure) {
         ASSERT_EQ(w2.bodies.vel[i].v, w.bodies.vel[i].v) << i;
         ASSERT_EQ(w2.bodies.vel[i].w, w.bodies.vel[i].w) << i;
       }
-      EXPECT_EQ(w2.params().cell, w.params().cell);
-      EXPECT_EQ(w2.params().cell_rate, w.params().cell_rate);
+      EXPECT_EQ(w2.cell().size, w.cell().size);
+      EXPECT_EQ(w2.cell().rate, w.cell().rate);
     }
     const Eigen::Matrix3d S = w.contact_stress() + w.kinetic_stress();
     finite = finite && S.allFinite();

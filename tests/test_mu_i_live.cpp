@@ -185,7 +185,7 @@ TEST(MuILive, SpheresMatchTheReferenceCampaign) {
   run_shear<World3>(
       3, 150, I, "3d", [](const Scene& sc) { return build_world3(sc); },
       [](const std::string& path, const World3& w) { save_checkpoint3(path, w, 1); },
-      [](const World3& w) { return w.params().strain; },
+      [](const World3& w) { return w.cell().strain; },
       [&](const Eigen::Matrix3d& S, double kyy, const World3& w) {
         mu.push_back(-0.5 * (S(0, 1) + S(1, 0)) / S(1, 1));
         inum.push_back(inertial(w.shear_rate(), s, S(1, 1) + kyy));

@@ -68,12 +68,12 @@ TEST(Shear3Cell, HeightUnderPressureWithoutContactsIsAMassUnderAConstantForce) {
   const int n = 200;
   for (int k = 0; k < n; ++k) w.step();
   const double t = n * p.dt;
-  EXPECT_NEAR(w.params().cell_rate.y(), -a * t, 1e-12 * a * t);
-  EXPECT_NEAR(w.params().cell.y(), p.cell.y() - 0.5 * a * t * t, 1e-12 * p.cell.y());
-  EXPECT_EQ(w.params().cell.x(), p.cell.x());
-  EXPECT_EQ(w.params().cell.z(), p.cell.z());
+  EXPECT_NEAR(w.cell().rate.y(), -a * t, 1e-12 * a * t);
+  EXPECT_NEAR(w.cell().size.y(), p.cell.y() - 0.5 * a * t * t, 1e-12 * p.cell.y());
+  EXPECT_EQ(w.cell().size.x(), p.cell.x());
+  EXPECT_EQ(w.cell().size.z(), p.cell.z());
   EXPECT_EQ(w.bodies.pos[0], Vec3(0.005, 0.004, 0.01));  // at rest, no drift
-  std::printf("L_y: %.9g m after %d steps (closed form %.9g m)\n", w.params().cell.y(), n,
+  std::printf("L_y: %.9g m after %d steps (closed form %.9g m)\n", w.cell().size.y(), n,
               p.cell.y() - 0.5 * a * t * t);
 
   // The brake: -dL/dt <= min(rate L_m, alert / (4 dt)).
@@ -84,11 +84,11 @@ TEST(Shear3Cell, HeightUnderPressureWithoutContactsIsAMassUnderAConstantForce) {
   b.bodies.add_sphere(Vec3(0.005, 0.004, 0.01), 0.002, 1000);
   bool floored = false;
   for (int k = 0; k < n; ++k) {
-    const double Ly = b.params().cell.y(), Lm = Ly + 0.5 * q.dt * b.params().cell_rate.y();
-    const double free = b.params().cell_rate.y() - q.dt * a;
+    const double Ly = b.cell().size.y(), Lm = Ly + 0.5 * q.dt * b.cell().rate.y();
+    const double free = b.cell().rate.y() - q.dt * a;
     const double floor = -std::min(q.max_strain_rate * Lm, 0.25 * q.alert / q.dt);
     b.step();
-    EXPECT_DOUBLE_EQ(b.params().cell_rate.y(), std::max(free, floor)) << k;
+    EXPECT_DOUBLE_EQ(b.cell().rate.y(), std::max(free, floor)) << k;
     floored = floored || free < floor;
   }
   EXPECT_TRUE(floored);  // the test reaches the brake
@@ -148,7 +148,7 @@ TEST(Shear3Cell, IsotropicCompactionReachesThePressureOnAllThreeAxes) {
   const Eigen::Matrix3d S = a.mean();
   std::printf("phi %.4f -> %.4f [%.4f, %.4f]; (sigma + K)/p = %.4f %.4f %.4f (xy %.2g); L = %.4g %.4g %.4g m\n", phi0,
               a.phi / a.n, a.phi_min, a.phi_max, S(0, 0) / s.pressure, S(1, 1) / s.pressure, S(2, 2) / s.pressure,
-              S(0, 1) / s.pressure, w.params().cell.x(), w.params().cell.y(), w.params().cell.z());
+              S(0, 1) / s.pressure, w.cell().size.x(), w.cell().size.y(), w.cell().size.z());
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(S(k, k) / s.pressure, 1.0, 0.01) << k;
   EXPECT_GT(a.phi_min, 0.55);
   EXPECT_LT(a.phi_max, 0.64);
@@ -157,7 +157,7 @@ TEST(Shear3Cell, IsotropicCompactionReachesThePressureOnAllThreeAxes) {
   // cube shrinks into a near cube (measured 1.07 for 100 spheres: the shape
   // a small jammed sample settles into is its own); no axis takes the load
   // for the others.
-  const Vec3 L = w.params().cell;
+  const Vec3 L = w.cell().size;
   EXPECT_LT(L.maxCoeff() / L.minCoeff(), 1.15);
 }
 
@@ -204,7 +204,7 @@ TEST(Shear3Cell, ShearAtImposedInertialNumber) {
   EXPECT_DOUBLE_EQ(w.params().shear_rate, gd);
   EXPECT_TRUE(w.cell_dofs());
   EXPECT_EQ(w.params().cell_dof, (std::array<bool, 3>{false, true, false}));
-  const Vec3 L0 = w.params().cell;
+  const Vec3 L0 = w.cell().size;
   const int steps = static_cast<int>(std::lround(1.0 / gd / w.params().dt));  // strain 1
   for (int k = 0; k < steps; ++k) w.step();
   constexpr int nb = 5, nblk = 8;
@@ -215,9 +215,9 @@ TEST(Shear3Cell, ShearAtImposedInertialNumber) {
     const int q = k * nblk / avg;
     const Eigen::Matrix3d S = w.contact_stress() + w.kinetic_stress();
     syy[q] += S(1, 1) / (avg / nblk);
-    const double L = w.params().cell.y();
+    const double L = w.cell().size.y();
     // The images' velocity: gamma-dot times the step's midpoint height.
-    EXPECT_NEAR(w.params().le_velocity, gd * L, 1e-3 * gd * L);
+    EXPECT_NEAR(w.le_velocity(), gd * L, 1e-3 * gd * L);
     double sy = 0, sv = 0, syy2 = 0, syv = 0, m = 0;
     for (std::size_t i = 0; i < w.bodies.size(); ++i) {
       const double y = w.bodies.pos[i].y(), v = w.bodies.vel[i].v.x();
@@ -238,7 +238,7 @@ TEST(Shear3Cell, ShearAtImposedInertialNumber) {
   stats([&](int q) { return slope[q] / gd; }, sm, sse);
   stats([&](int q) { return syy[q] / s.pressure; }, pm, pse);
   std::printf("gamma-dot %.5g /s; flow slope / gamma-dot = %.4f +- %.4f; (sigma_yy + K_yy)/p = %.4f +- %.4f; "
-              "L_y %.4g -> %.4g m\n", gd, sm, sse, pm, pse, L0.y(), w.params().cell.y());
+              "L_y %.4g -> %.4g m\n", gd, sm, sse, pm, pse, L0.y(), w.cell().size.y());
   EXPECT_NEAR(sm, 1.0, 3 * sse + 0.05);
   EXPECT_NEAR(pm, 1.0, 3 * pse + 0.05);
   for (int b = 0; b < nb; ++b) {
@@ -248,9 +248,9 @@ TEST(Shear3Cell, ShearAtImposedInertialNumber) {
     EXPECT_NEAR(dm, 0.0, 3 * dse + 0.05) << b;
   }
   // L_x, L_z fixed; the strain counted.
-  EXPECT_EQ(w.params().cell.x(), L0.x());
-  EXPECT_EQ(w.params().cell.z(), L0.z());
-  EXPECT_NEAR(w.params().strain, 3.0, 1e-9);
+  EXPECT_EQ(w.cell().size.x(), L0.x());
+  EXPECT_EQ(w.cell().size.z(), L0.z());
+  EXPECT_NEAR(w.cell().strain, 3.0, 1e-9);
 }
 
 // ---------------------------------------------------------------- restart, threads
@@ -288,16 +288,16 @@ TEST(Shear3Cell, CheckpointResumesBitIdenticallyOnOneOrTwoThreads) {
   int across = 0;
   for (const ContactInfo3& f : a.infos()) across += f.iy != 0;
   EXPECT_GT(across, 0);
-  EXPECT_NE(a.params().cell_rate.y(), 0.0);
+  EXPECT_NE(a.cell().rate.y(), 0.0);
   for (std::size_t i = 0; i < a.bodies.size(); ++i) {
     ASSERT_EQ(c.bodies.pos[i], a.bodies.pos[i]) << i;
     ASSERT_EQ(c.bodies.vel[i].v, a.bodies.vel[i].v) << i;
     ASSERT_EQ(c.bodies.vel[i].w, a.bodies.vel[i].w) << i;
   }
-  EXPECT_EQ(c.params().cell, a.params().cell);
-  EXPECT_EQ(c.params().cell_rate, a.params().cell_rate);
-  EXPECT_EQ(c.params().le_offset, a.params().le_offset);
-  EXPECT_EQ(c.params().strain, a.params().strain);
+  EXPECT_EQ(c.cell().size, a.cell().size);
+  EXPECT_EQ(c.cell().rate, a.cell().rate);
+  EXPECT_EQ(c.cell().le_offset, a.cell().le_offset);
+  EXPECT_EQ(c.cell().strain, a.cell().strain);
 }
 
 // ---------------------------------------------------------------- bad input
@@ -408,7 +408,7 @@ TEST(Shear3Cell, CheckpointByStrain) {
   opt.quiet = true;
   opt.fresh = true;
   run3(w, s, opt);
-  EXPECT_NEAR(w.params().strain, 0.5, 1e-9);
+  EXPECT_NEAR(w.cell().strain, 0.5, 1e-9);
   // series.csv's strain column (as in 2D) is gamma-dot t at every row: the
   // rate is imposed, so row k (every 5 steps) is at 5 k dt gd; the last 0.5.
   {
@@ -435,9 +435,9 @@ TEST(Shear3Cell, CheckpointByStrain) {
   }
   World3 c = build_world3(s);
   load_checkpoint3((dir / "checkpoint.bin").string(), c);
-  EXPECT_EQ(c.params().strain, w.params().strain);
-  EXPECT_EQ(c.params().cell, w.params().cell);
-  EXPECT_EQ(c.params().cell_rate, w.params().cell_rate);
-  EXPECT_EQ(c.params().le_offset, w.params().le_offset);
+  EXPECT_EQ(c.cell().strain, w.cell().strain);
+  EXPECT_EQ(c.cell().size, w.cell().size);
+  EXPECT_EQ(c.cell().rate, w.cell().rate);
+  EXPECT_EQ(c.cell().le_offset, w.cell().le_offset);
   for (std::size_t i = 0; i < w.bodies.size(); ++i) ASSERT_EQ(c.bodies.pos[i], w.bodies.pos[i]) << i;
 }

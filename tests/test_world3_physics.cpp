@@ -523,7 +523,7 @@ static void sheared_boundary_impact(bool cross_first) {
     PeriodicCell3 c;
     c.size = p.cell;
     c.periodic = p.periodic;
-    c.le_offset = w.params().le_offset;
+    c.le_offset = w.cell().le_offset;
     std::array<int, 3> k;
     const Vec3 xi = c.nearest_image(w.bodies.pos[a], w.bodies.pos[b], k);
     n = (xi - w.bodies.pos[a]).normalized();
@@ -653,7 +653,45 @@ TEST(Periodic3, SpherePlacedOutsideIsBroughtIn) {
   EXPECT_NEAR(w.bodies.pos[s].x(), x, 1e-15);
   EXPECT_NEAR(w.bodies.pos[s].y(), 0.13 + v0.y() * p.dt, 1e-15);
   EXPECT_NEAR(w.bodies.pos[s].z(), 0.1 + v0.z() * p.dt, 1e-15);
-  EXPECT_NEAR(w.params().le_offset, 0.03 + 0.7 * p.dt, 1e-16);
+  EXPECT_NEAR(w.cell().le_offset, 0.03 + 0.7 * p.dt, 1e-16);
+}
+
+// WorldParams3 is constant during a run (issue 27): what a Lees-Edwards
+// cell with L_y at imposed stress changes (lengths, rates, offset, strain,
+// the images' velocity) is the world's state, World3::cell(). One sphere,
+// no contact: L_y falls under the load p L_x L_z of mass M (a = p A / M =
+// 100 m/s^2: L_y = L0 - a t^2/2), the strain is gamma-dot t, the offset
+// the sum of dt gamma-dot L_y at each step's midpoint.
+TEST(Periodic3, ParametersStayConstantWhileTheCellMoves) {
+  WorldParams3 p;
+  p.dt = 1e-4;
+  p.cell = Vec3(0.1, 0.1, 0.1);
+  p.periodic = {true, true, true};
+  p.shear_rate = 2.0;
+  p.pressure = 100.0;
+  p.cell_mass = 0.01;
+  p.cell_dof = {false, true, false};
+  World3 w(p);
+  w.bodies.add_sphere(Vec3(0.05, 0.05, 0.05), 0.01, 1000);
+  const int n = 10;
+  double offset = 0.0;
+  for (int k = 0; k < n; ++k) {
+    // L_y at the step's midpoint: L0 - a dt^2 (k^2 + k) / 2.
+    offset += p.dt * p.shear_rate * (0.1 - 0.5 * 100.0 * p.dt * p.dt * (k * k + k));
+    w.step();
+  }
+  ASSERT_EQ(w.rows().size(), 0u);
+  const WorldParams3& q = w.params();
+  EXPECT_EQ(q.cell, p.cell);
+  EXPECT_EQ(q.le_offset, 0.0);
+  EXPECT_EQ(q.le_velocity, 0.0);
+  const double t = n * p.dt;
+  EXPECT_NEAR(w.cell().rate.y(), -100.0 * t, 1e-12);
+  EXPECT_NEAR(w.cell().size.y(), 0.1 - 0.5 * 100.0 * t * t, 1e-15);
+  EXPECT_EQ(w.cell().size.x(), 0.1);
+  EXPECT_NEAR(w.cell().strain, p.shear_rate * t, 1e-15);
+  EXPECT_NEAR(w.cell().le_offset, offset, 1e-16);
+  EXPECT_NEAR(w.le_velocity(), p.shear_rate * (0.1 - 0.5 * 100.0 * p.dt * p.dt * ((n - 1) * (n - 1) + n - 1)), 1e-14);
 }
 
 // Refused: Lees-Edwards without periodic x and y, a periodic axis without a

@@ -78,9 +78,10 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
   o.array("3d.warm.keys", w.warm_start().keys);
   o.array("3d.warm.p", w.warm_start().p);
   const WorldParams3& p = w.params();
-  o.array("3d.cell", std::vector<double>{p.cell.x(), p.cell.y(), p.cell.z(), p.le_offset, double(p.periodic[0]),
-                                         double(p.periodic[1]), double(p.periodic[2]), p.cell_rate.x(),
-                                         p.cell_rate.y(), p.cell_rate.z(), p.strain});
+  const CellState3& c = w.cell();
+  o.array("3d.cell", std::vector<double>{c.size.x(), c.size.y(), c.size.z(), c.le_offset, double(p.periodic[0]),
+                                         double(p.periodic[1]), double(p.periodic[2]), c.rate.x(), c.rate.y(),
+                                         c.rate.z(), c.strain});
   ckpt::finish(o, totals, path);
 }
 
@@ -101,7 +102,7 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
   if (cell.size() != 7 && cell.size() != 11)
     in.fail(fmt::format("is corrupt: '3d.cell' holds {} numbers (must be 7 or 11)", cell.size()));
   for (std::size_t c = 0; c < cell.size(); ++c) in.finite("3d.cell", c, "", cell[c]);
-  WorldParams3 p = w.params();
+  const WorldParams3& p = w.params();
   for (int a = 0; a < 3; ++a)
     if ((cell[4 + a] != 0.0) != p.periodic[a])
       in.fail(fmt::format("holds a cell periodic along (x, y, z) = ({:d}, {:d}, {:d}); this scene's is ({:d}, "
@@ -110,16 +111,18 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
   const RunTotals tot = ckpt::close(in, h);
   ckpt::check_count(in, b.size(), w.bodies.size());
 
-  p.cell = Vec3(cell[0], cell[1], cell[2]);
-  p.le_offset = cell[3];
-  p.cell_rate = cell.size() == 11 ? Vec3(cell[7], cell[8], cell[9]) : Vec3::Zero();
-  p.strain = cell.size() == 11 ? cell[10] : 0.0;
+  CellState3 c;
+  c.size = Vec3(cell[0], cell[1], cell[2]);
+  c.le_offset = cell[3];
+  c.rate = cell.size() == 11 ? Vec3(cell[7], cell[8], cell[9]) : Vec3::Zero();
+  c.strain = cell.size() == 11 ? cell[10] : 0.0;
   try {
     World3 probe(p);  // checks the cell without touching w
+    probe.set_cell(c);
   } catch (const std::invalid_argument& e) {
     in.fail(fmt::format("holds a cell this scene cannot take ({})", e.what()));
   }
-  w.set_params(p);
+  w.set_cell(c);
   w.bodies = std::move(b);
   w.steps = h.steps;
   w.time = h.time;

@@ -23,9 +23,9 @@ namespace cd {
 void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
                       const RunTotals& totals = {});
 
-// Reads a checkpoint into w: its parameters are kept but for the cell's
-// state (lengths, Lees-Edwards offset, rates, strain), which the checkpoint's replace;
-// a checkpoint whose periodic axes differ from w's is refused. Returns the
+// Reads a checkpoint into w: its parameters are kept, its cell's state
+// (CellState3: lengths, Lees-Edwards offset, rates, strain) is the
+// checkpoint's; a checkpoint whose periodic axes differ from w's is refused. Returns the
 // stored scene key; with `totals`, also the run's totals. w is changed only if the
 // whole file is valid; otherwise throws CheckpointError naming the file.
 std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals = nullptr);

@@ -70,10 +70,10 @@ Columns cell_columns3(const World3& w, const Eigen::Matrix3d& S, double density,
   const double gd = w.shear_rate();
   const Eigen::Matrix3d K = w.kinetic_stress();
   const obs::Coordination zc = coordination3(w);
-  const Vec3 L = w.params().cell;
+  const Vec3 L = w.cell().size;
   const double syy = S(1, 1), sxy_sym = 0.5 * (S(0, 1) + S(1, 0));
   const char* name[3] = {"x", "y", "z"};
-  Columns c{{"strain", w.params().strain}, {"shear_rate", gd}};
+  Columns c{{"strain", w.cell().strain}, {"shear_rate", gd}};
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) c.emplace_back(fmt::format("s{}{}", name[i], name[j]), S(i, j));
   c.insert(c.end(), {{"p", p},

@@ -242,14 +242,14 @@ void load_start3(const Scene& s, World3& w) {
     throw SceneError(fmt::format("shear.start: the sample's mean diameter is {:.4g} m, particles.d_mean is "
                                  "{:.4g} m; set particles.d_mean to the preparation's",
                                  nd ? dsum / nd : 0.0, d_ref));
-  WorldParams3 q = w.params();
-  const bool sheared = q.strain != 0.0;
+  CellState3 c = w.cell();
+  const bool sheared = c.strain != 0.0;
   if (!sheared) {
-    q.le_offset = 0.0;
-    q.cell_rate = Vec3::Zero();
+    c.le_offset = 0.0;
+    c.rate = Vec3::Zero();
   }
-  q.strain = 0.0;
-  w.set_params(q);
+  c.strain = 0.0;
+  w.set_cell(c);
   w.steps = 0;
   w.time = 0.0;
   w.times = StageTimes{};
@@ -264,7 +264,8 @@ void load_start3(const Scene& s, World3& w) {
     g = den > 0 ? (m * syv - sy * sv) / den : 0.0;
     a = m > 0 ? (sv - g * sy) / m : 0.0;
   }
-  const double y0 = q.cell_origin.y() + 0.5 * q.cell.y();
+  const WorldParams3& q = w.params();
+  const double y0 = q.cell_origin.y() + 0.5 * c.size.y();
   for (std::size_t i = 0; i < B.size(); ++i) {
     const double y = B.pos[i].y();
     if (sheared) B.vel[i].v.x() -= a + g * y;

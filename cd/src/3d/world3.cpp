@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <variant>
 
 #include "cell_dof.hpp"
 #include "colour_rows.hpp"
@@ -32,11 +33,13 @@ void World3::configure() {
   gravity_on_ = prm_.gravity.squaredNorm() > 0.0;
   adhesion_on_ = prm_.adhesion > 0.0;
   restitution_on_ = prm_.e_n > 0.0 || prm_.e_t > 0.0;
-  periodic_on_ = prm_.periodic[0] || prm_.periodic[1] || prm_.periodic[2];
+  const bool periodic = prm_.periodic[0] || prm_.periodic[1] || prm_.periodic[2];
   for (int a = 0; a < 3; ++a)
-    if (prm_.periodic[a] && !(prm_.cell[a] > 0.0))
+    if (prm_.periodic[a] && !(cell_.size[a] > 0.0))
       throw std::invalid_argument("WorldParams3: a periodic axis needs cell > 0");
-  const bool le = prm_.le_offset != 0.0 || prm_.le_velocity != 0.0 || prm_.shear_rate != 0.0;
+  // Lees-Edwards: images that slide, or a cell whose images are offset (a
+  // checkpoint's or a start sample's, the shear stopped).
+  const bool le = cell_.le_offset != 0.0 || prm_.le_velocity != 0.0 || prm_.shear_rate != 0.0;
   if (le && !(prm_.periodic[0] && prm_.periodic[1]))
     throw std::invalid_argument("WorldParams3: Lees-Edwards needs periodic x and y");
   const bool tri = prm_.periodic[0] && prm_.periodic[1] && prm_.periodic[2];
@@ -44,9 +47,17 @@ void World3::configure() {
              (prm_.cell_dof[0] || prm_.cell_dof[1] || prm_.cell_dof[2]);
   if (dofs_on_ && !tri)
     throw std::invalid_argument("WorldParams3: cell lengths at imposed stress need a tri-periodic cell");
+  // The protocol, chosen here once (boundary3.hpp).
+  if (!periodic)
+    boundary_ = NoBoundary3{};
+  else if (le)
+    boundary_ = LeesEdwardsCell3{};
+  else
+    boundary_ = Cell3{};
   // Images move relative to the bodies: Lees-Edwards, or lengths that move.
-  moving_images_ = (le && (prm_.le_velocity != 0.0 || prm_.shear_rate != 0.0)) || dofs_on_;
-  cm_ = prm_.cell;
+  const bool moving_images = (le && (prm_.le_velocity != 0.0 || prm_.shear_rate != 0.0)) || dofs_on_;
+  le_velocity_ = prm_.le_velocity;
+  cm_ = cell_.size;
   if (!dofs_on_) prob_.dofs.clear();
   // Contacts within the alert distance enter the solver with the gap term
   // u_n + g_m/dt >= 0, which closes gaps without overlap (as in 2D). With
@@ -60,7 +71,7 @@ void World3::configure() {
                  (prm_.orthotropic && (prm_.mu_b > 0.0 || prm_.mu_wall_b > 0.0));
   // Tangential offsets: tangential restitution or moving images; they and
   // the orthotropic mu_b are the rows' RowExtra3.
-  const bool offsets = prm_.e_t > 0.0 || moving_images_;
+  const bool offsets = prm_.e_t > 0.0 || moving_images;
   extras_on_ = friction_on_ && (offsets || prm_.orthotropic);
   prob_.law = choose_law3(friction_on_, adhesion_on_, offsets, prm_.orthotropic);
 }
@@ -95,13 +106,7 @@ void World3::predict() {
   xm_.resize(n);
   qm_.resize(n);
   const bool par = static_cast<int>(n) >= prm_.solver.min_parallel / 2;
-  // The midpoint cell: lengths at imposed stress move at their rates; an
-  // imposed shear rate sets the images' velocity from the midpoint height.
-  if (dofs_on_) cm_ = prm_.cell + h * prm_.cell_rate;
-  if (prm_.shear_rate != 0.0) prm_.le_velocity = prm_.shear_rate * cm_.y();
-  // Spheres placed outside a periodic cell are brought in first (the end
-  // of each step keeps them in), so that image counts stay small.
-  if (periodic_on_) wrap_into_cell(prm_.le_offset);
+  std::visit([&](const auto& b) { b.predict(*this, h); }, boundary_);
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t i = 0; i < n; ++i) {
     const BodyVel3& v = bodies.vel[i];
@@ -111,14 +116,15 @@ void World3::predict() {
 }
 
 void World3::detect_stage() {
-  if (periodic_on_)
-    detect3(bodies, xm_, alert_, cell_at(prm_.le_offset + 0.5 * prm_.dt * prm_.le_velocity, cm_), grid_, prob_.rows,
-            info_, prm_.solver.min_parallel);
-  else
-    detect3(bodies, xm_, alert_, grid_, prob_.rows, info_, prm_.solver.min_parallel);
+  std::visit([&](const auto& b) { b.detect(*this); }, boundary_);
 }
 
 void World3::build() {
+  std::visit([&](const auto& b) { build_rows(b); }, boundary_);
+}
+
+template <class B>
+void World3::build_rows([[maybe_unused]] const B& b) {
   const double dt = prm_.dt;
   const auto& V = bodies.vel;
   const std::size_t nr = prob_.rows.size();
@@ -157,14 +163,16 @@ void World3::build() {
     // the step's start). That velocity is part of the relative velocity the
     // law sees.
     Vec3 vimg = Vec3::Zero();
-    const ContactInfo3& f = info_[k];
-    if (moving_images_ && (f.iy != 0 || (dofs_on_ && (f.ix != 0 || f.iz != 0)))) {
-      const Vec3& L = prm_.cell_rate;
-      vimg = Vec3(f.iy * prm_.le_velocity + f.ix * L.x(), f.iy * L.y(), f.iz * L.z());
-      r.bn += r.n.dot(vimg);
-      if (x) {
-        x->bt1 = r.t1.dot(vimg);
-        x->bt2 = r.t2.dot(vimg);
+    if constexpr (B::moving_images) {
+      const ContactInfo3& f = info_[k];
+      if (b.image_moves(f, dofs_on_)) {
+        const Vec3& L = cell_.rate;
+        vimg = Vec3(f.iy * le_velocity_ + f.ix * L.x(), f.iy * L.y(), f.iz * L.z());
+        r.bn += r.n.dot(vimg);
+        if (x) {
+          x->bt1 = r.t1.dot(vimg);
+          x->bt2 = r.t2.dot(vimg);
+        }
       }
     }
     // Restitution: the law on u+ + e u-, u- the relative velocity at the
@@ -223,7 +231,7 @@ void World3::solve() {
   if (hook_) hook_(prob_, prm_.solver);
   last_.solve = solver_ ? solver_(prob_, prm_.solver) : nlgs_solve3(prob_, prm_.solver);
   prob_.vel.swap(V);
-  for (const CellDof3& d : prob_.dofs) prm_.cell_rate[d.axis] = d.v;
+  for (const CellDof3& d : prob_.dofs) cell_.rate[d.axis] = d.v;
 
   // Keep the impulses (world frame) for the next step's warm start.
   const std::size_t nr = prob_.rows.size();
@@ -253,7 +261,7 @@ void World3::set_dofs(const Eigen::Matrix3d& K) {
     CellDof3 d;
     d.axis = a;
     d.inv_mass = 1.0 / M;
-    const double area = V / cm_[a], v_start = prm_.cell_rate[a];
+    const double area = V / cm_[a], v_start = cell_.rate[a];
     d.v0 = cell_dof::free_velocity(v_start, (prm_.pressure - K(a, a)) * area, M, dt,
                                    cell_dof::floor(prm_.max_strain_rate, cm_[a], alert_, dt));
     d.v = d.v0;
@@ -288,20 +296,14 @@ void World3::integrate() {
     bodies.pos[i] = xm_[i] + h * v.v;
     bodies.orient[i] = rotate(qm_[i], v.w, h);
   }
-  if (!periodic_on_) return;
-  if (dofs_on_) prm_.cell = cm_ + h * prm_.cell_rate;
-  prm_.strain += prm_.dt * shear_rate();
-  double off = prm_.le_offset + prm_.dt * prm_.le_velocity;
-  if (prm_.periodic[0]) off -= prm_.cell.x() * std::floor(off / prm_.cell.x());
-  wrap_into_cell(off);
-  prm_.le_offset = off;
+  std::visit([&](const auto& b) { b.integrate(*this, h); }, boundary_);
 }
 
 // Spheres back into the periodic cell at Lees-Edwards offset `off`: a
 // sphere moved by ky images across y takes the images' shift and velocity.
 void World3::wrap_into_cell(double off) {
   const std::size_t n = bodies.size();
-  const PeriodicCell3 c = cell_at(off, prm_.cell);
+  const PeriodicCell3 c = cell_at(off, cell_.size);
   if (dofs_on_) {
     // Lengths that move: a sphere brought back across face a takes the
     // images' velocity there, k_a dL_a/dt e_a, too. The origin is fixed, so
@@ -311,7 +313,7 @@ void World3::wrap_into_cell(double off) {
     // symmetry of the periodic cell, so it is removed (2D's rule; the
     // gamma-dot L_y part is the usual Lees-Edwards one, kept). In body
     // order, one thread: the sum must not depend on the thread count.
-    const Vec3& R = prm_.cell_rate;
+    const Vec3& R = cell_.rate;
     Vec3 P = Vec3::Zero();
     double mass = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -320,7 +322,7 @@ void World3::wrap_into_cell(double off) {
       bodies.pos[i] = c.wrap(bodies.pos[i], k);
       const Vec3 dv(k[0] * R.x(), k[1] * R.y(), k[2] * R.z());
       bodies.vel[i].v += dv;
-      bodies.vel[i].v.x() += k[1] * prm_.le_velocity;
+      bodies.vel[i].v.x() += k[1] * le_velocity_;
       P += bodies.mass[i] * dv;
       mass += bodies.mass[i];
     }
@@ -336,7 +338,7 @@ void World3::wrap_into_cell(double off) {
     if (bodies.shape[i] != Shape3::Sphere) continue;
     std::array<int, 3> k;
     bodies.pos[i] = c.wrap(bodies.pos[i], k);
-    if (k[1] != 0) bodies.vel[i].v.x() += k[1] * prm_.le_velocity;
+    if (k[1] != 0) bodies.vel[i].v.x() += k[1] * le_velocity_;
   }
 }
 
@@ -392,12 +394,11 @@ std::vector<obs::Contact<3>> World3::contact_forces() const {
 
 double World3::cell_volume() const {
   const bool tri = prm_.periodic[0] && prm_.periodic[1] && prm_.periodic[2];
-  return tri ? prm_.cell.x() * prm_.cell.y() * prm_.cell.z() : 0.0;
+  return tri ? cell_.size.x() * cell_.size.y() * cell_.size.z() : 0.0;
 }
 
 double World3::shear_rate() const {
-  if (!prm_.periodic[1]) return 0.0;
-  return prm_.shear_rate != 0.0 ? prm_.shear_rate : prm_.le_velocity / prm_.cell.y();
+  return std::visit([&](const auto& b) { return b.shear_rate(*this); }, boundary_);
 }
 
 Eigen::Matrix3d World3::contact_stress(double volume) const {

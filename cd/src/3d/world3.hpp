@@ -15,7 +15,11 @@
 //   observe    contacts, active contacts, overlaps
 // The law (frictionless, Coulomb round or orthotropic, cohesive or not, with
 // or without tangential offsets) is fixed once per scene into a template
-// instance of the sweep.
+// instance of the sweep; the boundary protocol (no cell, periodic cell,
+// Lees-Edwards cell: boundary3.hpp) once per scene into a Boundary3, whose
+// hooks the predict, detect, build and integrate stages call. WorldParams3
+// is constant during a run; what the steps change is World3's state: the
+// bodies, the cell (CellState3), the warm-start memory.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -24,6 +28,7 @@
 #include <vector>
 
 #include "bodies3.hpp"
+#include "boundary3.hpp"
 #include "contact3.hpp"
 #include "contact_problem3.hpp"
 #include "detect3.hpp"
@@ -66,20 +71,22 @@ struct WorldParams3 {
 
   // Periodic cell (off unless some periodic[a]): along a periodic axis the
   // spheres meet the images of the others and are brought back into
-  // [cell_origin, cell_origin + cell) at the end of each step. Lees-Edwards
-  // (periodic x and y): the images across y, at +-cell.y, are shifted along x
-  // by +-le_offset and move at +-le_velocity along x (shear along x,
-  // gradient along y); a sphere brought back across y has its x and v_x
-  // shifted with them. le_offset is the current shift: each step advances it
-  // by le_velocity dt (kept in [0, cell.x)). Each periodic length must be
-  // >= 2 (2 r_max + alert).
+  // [cell_origin, cell_origin + L) at the end of each step. Lees-Edwards
+  // (periodic x and y): the images across y, at +-L_y, are shifted along x
+  // by +-offset and move at +-V along x (shear along x, gradient along y);
+  // a sphere brought back across y has its x and v_x shifted with them.
+  // Each step advances the offset by V dt (kept in [0, L_x)). Each periodic
+  // length must be >= 2 (2 r_max + alert). `cell` and `le_offset` are the
+  // lengths L and the offset at construction: from there on they are the
+  // world's state (World3::cell(), CellState3), which the step changes.
+  // le_velocity: V, the images' velocity, unless shear_rate is set.
   Vec3 cell_origin = Vec3::Zero(), cell = Vec3::Zero();
   std::array<bool, 3> periodic{false, false, false};
   double le_offset = 0.0, le_velocity = 0.0;
 
   // Imposed shear rate gamma-dot (> 0): the images across y move at
-  // le_velocity = gamma-dot L_y, L_y at each step's midpoint (a height that
-  // follows a pressure changes it); 0: le_velocity as given.
+  // V = gamma-dot L_y, L_y at each step's midpoint (a height that follows a
+  // pressure changes it); 0: V = le_velocity.
   double shear_rate = 0.0;
   // Cell lengths at imposed stress (tri-periodic cell; method.md section 9,
   // docs/3d.md; 2D's LeesEdwardsCell in 3D): with pressure > 0 and
@@ -92,24 +99,42 @@ struct WorldParams3 {
   // shrink at most at that strain rate (the brake, core/cell_dof.hpp).
   double pressure = 0.0, cell_mass = 0.0, max_strain_rate = 0.0;
   std::array<bool, 3> cell_dof{false, false, false};
-  // The cell's state beside its lengths and le_offset (checkpointed):
-  // dL/dt, and the shear strain sum dt gamma-dot.
-  Vec3 cell_rate = Vec3::Zero();
+};
+
+// The periodic cell's state, what the steps change (checkpointed, "3d.cell";
+// 2D's CellState): the lengths L, the Lees-Edwards offset (in [0, L_x)),
+// the rates dL/dt of the lengths at imposed stress, and the shear strain
+// sum dt gamma-dot. All 0 without a cell.
+struct CellState3 {
+  Vec3 size = Vec3::Zero();
+  double le_offset = 0.0;
+  Vec3 rate = Vec3::Zero();
   double strain = 0.0;
 };
 
 class World3 {
  public:
-  explicit World3(const WorldParams3& p) : prm_(p) { configure(); }
+  // The cell starts from the parameters' lengths and offset, at rest.
+  explicit World3(const WorldParams3& p) : prm_(p), cell_{p.cell, p.le_offset} { configure(); }
 
   Bodies3 bodies;
   double time = 0.0;
   std::int64_t steps = 0;
   StageTimes times;
 
+  // The parameters are constant during the run; set_params replaces them
+  // (a study's or a test's change), the cell's state kept.
   const WorldParams3& params() const { return prm_; }
   void set_params(const WorldParams3& p) {
     prm_ = p;
+    configure();
+  }
+  // The periodic cell's state; set_cell replaces it (a checkpoint, a start
+  // sample), checked against the parameters as at construction (throws
+  // std::invalid_argument).
+  const CellState3& cell() const { return cell_; }
+  void set_cell(const CellState3& c) {
+    cell_ = c;
     configure();
   }
 
@@ -147,6 +172,9 @@ class World3 {
   // Shear rate of the Lees-Edwards cell: WorldParams3::shear_rate if set,
   // else le_velocity / L_y (0 without).
   double shear_rate() const;
+  // The Lees-Edwards images' velocity V along x of the last step
+  // (gamma-dot L_y at its midpoint, or WorldParams3::le_velocity).
+  double le_velocity() const { return le_velocity_; }
   // The cell lengths solved at imposed stress (pressure, cell_mass and some
   // cell_dof set).
   bool cell_dofs() const { return dofs_on_; }
@@ -170,6 +198,9 @@ class World3 {
   void set_warm_start(WarmStart w) { warm_ = std::move(w); }
 
  private:
+  friend struct NoBoundary3;
+  friend struct Cell3;
+  friend struct LeesEdwardsCell3;
   void configure();
   void predict();
   void detect_stage();
@@ -179,14 +210,21 @@ class World3 {
   void integrate();
   void observe();
 
+  template <class B>
+  void build_rows(const B& b);
   PeriodicCell3 cell_at(double offset, const Vec3& size) const;
   void wrap_into_cell(double offset);
   void set_dofs(const Eigen::Matrix3d& K);
 
   WorldParams3 prm_;
-  bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, periodic_on_ = false,
-       moving_images_ = false, extras_on_ = false, dofs_on_ = false, friction_on_ = false;
+  CellState3 cell_;
+  Boundary3 boundary_;
+  // dofs_on_: the cell's lengths at imposed stress (a Cell3's or a
+  // LeesEdwardsCell3's).
+  bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, extras_on_ = false,
+       dofs_on_ = false, friction_on_ = false;
   double alert_ = 0.0;
+  double le_velocity_ = 0.0;  // V of the step (LeesEdwardsCell3)
   StepStats last_;
   std::vector<Vec3> xm_;
   std::vector<Quat> qm_;
