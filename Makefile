@@ -32,6 +32,7 @@ all: build
 # fails when a target of this Makefile, or a variable it reads with ?= or
 # never sets, is missing here.
 help_space := $() $()
+# '$(1)', quoted for the shell (also the manifests' 'VAR=value' pairs).
 help_q = '$(subst ','\'',$(1))'
 help_var = @printf '  %-34s %s\n' $(call help_q,$(1)=$(if $(findstring $(help_space),$($(1))),"$($(1))",$($(1))))\
   $(call help_q,$(2))
@@ -66,10 +67,15 @@ help:
 	@echo "  make campaign-angularity        each shape of ANGULAR_NS (2D) at ANGULAR_I"
 	@echo "  make campaign-pressure          steady shear at PRESSURE_I under each p of PRESSURE_P"
 	@echo "  make campaign-pressure-ladder   the same from the lowest p up, each from the point below"
+	@echo "  make campaign-status [CAMPAIGN=inertial]  each run: done / running / not started / failed / stopped,"
+	@echo "                       its progress, cost (CPU, steps) and ETA (every campaign in CAMPAIGNS unless CAMPAIGN)"
+	@echo "  (each campaign folder's manifest.toml holds what made it: make refuses to add runs made with another"
+	@echo "   N, STRAIN, P, ... to it, naming the difference; docs/shear.md, \"What made a campaign\")"
 	@echo "Analyses of CAMPAIGNS/<name> into outputs/analysis[3d]/<name>/ (docs/analysis.md)"
 	@echo "  make analyze-inertial, analyze-inertial-ladder, analyze-cohesive, analyze-angularity"
 	@echo "  make analyze-pressure, analyze-pressure-ladder   cdanalysis report and the campaign's fits"
 	@echo "Used by the targets above and by scripts"
+	@echo "  make programs        build cdsim, cdanalysis and cdproblem only (what the campaigns run)"
 	@echo "  make campaign-list CAMPAIGN=inertial      the run folders of a campaign (configs/cluster/job-array.sh)"
 	@echo "  make campaign-prep-of RUN=<run folder>    the sample that run starts from"
 	@echo "  make regress-campaign, regress3-campaign  the reference campaigns of make regress"
@@ -107,7 +113,7 @@ help:
 	$(call help_var,CKPT_WALL,and every this many seconds of wall clock)
 	$(call help_var,PROGRESS,seconds of wall clock between the progress lines of a campaign run)
 	$(call help_var,WINDOW,steady window of the fits: a:b (strain) or a%:b%; empty: detected)
-	$(call help_var,CAMPAIGN,campaign of make campaign-list (inertial cohesive angularity ...))
+	$(call help_var,CAMPAIGN,campaign of make campaign-list or campaign-status (inertial inertial-ladder cohesive ...))
 	$(call help_var,RUN,run folder of make campaign-prep-of)
 	$(call help_var,QUICK,1: the short version of accuracy-cost, tensile and compare-liggghts-shear)
 	$(call help_var,BIG,1: make bench's 3D sizes up to 1e5)
@@ -269,8 +275,12 @@ prep-overlap: build
 # a .done file written after cdsim succeeds), so `make -j` runs campaigns in
 # parallel, finished runs are skipped, and a killed run resumes from its
 # checkpoint when made again. Every shear run starts from a compacted sample
-# (prep/...) made once per size and shape. Changing N or STRAIN does not
-# invalidate finished runs: use another CAMPAIGNS folder (or remove it).
+# (prep/...) made once per size and shape. Each campaign folder and prep/
+# hold a manifest.toml of the variables their runs were made with
+# (cd/campaign/manifest.sh): make refuses, naming the difference, to add runs
+# made with another N, STRAIN, P, ... to them (use another CAMPAIGNS folder,
+# or remove it), before any run starts. `make campaign-status` tells each
+# run's state, cost and ETA (cd/campaign/status.sh).
 N        ?= 200
 STRAIN   ?= 2
 # The imposed pressure and the grains' density: 2D per length and per area
@@ -332,7 +342,7 @@ inertial_runs   := $(foreach i,$(INERTIAL_I),$(CAMPAIGNS)/inertial/I_$(i))
 cohesive_runs   := $(foreach e,$(COHESIVE_ETA),$(foreach i,$(COHESIVE_I),$(CAMPAIGNS)/cohesive/eta_$(e)_I_$(i)))
 angularity_runs := $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/angularity/ns_$(n))
 
-.PHONY: campaign-inertial campaign-cohesive campaign-angularity campaign-list
+.PHONY: campaign-inertial campaign-cohesive campaign-angularity campaign-list campaign-status programs
 campaign-inertial: $(addsuffix /.done,$(inertial_runs))
 campaign-cohesive: $(addsuffix /.done,$(cohesive_runs))
 campaign-angularity: $(addsuffix /.done,$(angularity_runs))
@@ -341,6 +351,16 @@ campaign-angularity: $(addsuffix /.done,$(angularity_runs))
 .PHONY: campaign-prep-of
 campaign-list:
 	@for r in $($(CAMPAIGN)_runs); do echo $$r; done
+# make campaign-status [CAMPAIGN=<name>]: each run's state, cost and ETA
+# (cd/campaign/status.sh), of CAMPAIGN or of every campaign in CAMPAIGNS.
+inertial-ladder_runs = $(ladder_runs)
+pressure-ladder_runs = $(pressure_ladder_runs)
+status_campaigns = $(or $(CAMPAIGN),$(foreach c,inertial inertial-ladder cohesive angularity pressure pressure-ladder,\
+  $(if $(wildcard $(CAMPAIGNS)/$(c)),$(c))))
+prep_runs = $(CAMPAIGNS)/prep/ns_0 $(if $(filter angularity,$(status_campaigns)),$(filter-out %/ns_0,\
+  $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/prep/ns_$(n))))
+campaign-status:
+	@cd/campaign/status.sh $(CAMPAIGNS) $(foreach c,prep $(status_campaigns),$(call help_q,$(c)=$($(c)_runs)))
 campaign-prep-of:
 	@case "$(RUN)" in */angularity/ns_*) echo $(CAMPAIGNS)/prep/$(notdir $(RUN))/.done ;; \
 	  *) echo $(CAMPAIGNS)/prep/ns_0/.done ;; esac
@@ -348,10 +368,51 @@ campaign-prep-of:
 # Products, never intermediates: make must not delete a sample when done.
 .PRECIOUS: $(CAMPAIGNS)/prep/ns_%/.done
 
+# What the runs need: the programs, not the tests and benchmarks.
+programs: deps $(BUILD)/CMakeCache.txt
+	$(call build_only,cdsim cdanalysis cdproblem)
+
+# ---- Manifests: what made a campaign (docs/shear.md) ------------------------
+# $(CAMPAIGNS)/<c>/.manifest-check (never a file: it runs on every make)
+# compares the variables of campaign c's runs with <c>/manifest.toml, or
+# writes it; every run rule of c has it as an order-only prerequisite, so a
+# refusal comes before any run of the campaign starts. prep/ holds the
+# samples' variables; each campaign's manifest has them too (a campaign
+# folder tells alone what made it). Compared: what changes a finished run
+# and is not in its folder's name; recorded: the values (I, eta, shapes, p)
+# run so far, the tolerance policy, and the builds.
+manifest_keys_prep :=
+manifest_keys_inertial := STRAIN SHEAR_TOL SHEAR_SET
+manifest_record_inertial := INERTIAL_I
+# A ladder's points start from each other: its values are compared.
+manifest_keys_inertial-ladder := LADDER_STRAIN SHEAR_TOL SHEAR_SET INERTIAL_I
+manifest_keys_cohesive := STRAIN SHEAR_TOL SHEAR_SET COHESIVE_TOL
+manifest_record_cohesive := COHESIVE_ETA COHESIVE_I
+manifest_keys_angularity := STRAIN SHEAR_TOL SHEAR_SET ANGULAR_I
+manifest_record_angularity := ANGULAR_NS
+manifest_keys_pressure := STRAIN SHEAR_TOL SHEAR_SET PRESSURE_I
+manifest_record_pressure := PRESSURE_P
+manifest_keys_pressure-ladder := LADDER_STRAIN SHEAR_TOL SHEAR_SET PRESSURE_I PRESSURE_P
+sample_keys := DIM N P SIZE_RATIO SIZE_DIST PREP_SET
+tolerance_policy = $(if $(SHEAR_TOL),solver.tol = $(SHEAR_TOL) and residual_tol = 0 for every run (SHEAR_TOL),by I: cdsim's shear policy (docs/shear.md, Settings by I))
+make_dry = $(if $(findstring n,$(firstword -$(MAKEFLAGS))),1,0)
+# `+`: checked under make -n too (which writes nothing). A static pattern
+# rule: an implicit rule's product would be an intermediate file, which make
+# does not make when the runs after it are done (so no refusal then).
+manifest_checks := $(foreach c,prep inertial inertial-ladder cohesive angularity pressure pressure-ladder,\
+  $(CAMPAIGNS)/$(c)/.manifest-check)
+$(manifest_checks): $(CAMPAIGNS)/%/.manifest-check:
+	+@cd/campaign/manifest.sh $(@D)/manifest.toml $(make_dry) \
+	  $(foreach v,$(sample_keys) $(manifest_keys_$*),$(call help_q,$(v)=$($(v)))) \
+	  -- $(foreach v,$(manifest_record_$*),$(call help_q,$(v)=$($(v)))) \
+	  $(if $(filter prep,$*),,$(call help_q,tolerance=$(tolerance_policy)))
+# The campaigns asked on the command line: checked before a sample is made.
+goal_manifests = $(foreach c,$(filter-out list prep-of status,$(patsubst campaign-%,%,$(filter campaign-%,$(MAKECMDGOALS)))),$(CAMPAIGNS)/$(c)/.manifest-check)
+
 # Compacted samples: disks (ns_0) or n-gons, N grains, isotropic at P
 # (3D: spheres, compacted at 0.05 / t_p for 50 t_p; PREP_SET adds settings).
 PREP_SET ?= $(if $(dim3),$(PREP3_FAST))
-$(CAMPAIGNS)/prep/ns_%/.done: | build
+$(CAMPAIGNS)/prep/ns_%/.done: | programs $(CAMPAIGNS)/prep/.manifest-check $(goal_manifests)
 	$(CDSIM) $(PREP_SCENE) --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_strain=0 \
 	  --set output.snapshot_interval=0 \
 	  --set particles.n=$(N) --set particles.nsides=[$*] --set shear.pressure=$(P) \
@@ -375,7 +436,7 @@ SHEAR_SET ?=
 # A fresh run: $(1) I, $(2) the shape (its compacted sample).
 shear_run = $(call shear_cmd,$(1),$(CAMPAIGNS)/prep/ns_$(2),$(P),$(STRAIN)) --set particles.nsides=[$(2)]
 
-$(CAMPAIGNS)/inertial/I_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
+$(CAMPAIGNS)/inertial/I_%/.done: $(CAMPAIGNS)/prep/ns_0/.done | $(CAMPAIGNS)/inertial/.manifest-check
 	$(call shear_run,$*,0)
 	touch $@
 
@@ -395,7 +456,7 @@ ladder_start = $(if $(call ladder_above,$(1)),$(CAMPAIGNS)/inertial-ladder/I_$(c
 .PHONY: campaign-inertial-ladder
 campaign-inertial-ladder: $(addsuffix /.done,$(ladder_runs))
 .SECONDEXPANSION:
-$(CAMPAIGNS)/inertial-ladder/I_%/.done: $$(call ladder_start,$$*)/.done
+$(CAMPAIGNS)/inertial-ladder/I_%/.done: $$(call ladder_start,$$*)/.done | $(CAMPAIGNS)/inertial-ladder/.manifest-check
 	$(call shear_cmd,$*,$(call ladder_start,$*),$(P),$(LADDER_STRAIN))
 	touch $@
 
@@ -417,20 +478,20 @@ pressure_run = $(call shear_cmd,$(PRESSURE_I),$(2),$(1),$(3))
 .PHONY: campaign-pressure campaign-pressure-ladder
 campaign-pressure: $(addsuffix /.done,$(pressure_runs))
 campaign-pressure-ladder: $(addsuffix /.done,$(pressure_ladder_runs))
-$(CAMPAIGNS)/pressure/p_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
+$(CAMPAIGNS)/pressure/p_%/.done: $(CAMPAIGNS)/prep/ns_0/.done | $(CAMPAIGNS)/pressure/.manifest-check
 	$(call pressure_run,$*,$(CAMPAIGNS)/prep/ns_0,$(STRAIN))
 	touch $@
-$(CAMPAIGNS)/pressure-ladder/p_%/.done: $$(call pressure_start,$$*)/.done
+$(CAMPAIGNS)/pressure-ladder/p_%/.done: $$(call pressure_start,$$*)/.done | $(CAMPAIGNS)/pressure-ladder/.manifest-check
 	$(call pressure_run,$*,$(call pressure_start,$*),$(LADDER_STRAIN))
 	touch $@
 
 # eta_<eta>_I_<I>: f_a = eta p d (3D: eta p d^2); eta = 0 are the reference runs of the fit.
-$(CAMPAIGNS)/cohesive/eta_%/.done: $(CAMPAIGNS)/prep/ns_0/.done
+$(CAMPAIGNS)/cohesive/eta_%/.done: $(CAMPAIGNS)/prep/ns_0/.done | $(CAMPAIGNS)/cohesive/.manifest-check
 	$(call shear_run,$(lastword $(subst _I_, ,$*)),0) --set contact.cohesion_number=$(firstword $(subst _I_, ,$*)) \
 	  --set solver.tol=$(COHESIVE_TOL)
 	touch $@
 
-$(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done
+$(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done | $(CAMPAIGNS)/angularity/.manifest-check
 	$(if $(dim3),@echo "campaign-angularity is 2D only (3D grains are spheres)"; exit 2)
 	$(call shear_run,$(ANGULAR_I),$*)
 	touch $@
