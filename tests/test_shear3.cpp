@@ -383,7 +383,8 @@ TEST(Shear3Cell, KeysWithoutWhatTheyNeedAreRefusedByName) {
   { Scene t = s; t.pressure = 0; t.dt_tp = 0; t.dt = 1e-5; refused(t, "shear.isotropic needs shear.pressure"); }
   { Scene t = s; t.pressure = 0; t.isotropic = false; t.dt_tp = 0; t.dt = 1e-5; refused(t, "shear.compaction_rate needs shear.pressure"); }
   { Scene t = s; t.pressure = std::nan(""); refused(t, "t_p"); }
-  { Scene t = s; t.overlap_projection = 0.5; refused(t, "contact.overlap_projection"); }
+  // The overlap projection serves 3D too (tests/test_projection3.cpp).
+  { Scene t = s; t.overlap_projection = 0.5; EXPECT_NO_THROW(check_scene3(t)); }
 }
 
 // output.checkpoint_strain in 3D: the plan (core/run_plan.hpp's, shared) puts a

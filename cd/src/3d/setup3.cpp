@@ -121,8 +121,6 @@ void check_scene3(const Scene& s) {
   const auto fail = fail3;
   if (s.dimension != 3) fail(fmt::format("dimension = {}: not a 3D scene", s.dimension));
   if (s.gravity.size() != 3) fail("gravity.g: a 3D scene needs [gx, gy, gz]");
-  if (s.overlap_projection != 0)
-    fail("contact.overlap_projection: the overlap projection is 2D only; leave it at 0");
   if (s.shear_mode == ShearMode::Periodic) {
     check_derived(s);
     return check_cell3(with_auto_cell3(s));
@@ -183,6 +181,7 @@ WorldParams3 world_params3(const Scene& s0) {
   p.d_ref = mean_diameter(s);
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
+  p.overlap_projection = s.overlap_projection;
   p.adhesion = pull_off_force(s);  // contact.adhesion, or eta p d^2 with d = p.d_ref
   p.debond = s.debond * p.d_ref;
   p.e_n = s.e_n;  // restitution by mean velocities (method.md section 14)

@@ -232,6 +232,7 @@ void World3::solve() {
   last_.solve = solver_ ? solver_(prob_, prm_.solver) : nlgs_solve3(prob_, prm_.solver);
   prob_.vel.swap(V);
   for (const CellDof3& d : prob_.dofs) cell_.rate[d.axis] = d.v;
+  if (prm_.overlap_projection > 0.0) project_overlaps();
 
   // Keep the impulses (world frame) for the next step's warm start.
   const std::size_t nr = prob_.rows.size();

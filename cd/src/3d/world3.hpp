@@ -47,6 +47,13 @@ struct WorldParams3 {
   // at beta |g|/dt (0: pure CD, overlaps are never pushed apart). The
   // velocity it gives persists, so it injects energy.
   double overlap_correction = 0.0;
+  // Overlap projection beta_p (2D's World::overlap_projection; projection3.cpp):
+  // after the solve, on steps where some overlap reaches 1e-3 of its pair's
+  // smaller diameter, the midpoint positions (and the solved cell lengths)
+  // move by the smallest mass-weighted displacement that opens every
+  // overlap by beta_p times itself and closes no gap; velocities untouched.
+  // 0: off.
+  double overlap_projection = 0.0;
   // Adhesion-shifted Signorini law: pull-off force f_a on every contact
   // whose midpoint gap is <= debond (absolute); 0: none.
   double adhesion = 0.0, debond = 0.0;
@@ -209,6 +216,7 @@ class World3 {
   void solve();
   void integrate();
   void observe();
+  void project_overlaps();
 
   template <class B>
   void build_rows(const B& b);
@@ -228,6 +236,7 @@ class World3 {
   StepStats last_;
   std::vector<Vec3> xm_;
   std::vector<Quat> qm_;
+  ContactProblem3 proj_;  // project_overlaps' pseudo-velocity problem
   ContactProblem3 prob_;  // rows, extras (empty unless extras_on_), colouring, dofs, law
   std::vector<ContactInfo3> info_;
   CellGrid3 grid_;

@@ -34,7 +34,7 @@ struct StepStats {
   double mean_overlap = 0; // mean of -gap / d_ref over overlapping contacts
   double max_overlap_small = 0;  // max over contacts of -gap / (the smaller grain's diameter)
   double correction_work = 0;  // sum of p_n x bias velocity of the overlap correction (J)
-  double projection_work = 0;  // 2D overlap projection: sum of f_n x the separation it added (J)
+  double projection_work = 0;  // overlap projection: sum of f_n x the separation it added (J)
 };
 
 // The stages of a world's step W, in order, each a member function.
