@@ -5,8 +5,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
-#include <omp.h>
-
+#include "cell_grid.hpp"
 #include "parallel.hpp"
 
 namespace cd {
@@ -374,33 +373,20 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
             std::vector<ContactInfo>& info, const PeriodicCell* cell) {
   rows.clear();
   info.clear();
-  const int nb = static_cast<int>(bodies.size());
-
   // Particles go in the grid (bounding circles); walls are tested against
   // every particle.
-  std::vector<int> parts, walls;
-  parts.reserve(nb);
-  double rmax = 0;
-  bool poly = false;
-  Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
-  for (int i = 0; i < nb; ++i) {
-    if (bodies.shape[i] == Shape::Segment) {
-      walls.push_back(i);
-    } else {
-      parts.push_back(i);
-      poly = poly || bodies.shape[i] == Shape::Polygon;
-      rmax = std::max(rmax, bodies.radius[i]);
-      lo = lo.cwiseMin(x[i]);
-      hi = hi.cwiseMax(x[i]);
-    }
-  }
+  const GridMembers<Vec2> g = grid_members<Vec2>(
+      static_cast<int>(bodies.size()), bodies.radius,
+      [&](int i) { return bodies.shape[i] == Shape::Segment; }, [&](int i) { return x[i]; });
+  const std::vector<int>& parts = g.members;
+  const std::vector<int>& walls = g.others;
+  const bool poly = std::any_of(parts.begin(), parts.end(),
+                                [&](int i) { return bodies.shape[i] == Shape::Polygon; });
   const int nd = static_cast<int>(parts.size());
-  const int nthreads = omp_get_max_threads();
-  grid.rows_t.resize(nthreads);
-  grid.info_t.resize(nthreads);
+  const Vec2 &lo = g.lo, &hi = g.hi;
 
   if (nd > 0) {
-    const double h = 2 * rmax + alert;
+    const double h = 2 * g.rmax + alert;
     const bool px = cell && cell->x, py = cell && cell->y;
     const double wx = cell ? cell->width : 0, wy = cell ? cell->height : 0;
     if (!std::isfinite(wx) || !std::isfinite(wy) || !std::isfinite(h))
@@ -425,43 +411,29 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
     if ((px && ax.n < 4) || (py && ay.n < 3))
       throw std::runtime_error(
           "periodic cell too small: it must span at least 4 (x) and 3 (y) times 2 r_max + alert");
-    const int ncx = ax.n, ncy = ay.n;
-    auto cell_of = [&](int i) { return ay.cell(x[i].y()) * ncx + ax.cell(x[i].x()); };
-    grid.cell_start.assign(static_cast<std::size_t>(ncx) * ncy + 1, 0);
-    for (int i : parts) ++grid.cell_start[cell_of(i) + 1];
-    for (std::size_t c = 0; c + 1 < grid.cell_start.size(); ++c)
-      grid.cell_start[c + 1] += grid.cell_start[c];
-    grid.items.resize(nd);
-    {
-      std::vector<int> fill(grid.cell_start.begin(), grid.cell_start.end() - 1);
-      for (int i : parts) grid.items[fill[cell_of(i)]++] = i;  // ascending index inside a cell
-    }
+    const int ncx = ax.n;
+    grid.bins.bin(static_cast<std::size_t>(ncx) * ay.n, parts,
+                  [&](int i) { return ay.cell(x[i].y()) * ncx + ax.cell(x[i].x()); });
     const double offset = cell ? cell->offset : 0.0;
+    const auto& cs = grid.bins.cell_start;
+    const auto& it = grid.bins.items;
     // Small systems detect on one thread (parallel.hpp).
-#pragma omp parallel if (nd >= kMinParallelBodies)
-    {
-      auto& R = grid.rows_t[omp_get_thread_num()];
-      auto& I = grid.info_t[omp_get_thread_num()];
-      R.clear();
-      I.clear();
-      const auto& cs = grid.cell_start;
-      const auto& it = grid.items;
-      if (cell) {
-        if (poly)
-          grid_pairs<true, true>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
-        else
-          grid_pairs<false, true>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
-      } else {
-        if (poly)
-          grid_pairs<true, false>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
-        else
-          grid_pairs<false, false>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
-      }
-    }
-    for (int t = 0; t < nthreads; ++t) {
-      rows.insert(rows.end(), grid.rows_t[t].begin(), grid.rows_t[t].end());
-      info.insert(info.end(), grid.info_t[t].begin(), grid.info_t[t].end());
-    }
+    grid.threads.run(
+        nd >= kMinParallelBodies,
+        [&](std::vector<ContactRow>& R, std::vector<ContactInfo>& I) {
+          if (cell) {
+            if (poly)
+              grid_pairs<true, true>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
+            else
+              grid_pairs<false, true>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
+          } else {
+            if (poly)
+              grid_pairs<true, false>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
+            else
+              grid_pairs<false, false>(bodies, x, th, alert, ax, ay, offset, cs, it, R, I);
+          }
+        },
+        rows, info);
   }
 
   // Walls: few, each tested against every particle, wall as body 1.

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bodies.hpp"
+#include "cell_grid.hpp"
 #include "contact.hpp"
 #include "polygon.hpp"
 
@@ -22,11 +23,8 @@ struct PeriodicCell {
   double offset = 0.0;  // in [0, width)
 };
 
-struct CellGrid {  // scratch kept between steps to avoid reallocation
-  std::vector<int> cell_start, items;
-  std::vector<std::vector<ContactRow>> rows_t;
-  std::vector<std::vector<ContactInfo>> info_t;
-};
+// Scratch kept between steps to avoid reallocation (core/cell_grid.hpp).
+using CellGrid = CellGridScratch<ContactRow, ContactInfo>;
 
 // Candidate contacts with gap <= alert among the bodies at positions x and
 // angles th. Fills geometry only (b1, b2, frame, lever arms, gap, point);

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <omp.h>
+#include "cell_grid.hpp"
 
 namespace cd {
 
@@ -113,121 +113,130 @@ bool plane_sphere(int pl, int k, const Vec3& xp, const Vec3& np, const Vec3& xk,
   return true;
 }
 
+namespace {
+
+// The spheres go in the grid, the planes are tested against every sphere;
+// pos(i) is where sphere i is binned.
+template <class Pos>
+GridMembers<Vec3> sphere_members(const Bodies3& bodies, Pos&& pos) {
+  return grid_members<Vec3>(static_cast<int>(bodies.size()), bodies.radius,
+                            [&](int i) { return bodies.shape[i] == Shape3::Plane; }, pos);
+}
+
+// The grid of both detections: along a periodic axis n = floor(L / h)
+// cells of side L / n >= h over the cell, along the others cells of side h
+// over the spheres' box. h starts at the reach 2 r_max + alert (a pair
+// within reach is in the same or a neighbouring cell) and coarsens by 1.25
+// until there are at most ~2 cells a sphere (a sphere far away coarsens the
+// grid rather than blowing up memory).
+struct Grid3 {
+  std::array<int, 3> n{1, 1, 1};
+  Vec3 side = Vec3::Ones(), org = Vec3::Zero();
+  std::array<bool, 3> periodic{false, false, false};
+  double h = 0.0;
+
+  Grid3(const GridMembers<Vec3>& g, double reach, const PeriodicCell3& cell) : periodic(cell.periodic) {
+    const int ns = static_cast<int>(g.members.size());
+    std::array<double, 3> count;
+    auto layout = [&](double hh) {
+      double cells = 1;
+      for (int a = 0; a < 3; ++a) {
+        count[a] = periodic[a] ? std::max(1.0, std::floor(cell.size[a] / hh)) : std::floor((g.hi[a] - g.lo[a]) / hh) + 1;
+        cells *= count[a];
+      }
+      return cells;
+    };
+    h = reach;
+    const double cap = 2.0 * ns + 64;
+    while (layout(h) > cap) h *= 1.25;
+    for (int a = 0; a < 3; ++a) {
+      n[a] = static_cast<int>(count[a]);
+      side[a] = periodic[a] ? cell.size[a] / n[a] : h;
+      org[a] = periodic[a] ? cell.origin[a] : g.lo[a];
+    }
+  }
+  std::size_t cells() const { return static_cast<std::size_t>(n[0]) * n[1] * n[2]; }
+  int axis(double v, int a) const {
+    const int c = static_cast<int>(std::floor((v - org[a]) / side[a]));
+    return periodic[a] ? wrap_index(c, n[a]) : std::clamp(c, 0, n[a] - 1);
+  }
+  // Cells in (z, y, x) order.
+  int cell(const Vec3& p) const { return (axis(p.z(), 2) * n[1] + axis(p.y(), 1)) * n[0] + axis(p.x(), 0); }
+};
+
+// The sphere pair (i, j), i < j, if within reach: a driven body is body 1
+// (the colouring's split and the wall friction look at body 1 only); with
+// Periodic, through body j's image nearest to body i. row, inf: scratch.
+template <bool Periodic>
+inline void sphere_pair(const Bodies3& bodies, const std::vector<Vec3>& x, double alert,
+                        const PeriodicCell3& cell, int i, int j, SphereRow& row, ContactInfo3& inf,
+                        std::vector<SphereRow>& R, std::vector<ContactInfo3>& I) {
+  if (bodies.driven[i] && bodies.driven[j]) return;
+  if (bodies.driven[j] && !bodies.driven[i]) std::swap(i, j);
+  if constexpr (Periodic) {
+    std::array<int, 3> k;
+    const Vec3 xj = cell.nearest_image(x[i], x[j], k);
+    if (!sphere_sphere(i, j, x[i], xj, bodies.radius[i], bodies.radius[j], alert, row, inf)) return;
+    inf.ix = static_cast<std::int8_t>(k[0]);
+    inf.iy = static_cast<std::int8_t>(k[1]);
+    inf.iz = static_cast<std::int8_t>(k[2]);
+  } else {
+    if (!sphere_sphere(i, j, x[i], x[j], bodies.radius[i], bodies.radius[j], alert, row, inf)) return;
+  }
+  R.push_back(row);
+  I.push_back(inf);
+}
+
+}  // namespace
+
 void detect3(const Bodies3& bodies, const std::vector<Vec3>& x, double alert, CellGrid3& grid,
              std::vector<SphereRow>& rows, std::vector<ContactInfo3>& info, int min_parallel) {
   rows.clear();
   info.clear();
-  const int nb = static_cast<int>(bodies.size());
-  std::vector<int> spheres, planes;
-  spheres.reserve(nb);
-  double rmax = 0;
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (int i = 0; i < nb; ++i) {
-    if (bodies.shape[i] == Shape3::Plane) {
-      planes.push_back(i);
-    } else {
-      spheres.push_back(i);
-      rmax = std::max(rmax, bodies.radius[i]);
-      lo = lo.cwiseMin(x[i]);
-      hi = hi.cwiseMax(x[i]);
-    }
-  }
-  const int ns = static_cast<int>(spheres.size());
-  const int nthreads = omp_get_max_threads();
-  grid.rows_t.resize(nthreads);
-  grid.info_t.resize(nthreads);
+  const GridMembers<Vec3> g = sphere_members(bodies, [&](int i) { return x[i]; });
+  const int ns = static_cast<int>(g.members.size());
   if (ns > 1) {
-    // Cells of side h >= 2 r_max + alert: a pair within reach is in the same
-    // or a neighbouring cell. The count is bounded by ~2 cells a sphere (and
-    // a sphere far away coarsens the grid rather than blowing up memory).
-    double h = 2 * rmax + alert;
-    const Vec3 ext = hi - lo;
-    auto cells = [&](double hh) {
-      return (std::floor(ext.x() / hh) + 1) * (std::floor(ext.y() / hh) + 1) * (std::floor(ext.z() / hh) + 1);
-    };
-    const double cap = 2.0 * ns + 64;
-    while (cells(h) > cap) h *= 1.25;
-    const int nx = static_cast<int>(ext.x() / h) + 1, ny = static_cast<int>(ext.y() / h) + 1,
-              nz = static_cast<int>(ext.z() / h) + 1;
-    const int ncell = nx * ny * nz;
-    auto axis = [&](double v, double l, int n) {
-      return std::clamp(static_cast<int>(std::floor((v - l) / h)), 0, n - 1);
-    };
-    // Counting sort of the spheres by cell, in index order inside a cell.
-    grid.cell_start.assign(ncell + 1, 0);
-    grid.cell_of.resize(ns);
-    for (int a = 0; a < ns; ++a) {
-      const Vec3& p = x[spheres[a]];
-      const int c = (axis(p.z(), lo.z(), nz) * ny + axis(p.y(), lo.y(), ny)) * nx + axis(p.x(), lo.x(), nx);
-      grid.cell_of[a] = c;
-      ++grid.cell_start[c + 1];
-    }
-    for (int c = 0; c < ncell; ++c) grid.cell_start[c + 1] += grid.cell_start[c];
-    grid.items.resize(ns);
-    {
-      std::vector<int> pos(grid.cell_start.begin(), grid.cell_start.end() - 1);
-      for (int a = 0; a < ns; ++a) grid.items[pos[grid.cell_of[a]]++] = spheres[a];
-    }
-    const std::vector<int>& cs = grid.cell_start;
-    const std::vector<int>& it = grid.items;
+    const PeriodicCell3 none;
+    const Grid3 gr(g, 2 * g.rmax + alert, none);
+    const int nx = gr.n[0], ny = gr.n[1], nz = gr.n[2];
+    grid.bins.bin(gr.cells(), g.members, [&](int i) { return gr.cell(x[i]); });
+    const std::vector<int>& cs = grid.bins.cell_start;
+    const std::vector<int>& it = grid.bins.items;
     // Half of the 27-cell stencil: the cell itself (pairs a < b) and the 13
     // neighbours after it in (z, y, x) order.
     static constexpr int off[13][3] = {{1, 0, 0},  {-1, 1, 0}, {0, 1, 0},  {1, 1, 0},  {-1, -1, 1},
                                        {0, -1, 1}, {1, -1, 1}, {-1, 0, 1}, {0, 0, 1},  {1, 0, 1},
                                        {-1, 1, 1}, {0, 1, 1},  {1, 1, 1}};
-    const bool par = ns >= min_parallel / 2;
-    for (int t = 0; t < nthreads; ++t) {  // a team may be smaller than nthreads
-      grid.rows_t[t].clear();
-      grid.info_t[t].clear();
-    }
-#pragma omp parallel if (par)
-    {
-      const int t = omp_get_thread_num();
-      std::vector<SphereRow>& R = grid.rows_t[t];
-      std::vector<ContactInfo3>& I = grid.info_t[t];
-      SphereRow row;
-      ContactInfo3 inf;
-      auto pair = [&](int i, int j) {
-        if (i > j) std::swap(i, j);
-        if (bodies.driven[i] && bodies.driven[j]) return;
-        // A driven body is body 1 (the colouring's split and the wall
-        // friction look at body 1 only).
-        if (bodies.driven[j] && !bodies.driven[i]) std::swap(i, j);
-        if (sphere_sphere(i, j, x[i], x[j], bodies.radius[i], bodies.radius[j], alert, row, inf)) {
-          R.push_back(row);
-          I.push_back(inf);
-        }
-      };
+    grid.threads.run(
+        ns >= min_parallel / 2,
+        [&](std::vector<SphereRow>& R, std::vector<ContactInfo3>& I) {
+          SphereRow row;
+          ContactInfo3 inf;
+          auto pair = [&](int i, int j) {
+            if (i > j) std::swap(i, j);
+            sphere_pair<false>(bodies, x, alert, none, i, j, row, inf, R, I);
+          };
 #pragma omp for schedule(static)
-      for (int cz = 0; cz < nz; ++cz)
-        for (int cy = 0; cy < ny; ++cy)
-          for (int cx = 0; cx < nx; ++cx) {
-            const int c = (cz * ny + cy) * nx + cx;
-            for (int a = cs[c]; a < cs[c + 1]; ++a) {
-              const int i = it[a];
-              for (int b = a + 1; b < cs[c + 1]; ++b) pair(i, it[b]);
-              for (const auto& o : off) {
-                const int qx = cx + o[0], qy = cy + o[1], qz = cz + o[2];
-                if (qx < 0 || qx >= nx || qy < 0 || qy >= ny || qz >= nz) continue;
-                const int d = (qz * ny + qy) * nx + qx;
-                for (int b = cs[d]; b < cs[d + 1]; ++b) pair(i, it[b]);
+          for (int cz = 0; cz < nz; ++cz)
+            for (int cy = 0; cy < ny; ++cy)
+              for (int cx = 0; cx < nx; ++cx) {
+                const int c = (cz * ny + cy) * nx + cx;
+                for (int a = cs[c]; a < cs[c + 1]; ++a) {
+                  const int i = it[a];
+                  for (int b = a + 1; b < cs[c + 1]; ++b) pair(i, it[b]);
+                  for (const auto& o : off) {
+                    const int qx = cx + o[0], qy = cy + o[1], qz = cz + o[2];
+                    if (qx < 0 || qx >= nx || qy < 0 || qy >= ny || qz >= nz) continue;
+                    const int d = (qz * ny + qy) * nx + qx;
+                    for (int b = cs[d]; b < cs[d + 1]; ++b) pair(i, it[b]);
+                  }
+                }
               }
-            }
-          }
-    }
-    // Joined in thread order: each thread had a contiguous range of slabs,
-    // so this is the sequential order.
-    for (int t = 0; t < nthreads; ++t) {
-      rows.insert(rows.end(), grid.rows_t[t].begin(), grid.rows_t[t].end());
-      info.insert(info.end(), grid.info_t[t].begin(), grid.info_t[t].end());
-    }
+        },
+        rows, info);
   }
-  plane_rows(bodies, x, alert, planes, spheres, rows, info);
+  plane_rows(bodies, x, alert, g.others, g.members, rows, info);
 }
-
-}  // namespace cd
-
-namespace cd {
 
 void detect3(const Bodies3& bodies, const std::vector<Vec3>& x, double alert, const PeriodicCell3& cell,
              CellGrid3& grid, std::vector<SphereRow>& rows, std::vector<ContactInfo3>& info,
@@ -238,164 +247,87 @@ void detect3(const Bodies3& bodies, const std::vector<Vec3>& x, double alert, co
   }
   rows.clear();
   info.clear();
-  const int nb = static_cast<int>(bodies.size());
-  std::vector<int> spheres, planes;
-  spheres.reserve(nb);
-  double rmax = 0;
   // Spheres are binned at an image inside the cell (xw); the narrow phase
   // takes the nearest image from the positions themselves.
-  std::vector<Vec3> xw(nb, Vec3::Zero());
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (int i = 0; i < nb; ++i) {
-    if (bodies.shape[i] == Shape3::Plane) {
-      planes.push_back(i);
-    } else {
-      spheres.push_back(i);
-      rmax = std::max(rmax, bodies.radius[i]);
-      std::array<int, 3> k;
-      xw[i] = cell.wrap(x[i], k);
-      lo = lo.cwiseMin(xw[i]);
-      hi = hi.cwiseMax(xw[i]);
-    }
-  }
-  const int ns = static_cast<int>(spheres.size());
-  const double reach = 2 * rmax + alert;
+  std::vector<Vec3> xw(bodies.size(), Vec3::Zero());
+  const GridMembers<Vec3> g = sphere_members(bodies, [&](int i) {
+    std::array<int, 3> k;
+    return xw[i] = cell.wrap(x[i], k);
+  });
+  const int ns = static_cast<int>(g.members.size());
+  const double reach = 2 * g.rmax + alert;
   for (int a = 0; a < 3; ++a)
     if (cell.periodic[a] && !(cell.size[a] >= 2 * reach))
       throw std::invalid_argument("detect3: a periodic length is below 2 (2 r_max + alert)");
-  const int nthreads = omp_get_max_threads();
-  grid.rows_t.resize(nthreads);
-  grid.info_t.resize(nthreads);
   if (ns > 1) {
-    // Periodic axes: n = floor(L / h) cells of side L / n >= h over the
-    // cell; the others: cells of side h over the bounding box. h >= reach,
-    // coarsened as in the open grid so that cells stay ~2 a sphere at most.
-    std::array<int, 3> n;
-    Vec3 side, org;
-    auto layout = [&](double h) {
-      double cells = 1;
-      for (int a = 0; a < 3; ++a) {
-        if (cell.periodic[a]) {
-          n[a] = std::max(1, static_cast<int>(std::floor(cell.size[a] / h)));
-          side[a] = cell.size[a] / n[a];
-          org[a] = cell.origin[a];
-        } else {
-          n[a] = static_cast<int>((hi[a] - lo[a]) / h) + 1;
-          side[a] = h;
-          org[a] = lo[a];
-        }
-        cells *= n[a];
-      }
-      return cells;
-    };
-    double h = reach;
-    const double cap = 2.0 * ns + 64;
-    while (layout(h) > cap) h *= 1.25;
-    const int nx = n[0], ny = n[1], nz = n[2];
-    const int ncell = nx * ny * nz;
-    auto axis = [&](double v, int a) {
-      const int c = static_cast<int>(std::floor((v - org[a]) / side[a]));
-      return cell.periodic[a] ? wrap_index(c, n[a]) : std::clamp(c, 0, n[a] - 1);
-    };
-    grid.cell_start.assign(ncell + 1, 0);
-    grid.cell_of.resize(ns);
-    for (int a = 0; a < ns; ++a) {
-      const Vec3& p = xw[spheres[a]];
-      const int c = (axis(p.z(), 2) * ny + axis(p.y(), 1)) * nx + axis(p.x(), 0);
-      grid.cell_of[a] = c;
-      ++grid.cell_start[c + 1];
-    }
-    for (int c = 0; c < ncell; ++c) grid.cell_start[c + 1] += grid.cell_start[c];
-    grid.items.resize(ns);
-    {
-      std::vector<int> pos(grid.cell_start.begin(), grid.cell_start.end() - 1);
-      for (int a = 0; a < ns; ++a) grid.items[pos[grid.cell_of[a]]++] = spheres[a];
-    }
-    const std::vector<int>& cs = grid.cell_start;
-    const std::vector<int>& it = grid.items;
+    const Grid3 gr(g, reach, cell);
+    const int nx = gr.n[0], ny = gr.n[1], nz = gr.n[2];
+    const double h = gr.h;
+    const Vec3& side = gr.side;
+    grid.bins.bin(gr.cells(), g.members, [&](int i) { return gr.cell(xw[i]); });
+    const std::vector<int>& cs = grid.bins.cell_start;
+    const std::vector<int>& it = grid.bins.items;
     const bool le = cell.periodic[0] && cell.periodic[1] && cell.le_offset != 0.0;
-    const bool par = ns >= min_parallel / 2;
-    for (int t = 0; t < nthreads; ++t) {
-      grid.rows_t[t].clear();
-      grid.info_t[t].clear();
-    }
-#pragma omp parallel if (par)
-    {
-      const int t = omp_get_thread_num();
-      std::vector<SphereRow>& R = grid.rows_t[t];
-      std::vector<ContactInfo3>& I = grid.info_t[t];
-      std::vector<int> nbr;
-      SphereRow row;
-      ContactInfo3 inf;
-      auto pair = [&](int i, int j) {
-        if (bodies.driven[i] && bodies.driven[j]) return;
-        if (bodies.driven[j] && !bodies.driven[i]) std::swap(i, j);
-        std::array<int, 3> k;
-        const Vec3 xj = cell.nearest_image(x[i], x[j], k);
-        if (sphere_sphere(i, j, x[i], xj, bodies.radius[i], bodies.radius[j], alert, row, inf)) {
-          inf.ix = static_cast<std::int8_t>(k[0]);
-          inf.iy = static_cast<std::int8_t>(k[1]);
-          inf.iz = static_cast<std::int8_t>(k[2]);
-          R.push_back(row);
-          I.push_back(inf);
-        }
-      };
-      // The whole 27-cell stencil, wrapped along periodic axes and without
-      // repeats (a periodic axis of 1 or 2 cells maps several offsets onto
-      // one cell); a pair is taken from the cell of its lower-index sphere.
-      // Across the y boundary of a Lees-Edwards cell the neighbours' images
-      // are shifted by +-le_offset along x: the x cells are those within h
-      // of this cell's x range once shifted back (up to 4).
+    grid.threads.run(
+        ns >= min_parallel / 2,
+        [&](std::vector<SphereRow>& R, std::vector<ContactInfo3>& I) {
+          std::vector<int> nbr;
+          SphereRow row;
+          ContactInfo3 inf;
+          // The whole 27-cell stencil, wrapped along periodic axes and
+          // without repeats (a periodic axis of 1 or 2 cells maps several
+          // offsets onto one cell); a pair is taken from the cell of its
+          // lower-index sphere. Across the y boundary of a Lees-Edwards cell
+          // the neighbours' images are shifted by +-le_offset along x: the x
+          // cells are those within h of this cell's x range once shifted
+          // back (up to 4).
 #pragma omp for schedule(static)
-      for (int cz = 0; cz < nz; ++cz)
-        for (int cy = 0; cy < ny; ++cy)
-          for (int cx = 0; cx < nx; ++cx) {
-            const int c = (cz * ny + cy) * nx + cx;
-            if (cs[c] == cs[c + 1]) continue;
-            nbr.clear();
-            for (int oz = -1; oz <= 1; ++oz) {
-              int qz = cz + oz;
-              if (cell.periodic[2]) qz = wrap_index(qz, nz);
-              else if (qz < 0 || qz >= nz) continue;
-              for (int oy = -1; oy <= 1; ++oy) {
-                int qy = cy + oy;
-                int cross = 0;
-                if (cell.periodic[1]) {
-                  cross = floor_div(qy, ny);
-                  qy -= cross * ny;
-                } else if (qy < 0 || qy >= ny) {
-                  continue;
+          for (int cz = 0; cz < nz; ++cz)
+            for (int cy = 0; cy < ny; ++cy)
+              for (int cx = 0; cx < nx; ++cx) {
+                const int c = (cz * ny + cy) * nx + cx;
+                if (cs[c] == cs[c + 1]) continue;
+                nbr.clear();
+                for (int oz = -1; oz <= 1; ++oz) {
+                  int qz = cz + oz;
+                  if (cell.periodic[2]) qz = wrap_index(qz, nz);
+                  else if (qz < 0 || qz >= nz) continue;
+                  for (int oy = -1; oy <= 1; ++oy) {
+                    int qy = cy + oy;
+                    int cross = 0;
+                    if (cell.periodic[1]) {
+                      cross = floor_div(qy, ny);
+                      qy -= cross * ny;
+                    } else if (qy < 0 || qy >= ny) {
+                      continue;
+                    }
+                    int x0 = cx - 1, x1 = cx + 1;
+                    if (le && cross != 0) {
+                      const double s = cross * cell.le_offset;
+                      x0 = static_cast<int>(std::floor((cx * side[0] - h - s) / side[0]));
+                      x1 = static_cast<int>(std::floor(((cx + 1) * side[0] + h - s) / side[0]));
+                    }
+                    for (int qx = x0; qx <= x1; ++qx) {
+                      int px = qx;
+                      if (cell.periodic[0]) px = wrap_index(qx, nx);
+                      else if (qx < 0 || qx >= nx) continue;
+                      nbr.push_back((qz * ny + qy) * nx + px);
+                    }
+                  }
                 }
-                int x0 = cx - 1, x1 = cx + 1;
-                if (le && cross != 0) {
-                  const double s = cross * cell.le_offset;
-                  x0 = static_cast<int>(std::floor((cx * side[0] - h - s) / side[0]));
-                  x1 = static_cast<int>(std::floor(((cx + 1) * side[0] + h - s) / side[0]));
-                }
-                for (int qx = x0; qx <= x1; ++qx) {
-                  int px = qx;
-                  if (cell.periodic[0]) px = wrap_index(qx, nx);
-                  else if (qx < 0 || qx >= nx) continue;
-                  nbr.push_back((qz * ny + qy) * nx + px);
+                std::sort(nbr.begin(), nbr.end());
+                nbr.erase(std::unique(nbr.begin(), nbr.end()), nbr.end());
+                for (int a = cs[c]; a < cs[c + 1]; ++a) {
+                  const int i = it[a];
+                  for (const int d : nbr)
+                    for (int b = cs[d]; b < cs[d + 1]; ++b)
+                      if (i < it[b]) sphere_pair<true>(bodies, x, alert, cell, i, it[b], row, inf, R, I);
                 }
               }
-            }
-            std::sort(nbr.begin(), nbr.end());
-            nbr.erase(std::unique(nbr.begin(), nbr.end()), nbr.end());
-            for (int a = cs[c]; a < cs[c + 1]; ++a) {
-              const int i = it[a];
-              for (const int d : nbr)
-                for (int b = cs[d]; b < cs[d + 1]; ++b)
-                  if (i < it[b]) pair(i, it[b]);
-            }
-          }
-    }
-    for (int t = 0; t < nthreads; ++t) {
-      rows.insert(rows.end(), grid.rows_t[t].begin(), grid.rows_t[t].end());
-      info.insert(info.end(), grid.info_t[t].begin(), grid.info_t[t].end());
-    }
+        },
+        rows, info);
   }
-  plane_rows(bodies, x, alert, planes, spheres, rows, info);
+  plane_rows(bodies, x, alert, g.others, g.members, rows, info);
 }
 
 }  // namespace cd

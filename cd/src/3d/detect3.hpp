@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bodies3.hpp"
+#include "cell_grid.hpp"
 #include "contact3.hpp"
 
 namespace cd {
@@ -34,11 +35,8 @@ struct PeriodicCell3 {
   }
 };
 
-struct CellGrid3 {  // scratch kept between steps to avoid reallocation
-  std::vector<int> cell_start, items, cell_of;
-  std::vector<std::vector<SphereRow>> rows_t;
-  std::vector<std::vector<ContactInfo3>> info_t;
-};
+// Scratch kept between steps to avoid reallocation (core/cell_grid.hpp).
+using CellGrid3 = CellGridScratch<SphereRow, ContactInfo3>;
 
 // Candidate contacts with gap <= alert among the bodies at positions x.
 // Fills geometry only (b1, b2, frame, lever arms, gap, point, branch; r,
