@@ -41,6 +41,23 @@ namespace {
 // of it: past this size it is minutes and gigabytes, not a reference.
 constexpr int kLemkeMaxContacts = 1000;
 
+// A matrix-form NLGS solve (2D or 3D): the residual history, then one
+// line; the exit status (1: not converged).
+int report_nlgs(const cd::NlgsStats& st) {
+  fmt::print("{:>8} {:>12} {:>14} {:>14}\n", "sweep", "rms|dr|/|r|", "residual max",
+             "residual mean");
+  for (const cd::NlgsCheckpoint& c : st.history)
+    fmt::print("{:>8} {:>12.3e} {:>14.3e} {:>14.3e}\n", c.sweep, c.dr_rel, c.residual_max,
+               c.residual_mean);
+  fmt::print(
+      "nlgs: {} after {} sweeps (rms |dr|/|r| {:.3e}), residual max {:.3e} mean {:.3e} "
+      "(mean |r| {:.3e}), Siconos error {:.3e}, time {:.3g} s ({:.3g} ms/sweep)\n",
+      st.converged ? "converged" : "NOT converged (sweep cap)", st.sweeps, st.dr_rel,
+      st.residual.max, st.residual.mean, st.residual.r_mean, st.siconos_error, st.time,
+      st.sweeps ? 1e3 * st.time / st.sweeps : 0.0);
+  return st.converged ? 0 : 1;
+}
+
 int solve2(const cd::Problem& p, const std::string& path, const cd::NlgsOptions& opt, bool lemke) {
   double wmin = p.nc ? p.W.diagonal().minCoeff() : 0, wmax = p.nc ? p.W.diagonal().maxCoeff() : 0;
   fmt::print(
@@ -62,31 +79,11 @@ int solve2(const cd::Problem& p, const std::string& path, const cd::NlgsOptions&
     return L.status == cd::LemkeStatus::Solved ? 0 : 1;
   }
   Eigen::VectorXd r;
-  const cd::NlgsStats st = cd::solve_nlgs(p, r, opt);
-  fmt::print("{:>8} {:>12} {:>14} {:>14}\n", "sweep", "rms|dr|/|r|", "residual max",
-             "residual mean");
-  for (const cd::NlgsCheckpoint& c : st.history)
-    fmt::print("{:>8} {:>12.3e} {:>14.3e} {:>14.3e}\n", c.sweep, c.dr_rel, c.residual_max,
-               c.residual_mean);
-  fmt::print(
-      "nlgs: {} after {} sweeps (rms |dr|/|r| {:.3e}), residual max {:.3e} mean {:.3e} "
-      "(mean |r| {:.3e}), Siconos error {:.3e}, time {:.3g} s ({:.3g} ms/sweep)\n",
-      st.converged ? "converged" : "NOT converged (sweep cap)", st.sweeps, st.dr_rel,
-      st.residual.max, st.residual.mean, st.residual.r_mean, st.siconos_error, st.time,
-      st.sweeps ? 1e3 * st.time / st.sweeps : 0.0);
-  return st.converged ? 0 : 1;
+  return report_nlgs(cd::solve_nlgs(p, r, opt));
 }
 
 // Lemke's tableau for the polyhedral LCP is (2e + 2) nc unknowns square.
 constexpr int kLemke3MaxUnknowns = 4000;
-
-void print_history(const cd::NlgsStats& st) {
-  fmt::print("{:>8} {:>12} {:>14} {:>14}\n", "sweep", "rms|dr|/|r|", "residual max",
-             "residual mean");
-  for (const cd::NlgsCheckpoint& c : st.history)
-    fmt::print("{:>8} {:>12.3e} {:>14.3e} {:>14.3e}\n", c.sweep, c.dr_rel, c.residual_max,
-               c.residual_mean);
-}
 
 // A 3D problem in matrix form (FCLib or Siconos .dat), `what` the line that
 // describes it.
@@ -108,15 +105,7 @@ int solve3(const cd::Problem3& p, const std::string& what, const cd::NlgsOptions
     return L.status == cd::LemkeStatus::Solved ? 0 : 1;
   }
   Eigen::VectorXd r;
-  const cd::NlgsStats st = cd::solve_nlgs(p, r, opt);
-  print_history(st);
-  fmt::print(
-      "nlgs: {} after {} sweeps (rms |dr|/|r| {:.3e}), residual max {:.3e} mean {:.3e} "
-      "(mean |r| {:.3e}), Siconos error {:.3e}, time {:.3g} s ({:.3g} ms/sweep)\n",
-      st.converged ? "converged" : "NOT converged (sweep cap)", st.sweeps, st.dr_rel,
-      st.residual.max, st.residual.mean, st.residual.r_mean, st.siconos_error, st.time,
-      st.sweeps ? 1e3 * st.time / st.sweeps : 0.0);
-  return st.converged ? 0 : 1;
+  return report_nlgs(cd::solve_nlgs(p, r, opt));
 }
 
 int solve_fclib(const std::string& path, const cd::NlgsOptions& opt, bool lemke, int facets) {

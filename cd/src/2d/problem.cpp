@@ -7,7 +7,6 @@
 #include <variant>
 #include <cctype>
 #include <cerrno>
-#include <chrono>
 #include <climits>
 #include <cmath>
 #include <cstdio>
@@ -24,34 +23,12 @@
 #include "problem_file.hpp"
 #include "siconos_dat.hpp"
 #include "text_reader.hpp"
-#include "block_rows.hpp"
 #include "coupling.hpp"
-#include "colour_blocks.hpp"
+#include "matrix_form.hpp"
 
 namespace cd {
 
 namespace {
-
-using Triplets = std::vector<Eigen::Triplet<double>>;
-
-Residual residual_of(const Problem& p, const Eigen::VectorXd& r, const Eigen::VectorXd& u,
-                     const Eigen::VectorXd& diag) {
-  Residual res;
-  if (p.nc == 0) return res;
-  double rmax = 0, rsum = 0, psum = 0;
-  for (int k = 0; k < p.nc; ++k) {
-    const double rn = r[2 * k], rt = r[2 * k + 1];
-    const double e = law_residual(u[2 * k], u[2 * k + 1], rn, rt, p.mu[k], 0.0, 1.0 / diag[2 * k]);
-    rmax = std::max(rmax, e);
-    rsum += e;
-    psum += std::sqrt(rn * rn + rt * rt);
-  }
-  res.r_mean = psum / p.nc;
-  const double scale = res.r_mean > 0 ? res.r_mean : 1.0;
-  res.max = rmax / scale;
-  res.mean = rsum / p.nc / scale;
-  return res;
-}
 
 void check_shape(const Problem& p) {
   const Eigen::Index n = 2 * static_cast<Eigen::Index>(p.nc);
@@ -117,10 +94,7 @@ void write_problem(const Problem& p, std::ostream& out, Storage s) {
 }
 
 void write_problem(const Problem& p, const std::string& path, Storage s) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
-  write_problem(p, out, s);
-  if (!out.flush()) throw std::runtime_error(fmt::format("{}: write failed", path));
+  problem_file::write_path(path, [&](std::ostream& out) { write_problem(p, out, s); });
 }
 
 // ---- cdlab's own format of a step's problem (contact_problem.hpp) -------
@@ -141,20 +115,14 @@ void write_contact_problem(const ContactProblem& p, const SolverParams& prm, std
                        x(r.nx), x(r.ny), x(r.c1n), x(r.c1t), x(r.c2n), x(r.c2t), x(r.wnn),
                        x(r.wnt), x(r.wtt), x(r.bn), x(r.bt), x(r.pn), x(r.pt), x(r.mu),
                        x(r.adh));
-  out << "dofs " << p.dofs.size() << "\n";
-  for (const BoundaryDof& d : p.dofs) {
-    out << problem_file::dof_scalars(d) << ' ' << d.rows.size() << '\n';
-    for (std::size_t m = 0; m < d.rows.size(); ++m)
-      out << fmt::format("{} {} {}\n", d.rows[m], x(d.an[m]), x(d.at[m]));
-  }
+  problem_file::write_dofs(
+      out, p.dofs, [](const BoundaryDof&) { return ""; },
+      [&](const BoundaryDof& d, std::size_t m) { return x(d.an[m]) + ' ' + x(d.at[m]); });
 }
 
 void write_contact_problem(const ContactProblem& p, const SolverParams& prm,
                            const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
-  write_contact_problem(p, prm, out);
-  if (!out.flush()) throw std::runtime_error(fmt::format("{}: write failed", path));
+  problem_file::write_path(path, [&](std::ostream& out) { write_contact_problem(p, prm, out); });
 }
 
 ContactProblem read_contact_problem(std::istream& in, const std::string& name, SolverParams& prm) {
@@ -192,31 +160,18 @@ ContactProblem read_contact_problem(std::istream& in, const std::string& name, S
     r.adh = rd.non_negative("the adhesion impulse" + w);
     if (!(r.wnn > 0)) rd.fail(fmt::format("W_nn{} is {}, not positive", w, r.wnn));
   }
-  rd.expect("dofs", "after the rows");
-  const long long nd = rd.count("the number of dofs", 16, 5);
-  p.dofs.resize(nd);
-  for (long long d = 0; d < nd; ++d) {
-    BoundaryDof& D = p.dofs[d];
-    const std::string w = fmt::format(" of dof {}", d);
-    problem_file::read_dof_scalars(rd, D, w);
-    const long long m = rd.count("the number of rows" + w, nr, 3);
-    D.rows.resize(m);
-    D.an.resize(m);
-    D.at.resize(m);
-    for (long long j = 0; j < m; ++j) {
-      D.rows[j] = static_cast<std::int32_t>(rd.integer("a row" + w, 0, nr - 1));
-      D.an[j] = rd.number("an" + w);
-      D.at[j] = rd.number("at" + w);
-    }
-  }
+  p.dofs = problem_file::read_dofs<BoundaryDof>(
+      rd, "after the rows", 16, nr, 3, [](BoundaryDof&, const std::string&) {},
+      [&](BoundaryDof& D, const std::string& w) {
+        D.an.push_back(rd.number("an" + w));
+        D.at.push_back(rd.number("at" + w));
+      });
   if (!rd.token().empty()) rd.fail("unexpected text after the last dof");
   return p;
 }
 
 ContactProblem read_contact_problem(const std::string& path, SolverParams& prm) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot open for reading", path));
-  return read_contact_problem(in, path, prm);
+  return problem_file::read_path(path, [&](std::istream& in) { return read_contact_problem(in, path, prm); });
 }
 
 Problem assemble_problem(const std::vector<BodyVel>& V, const std::vector<ContactRow>& rows,
@@ -228,7 +183,7 @@ Problem assemble_problem(const std::vector<BodyVel>& V, const std::vector<Contac
   // tangent; body rows 3b (x), 3b+1 (y), 3b+2 (rotation), then one row per
   // boundary dof. MH = M^-1 H keeps only the dynamic bodies, so W = H^T MH
   // has no structural entry through a wall.
-  Triplets h, mh;
+  matrix_form::Triplets h, mh;
   h.reserve(12 * nc);
   mh.reserve(12 * nc);
   auto add = [&](int b, int dof, int col, double v) {
@@ -255,9 +210,8 @@ Problem assemble_problem(const std::vector<BodyVel>& V, const std::vector<Contac
     }
   }
   // A boundary dof is one more body: u_k += (an, at) v, and v = v0 +
-  // inv_mass sum (an p_n + at p_t). Its v0 part is already in the rows'
-  // offsets (World::set_cell_dofs) and v = v0 before the solve, so it adds
-  // inv_mass a a^T to W and nothing to q.
+  // inv_mass sum (an p_n + at p_t) (its v0 part is in the rows' offsets,
+  // World::set_cell_dofs; matrix_form::condense).
   for (int d = 0; d < nd; ++d) {
     const BoundaryDof& D = (*dofs)[d];
     for (std::size_t m = 0; m < D.rows.size(); ++m) {
@@ -268,10 +222,7 @@ Problem assemble_problem(const std::vector<BodyVel>& V, const std::vector<Contac
       }
     }
   }
-  Eigen::SparseMatrix<double> H(3 * nb + nd, 2 * nc), MH(3 * nb + nd, 2 * nc);
-  H.setFromTriplets(h.begin(), h.end());
-  MH.setFromTriplets(mh.begin(), mh.end());
-  Eigen::VectorXd U = Eigen::VectorXd::Zero(3 * nb + nd), p(2 * nc), b(2 * nc);
+  Eigen::VectorXd U(3 * nb), p(2 * nc), b(2 * nc);
   for (int i = 0; i < nb; ++i) U.segment<3>(3 * i) << V[i].vx, V[i].vy, V[i].w;
   for (int k = 0; k < nc; ++k) {
     p.segment<2>(2 * k) << rows[k].pn, rows[k].pt;
@@ -279,13 +230,7 @@ Problem assemble_problem(const std::vector<BodyVel>& V, const std::vector<Contac
   }
   Problem P;
   P.nc = nc;
-  P.W = Eigen::SparseMatrix<double>(H.transpose() * MH);
-  P.W.makeCompressed();
-  // The bodies' velocities hold the warm start (G U includes W_body p), the
-  // dofs' do not (v = v0): q = G U - W_body p + b, the dof rows of U zero.
-  Eigen::SparseMatrix<double> Hb = H.topRows(3 * nb), MHb = MH.topRows(3 * nb);
-  const Eigen::SparseMatrix<double> Wb(Hb.transpose() * MHb);
-  P.q = Hb.transpose() * U.head(3 * nb) - Wb * p + b;
+  matrix_form::condense(3 * nb + nd, 2 * nc, 3 * nb, h, mh, U, p, b, P.W, P.q);
   P.mu.resize(nc);
   for (int k = 0; k < nc; ++k) P.mu[k] = rows[k].mu;
   return P;
@@ -308,7 +253,12 @@ Residual problem_residual(const Problem& p, const Eigen::VectorXd& r) {
   if (r.size() != p.q.size())
     throw std::invalid_argument(fmt::format("r has {} entries, expected {}", r.size(), p.q.size()));
   const Eigen::VectorXd u = p.W * r + p.q;
-  return residual_of(p, r, u, checked_diagonal(p));
+  const Eigen::VectorXd diag = checked_diagonal(p);
+  return matrix_form::residual_over(p.nc, [&](int k) {
+    const double rn = r[2 * k], rt = r[2 * k + 1];
+    return std::pair{law_residual(u[2 * k], u[2 * k + 1], rn, rt, p.mu[k], 0.0, 1.0 / diag[2 * k]),
+                     std::sqrt(rn * rn + rt * rt)};
+  });
 }
 
 namespace {
@@ -355,8 +305,7 @@ struct MatrixCoupling {
 double siconos_error(const Problem& p, const Eigen::VectorXd& r) {
   check_shape(p);
   const Eigen::VectorXd u = p.W * r + p.q;
-  double e2 = 0;
-  for (int k = 0; k < p.nc; ++k) {
+  return matrix_form::siconos_over(p.q, p.nc, [&](int k) {
     const double mu = p.mu[k], rn = r[2 * k], rt = r[2 * k + 1];
     // r - P_K(r - (u_n + mu |u_t|, u_t)), P_K the projection on the cone
     // |x_t| <= mu x_n (De Saxce's modified velocity, rho = 1).
@@ -371,39 +320,31 @@ double siconos_error(const Problem& p, const Eigen::VectorXd& r) {
       xt = mu * xn * (xt > 0 ? 1.0 : xt < 0 ? -1.0 : 0.0);
     }
     const double dn = rn - xn, dt = rt - xt;
-    e2 += dn * dn + dt * dt;
-  }
-  const double nq = p.q.norm();
-  return nq > std::numeric_limits<double>::epsilon() ? std::sqrt(e2) / nq : std::sqrt(e2);
+    return dn * dn + dt * dt;
+  });
 }
 
-NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& opt) {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  check_shape(p);
-  const int nc = p.nc;
-  if (r.size() != 2 * nc) r = Eigen::VectorXd::Zero(2 * nc);
-  NlgsStats st;
-  const Eigen::VectorXd diag = checked_diagonal(p);
+namespace {
 
-  // Block rows of W: for contact a, the 2x2 blocks W_ab of every b it
-  // couples to (W is column-major: entry (i, j) goes to block (i/2, j/2)).
-  auto brow = block_rows<2>(p.W, nc, std::array<double, 4>{0, 0, 0, 0},
-                           [](std::array<double, 4>& b, int i, int j, double v) { b[2 * i + j] += v; });
+// The 2D rows of matrix_form::nlgs. A dumped W need not be exactly
+// symmetric (the slider-crank files' W_nt and W_tn differ by 6e-7
+// relative), but the local solver takes a symmetric block: the row holds
+// the symmetric part S of W_kk and the law sees b = u_k - S r_k with u_k
+// from the true blocks, so a fixed point of the sweep satisfies u = W r + q
+// exactly. (Rejected: a non-symmetric local solver, only to serve dumped
+// round-off.)
+struct Form2 {
+  static constexpr int dim = 2;
+  using Row = ContactRow;
+  using Block = std::array<double, 4>;  // (nn, nt, tn, tt)
+  using Coupling = MatrixCoupling;
+  const Problem& p;
+  const Eigen::VectorXd& diag;
 
-  // Rows in colour order. A dumped W need not be exactly symmetric (the
-  // slider-crank files' W_nt and W_tn differ by 6e-7 relative), but the
-  // local solver takes a symmetric block: the row holds the symmetric part
-  // S of W_kk and the law sees b = u_k - S r_k with u_k from the true
-  // blocks, so a fixed point of the sweep satisfies u = W r + q exactly.
-  // (Rejected: a non-symmetric local solver, only to serve dumped round-off.)
-  const Colouring col = colour_blocks(nc, block_adjacency(brow));
-  const std::vector<std::int32_t> inv = inverse_permutation(col.perm);
-  std::vector<ContactRow> rows(nc);
-  bool friction = false;
-  for (int i = 0; i < nc; ++i) {
-    const int k = col.perm[i];
-    ContactRow& w = rows[i];
+  static Block zero() { return {0, 0, 0, 0}; }
+  static void add(Block& b, int i, int j, double v) { b[2 * i + j] += v; }
+  template <class Blocks>
+  bool row(int k, const Blocks&, const Eigen::VectorXd& r, ContactRow& w) const {
     w = {};
     w.wnn = diag[2 * k];
     w.wnt = 0.5 * (p.W.coeff(2 * k, 2 * k + 1) + p.W.coeff(2 * k + 1, 2 * k));
@@ -415,42 +356,30 @@ NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& op
     w.pn = r[2 * k];
     w.pt = r[2 * k + 1];
     w.mu = p.mu[k];
-    friction = friction || p.mu[k] > 0;
+    return p.mu[k] > 0;
   }
-  MatrixCoupling c;
-  c.base = rows.data();
-  colour_ordered_rows(brow, col.perm, inv, c.start, c.col, c.blk);
-
-  const SolverParams prm = solver_params(opt);
-  const int every = std::max(1, opt.check_every);
-  auto record = [&](int sweep, double dp_rel) {
-    SolveStats s;
-    sweep::residuals(rows, c, INT_MAX, s);
-    st.history.push_back({sweep, dp_rel, s.residual_max, s.residual_mean});
-  };
-  SolveStats s;
-  if (nc > 0)
-    s = std::visit(
+  template <class Observer>
+  SolveStats solve(bool friction, std::vector<ContactRow>& rows, const Colouring& col, const MatrixCoupling& c,
+                   const SolverParams& prm, Observer&& observer) const {
+    return std::visit(
         [&](auto law) {
-          using L = decltype(law);
-          return sweep::solve<L>(rows, col, c, prm, static_cast<std::vector<BoundaryDof>*>(nullptr), [&](int it, double dp) {
-            if (it % every == 0) record(it, dp);
-          });
+          return sweep::solve<decltype(law)>(rows, col, c, prm, static_cast<std::vector<BoundaryDof>*>(nullptr),
+                                             observer);
         },
         choose_law(friction, false));
-  st.sweeps = s.iterations;
-  st.converged = !s.cap_hit;
-  st.dr_rel = s.dp_rel;
-  for (int i = 0; i < nc; ++i) {
-    r[2 * col.perm[i]] = rows[i].pn;
-    r[2 * col.perm[i] + 1] = rows[i].pt;
   }
-  if (nc > 0 && (st.history.empty() || st.history.back().sweep != st.sweeps))
-    record(st.sweeps, st.dr_rel);
-  st.residual = residual_of(p, r, p.W * r + p.q, diag);
-  st.siconos_error = siconos_error(p, r);
-  st.time = std::chrono::duration<double>(clock::now() - t0).count();
-  return st;
+  static void store(const ContactRow& w, Eigen::VectorXd& r, int k) {
+    r[2 * k] = w.pn;
+    r[2 * k + 1] = w.pt;
+  }
+};
+
+}  // namespace
+
+NlgsStats solve_nlgs(const Problem& p, Eigen::VectorXd& r, const NlgsOptions& opt) {
+  check_shape(p);
+  const Eigen::VectorXd diag = checked_diagonal(p);
+  return matrix_form::nlgs(p, r, opt, Form2{p, diag});
 }
 
 }  // namespace cd

@@ -2,7 +2,6 @@
 
 #include <climits>
 #include <cmath>
-#include <fstream>
 #include <stdexcept>
 #include <utility>
 
@@ -85,11 +84,9 @@ void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, st
                        x3(r.c1), x3(r.c2), x(r.wnn), x(r.wtt), x(r.bn), x3(r.r), x(r.mu), x(r.adh));
   out << "extras " << p.extra.size() << "\n";
   for (const RowExtra3& e : p.extra) out << fmt::format("{} {} {}\n", x(e.bt1), x(e.bt2), x(e.mu_b));
-  out << "dofs " << p.dofs.size() << "\n";
-  for (const CellDof3& d : p.dofs) {
-    out << problem_file::dof_scalars(d) << ' ' << d.axis << ' ' << d.rows.size() << '\n';
-    for (std::size_t m = 0; m < d.rows.size(); ++m) out << fmt::format("{} {}\n", d.rows[m], x3(d.a[m]));
-  }
+  problem_file::write_dofs(
+      out, p.dofs, [](const CellDof3& d) { return fmt::format(" {}", d.axis); },
+      [](const CellDof3& d, std::size_t m) { return x3(d.a[m]); });
 }
 
 ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name, SolverParams& prm) {
@@ -147,31 +144,19 @@ ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name,
     e.mu_b = rd.number("mu_b" + w);
     if (e.mu_b < 0) rd.fail(fmt::format("mu_b{} negative", w));
   }
-  rd.expect("dofs", "after the extras");
-  const long long nd = rd.integer("the number of dofs", 0, 3);
-  p.dofs.resize(nd);
-  for (long long d = 0; d < nd; ++d) {
-    CellDof3& D = p.dofs[d];
-    const std::string w = fmt::format(" of dof {}", d);
-    problem_file::read_dof_scalars(rd, D, w);
-    if (!(D.inv_mass > 0) || !(D.scale > 0)) rd.fail(fmt::format("inv_mass or scale{} not positive", w));
-    D.axis = static_cast<int>(rd.integer("the axis" + w, 0, 2));
-    const long long m = rd.integer("the number of rows" + w, 0, nr);
-    D.rows.resize(m);
-    D.a.resize(m);
-    for (long long j = 0; j < m; ++j) {
-      D.rows[j] = static_cast<std::int32_t>(rd.integer("a row" + w, 0, nr - 1));
-      D.a[j] = vec3(rd, "a" + w);
-    }
-  }
+  p.dofs = problem_file::read_dofs<CellDof3>(
+      rd, "after the extras", 3, nr, 4,
+      [&](CellDof3& D, const std::string& w) {
+        if (!(D.inv_mass > 0) || !(D.scale > 0)) rd.fail(fmt::format("inv_mass or scale{} not positive", w));
+        D.axis = static_cast<int>(rd.integer("the axis" + w, 0, 2));
+      },
+      [&](CellDof3& D, const std::string& w) { D.a.push_back(vec3(rd, "a" + w)); });
   if (!rd.token().empty()) rd.fail("unexpected text after the last dof");
   return p;
 }
 
 ContactProblem3 read_contact_problem3(const std::string& path, SolverParams& prm) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot open for reading", path));
-  return read_contact_problem3(in, path, prm);
+  return problem_file::read_path(path, [&](std::istream& in) { return read_contact_problem3(in, path, prm); });
 }
 
 }  // namespace cd

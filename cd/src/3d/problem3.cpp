@@ -1,9 +1,6 @@
 #include "problem3.hpp"
 
-#include "block_rows.hpp"
-
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <climits>
 #include <cmath>
@@ -22,8 +19,8 @@ extern "C" {
 #include <fclib.h>
 }
 
-#include "colour_blocks.hpp"
 #include "contact_problem3.hpp"
+#include "matrix_form.hpp"
 #include "siconos_dat.hpp"
 #include "sweep.hpp"
 
@@ -32,7 +29,6 @@ namespace cd {
 namespace {
 
 using SpMat = Eigen::SparseMatrix<double>;
-using Triplets = std::vector<Eigen::Triplet<double>>;
 
 // An fclib_matrix as an Eigen matrix. Triplet storage (nz >= 0): the data
 // and Siconos' reader use p for column indices and i for row indices (the
@@ -40,7 +36,7 @@ using Triplets = std::vector<Eigen::Triplet<double>>;
 // compressed rows. Indices are checked against the size.
 SpMat to_eigen(const fclib_matrix* m, const std::string& what, const std::string& path) {
   if (!m) throw std::runtime_error(fmt::format("{}: {} is missing", path, what));
-  Triplets t;
+  matrix_form::Triplets t;
   auto add = [&](long long i, long long j, double v) {
     if (i < 0 || i >= m->m || j < 0 || j >= m->n)
       throw std::runtime_error(fmt::format("{}: {} ({}x{}) has an entry at ({}, {})", path, what,
@@ -147,7 +143,7 @@ Problem3 to_matrix(const ContactProblem3& cp) {
   // velocity (u_k,j = e_j.(v2 - v1) + w2.(c2 x e_j) - w1.(c1 x e_j)), then
   // one row per cell dof (u_k,j += a_j v). MH = M^-1 H keeps only what has
   // an inverse mass, so W = H^T MH has no structural entry through a wall.
-  Triplets h, mh;
+  matrix_form::Triplets h, mh;
   h.reserve(36 * static_cast<std::size_t>(nc));
   mh.reserve(36 * static_cast<std::size_t>(nc));
   auto add = [&](int b, const Vec3& lin, const Vec3& ang, int col) {
@@ -166,9 +162,8 @@ Problem3 to_matrix(const ContactProblem3& cp) {
       add(r.b1, -e[j], -r.c1.cross(e[j]), 3 * k + j);
     }
   }
-  // A cell dof is one more body: its v0 part is already in the rows'
-  // offsets and v = v0 before the solve, so it adds inv_mass a a^T to W and
-  // nothing to q (2D's assemble_problem, the same argument).
+  // A cell dof is one more body (matrix_form::condense: inv_mass a a^T in
+  // W, nothing in q).
   for (int d = 0; d < nd; ++d) {
     const CellDof3& D = cp.dofs[d];
     for (std::size_t m = 0; m < D.rows.size(); ++m)
@@ -177,15 +172,6 @@ Problem3 to_matrix(const ContactProblem3& cp) {
         mh.emplace_back(6 * nb + d, 3 * D.rows[m] + j, D.inv_mass * D.a[m][j]);
       }
   }
-  SpMat H(6 * nb + nd, 3 * nc), MH(6 * nb + nd, 3 * nc);
-  H.setFromTriplets(h.begin(), h.end());
-  MH.setFromTriplets(mh.begin(), mh.end());
-  Problem3 P;
-  P.nc = nc;
-  P.W = SpMat(H.transpose() * MH);
-  P.W.makeCompressed();
-  // The bodies' velocities hold the warm start (H^T U includes W_body r),
-  // the dofs' do not (v = v0): q = H_b^T U - W_b r + b.
   Eigen::VectorXd U(6 * nb), r(3 * nc), b(3 * nc);
   for (int i = 0; i < nb; ++i) U.segment<6>(6 * i) << V[i].v, V[i].w;
   for (int k = 0; k < nc; ++k) {
@@ -193,9 +179,9 @@ Problem3 to_matrix(const ContactProblem3& cp) {
     b.segment<3>(3 * k) = Vec3(rows[k].bn, cp.extra.empty() ? 0.0 : cp.extra[k].bt1,
                                cp.extra.empty() ? 0.0 : cp.extra[k].bt2);
   }
-  const SpMat Hb = H.topRows(6 * nb), MHb = MH.topRows(6 * nb);
-  const SpMat Wb(Hb.transpose() * MHb);
-  P.q = Hb.transpose() * U - Wb * r + b;
+  Problem3 P;
+  P.nc = nc;
+  matrix_form::condense(6 * nb + nd, 3 * nc, 6 * nb, h, mh, U, r, b, P.W, P.q);
   P.mu.resize(nc);
   for (int k = 0; k < nc; ++k) P.mu[k] = rows[k].mu;
   if (std::visit([](auto l) { return decltype(l)::orthotropic; }, cp.law)) {
@@ -335,60 +321,42 @@ Problem3 read_dat3(const std::string& path) {
 
 Residual problem_residual(const Problem3& p, const Eigen::VectorXd& r) {
   check_shape(p);
-  Residual res;
-  if (p.nc == 0) return res;
+  if (p.nc == 0) return {};
   const Eigen::VectorXd u = p.W * r + p.q;
-  double rmax = 0, rsum = 0, psum = 0;
-  for (int k = 0; k < p.nc; ++k) {
+  return matrix_form::residual_over(p.nc, [&](int k) {
     const Vec3 rk = r.segment<3>(3 * k);
-    const double e = law_residual3(u.segment<3>(3 * k), rk, p.cone(k), 0.0, 1.0 / p.W.coeff(3 * k, 3 * k));
-    rmax = std::max(rmax, e);
-    rsum += e;
-    psum += rk.norm();
-  }
-  res.r_mean = psum / p.nc;
-  const double scale = res.r_mean > 0 ? res.r_mean : 1.0;
-  res.max = rmax / scale;
-  res.mean = rsum / p.nc / scale;
-  return res;
+    return std::pair{law_residual3(u.segment<3>(3 * k), rk, p.cone(k), 0.0, 1.0 / p.W.coeff(3 * k, 3 * k)),
+                     rk.norm()};
+  });
 }
 
 double siconos_error(const Problem3& p, const Eigen::VectorXd& r) {
   check_shape(p);
   const Eigen::VectorXd u = p.W * r + p.q;
-  double e2 = 0;
-  for (int k = 0; k < p.nc; ++k)
-    e2 += siconos_term3(u.segment<3>(3 * k), r.segment<3>(3 * k), p.mu[k]);
-  const double nq = p.q.norm();
-  return nq > std::numeric_limits<double>::epsilon() ? std::sqrt(e2) / nq : std::sqrt(e2);
+  return matrix_form::siconos_over(
+      p.q, p.nc, [&](int k) { return siconos_term3(u.segment<3>(3 * k), r.segment<3>(3 * k), p.mu[k]); });
 }
 
-NlgsStats solve_nlgs(const Problem3& p, Eigen::VectorXd& r, const NlgsOptions& opt) {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  check_shape(p);
-  const int nc = p.nc;
-  if (r.size() != 3 * nc) r = Eigen::VectorXd::Zero(3 * nc);
-  NlgsStats st;
+namespace {
 
-  // Block rows of W: for contact a, the 3x3 blocks W_ab (W column-major:
-  // entry (i, j) goes to block (i/3, j/3)).
-  auto brow = block_rows<3>(p.W, nc, Mat3(Mat3::Zero()),
-                           [](Mat3& b, int i, int j, double v) { b(i, j) += v; });
-  const Colouring col = colour_blocks(nc, block_adjacency(brow));
-  const std::vector<std::int32_t> inv = inverse_permutation(col.perm);
+// The 3D rows of matrix_form::nlgs. As in 2D: the row holds the symmetric
+// part S of W_kk (a condensed W is symmetric only to round-off) and the
+// law sees b = u_k - S r_k with u_k from the true blocks, so a fixed point
+// satisfies u = W r + q exactly.
+struct Form3 {
+  static constexpr int dim = 3;
+  using Row = Row3;
+  using Block = Mat3;
+  using Coupling = MatrixCoupling3;
+  const Problem3& p;
 
-  // As in 2D: the row holds the symmetric part S of W_kk (a condensed W is
-  // symmetric only to round-off) and the law sees b = u_k - S r_k with u_k
-  // from the true blocks, so a fixed point satisfies u = W r + q exactly.
-  std::vector<Row3> rows(nc);
-  bool friction = false;
-  for (int i = 0; i < nc; ++i) {
-    const int k = col.perm[i];
+  static Block zero() { return Mat3::Zero(); }
+  static void add(Mat3& b, int i, int j, double v) { b(i, j) += v; }
+  template <class Blocks>
+  bool row(int k, const Blocks& blocks, const Eigen::VectorXd& r, Row3& w) const {
     Mat3 Wkk = Mat3::Zero();
-    for (const auto& e : brow[k])
+    for (const auto& e : blocks)
       if (e.first == k) Wkk = e.second;
-    Row3& w = rows[i];
     w.S = 0.5 * (Wkk + Wkk.transpose());
     if (!(w.S(0, 0) > 0.0) || (p.mu[k] > 0 && w.S.llt().info() != Eigen::Success))
       throw std::invalid_argument(
@@ -397,37 +365,23 @@ NlgsStats solve_nlgs(const Problem3& p, Eigen::VectorXd& r, const NlgsOptions& o
     w.r = r.segment<3>(3 * k);
     w.cone = p.cone(k);
     w.adh = 0.0;
-    friction = friction || w.cone.mu_a > 0 || w.cone.mu_b > 0;
+    return w.cone.mu_a > 0 || w.cone.mu_b > 0;
   }
-  MatrixCoupling3 c;
-  c.base = rows.data();
-  colour_ordered_rows(brow, col.perm, inv, c.start, c.col, c.blk);
+  template <class Observer>
+  SolveStats solve(bool friction, std::vector<Row3>& rows, const Colouring& col, const MatrixCoupling3& c,
+                   const SolverParams& prm, Observer&& observer) const {
+    std::vector<NoDof>* nodofs = nullptr;
+    return friction ? sweep::solve<Coulomb3>(rows, col, c, prm, nodofs, observer)
+                    : sweep::solve<Frictionless3>(rows, col, c, prm, nodofs, observer);
+  }
+  static void store(const Row3& w, Eigen::VectorXd& r, int k) { r.segment<3>(3 * k) = w.r; }
+};
 
-  const SolverParams prm = solver_params(opt);
-  const int every = std::max(1, opt.check_every);
-  auto record = [&](int sweep, double dp_rel) {
-    SolveStats s;
-    sweep::residuals(rows, c, INT_MAX, s);
-    st.history.push_back({sweep, dp_rel, s.residual_max, s.residual_mean});
-  };
-  auto observer = [&](int it, double dp) {
-    if (it % every == 0) record(it, dp);
-  };
-  SolveStats s;
-  std::vector<NoDof>* nodofs = nullptr;
-  if (nc > 0)
-    s = friction ? sweep::solve<Coulomb3>(rows, col, c, prm, nodofs, observer)
-                 : sweep::solve<Frictionless3>(rows, col, c, prm, nodofs, observer);
-  st.sweeps = s.iterations;
-  st.converged = nc == 0 || !s.cap_hit;
-  st.dr_rel = s.dp_rel;
-  for (int i = 0; i < nc; ++i) r.segment<3>(3 * col.perm[i]) = rows[i].r;
-  if (nc > 0 && (st.history.empty() || st.history.back().sweep != st.sweeps))
-    record(st.sweeps, st.dr_rel);
-  st.residual = problem_residual(p, r);
-  st.siconos_error = siconos_error(p, r);
-  st.time = std::chrono::duration<double>(clock::now() - t0).count();
-  return st;
+}  // namespace
+
+NlgsStats solve_nlgs(const Problem3& p, Eigen::VectorXd& r, const NlgsOptions& opt) {
+  check_shape(p);
+  return matrix_form::nlgs(p, r, opt, Form3{p});
 }
 
 }  // namespace cd

@@ -1,16 +1,20 @@
 // The parts of cdlab's frozen-step files (.cdp for 2D, .cdp3 for 3D;
 // 2d/contact_problem.hpp, 3d/contact_problem3.hpp) that do not depend on
-// the dimension: the solver's parameters and the colouring, written and read
-// the same way by both, every number a C hexadecimal float (read back to the
-// same bits) and every malformed value reported by TextReader with the file
-// and the line.
+// the dimension: the solver's parameters, the colouring and the boundary
+// dofs, written and read the same way by both, every number a C hexadecimal
+// float (read back to the same bits) and every malformed value reported by
+// TextReader with the file and the line; and the opening of a problem file
+// (these and Siconos' .dat) with an error that names it.
 #pragma once
 #include <climits>
 #include <cstdint>
+#include <fstream>
 #include <ostream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <variant>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -104,18 +108,63 @@ V read_law(TextReader& rd, Name&& name) {
   return out;
 }
 
-// A boundary dof's scalars "v0 v inv_mass scale" (2D BoundaryDof, 3D
-// CellDof3), `w` naming the dof in messages.
-template <class Dof>
-std::string dof_scalars(const Dof& d) {
-  return fmt::format("{} {} {} {}", hex(d.v0), hex(d.v), hex(d.inv_mass), hex(d.scale));
+// The boundary dofs (2D BoundaryDof, 3D CellDof3): "dofs D", then per dof
+// "v0 v inv_mass scale", the dimension's own fields head(dof), the row
+// count M, and M lines "row" followed by the dof's coefficients on that row,
+// coefficients(dof, m) (2D: a_n a_t; 3D: the three frame components).
+template <class Dof, class Head, class Coefficients>
+void write_dofs(std::ostream& out, const std::vector<Dof>& dofs, Head&& head, Coefficients&& coefficients) {
+  out << "dofs " << dofs.size() << "\n";
+  for (const Dof& d : dofs) {
+    out << hex(d.v0) << ' ' << hex(d.v) << ' ' << hex(d.inv_mass) << ' ' << hex(d.scale) << head(d) << ' '
+        << d.rows.size() << '\n';
+    for (std::size_t m = 0; m < d.rows.size(); ++m) out << d.rows[m] << ' ' << coefficients(d, m) << '\n';
+  }
 }
-template <class Dof>
-void read_dof_scalars(TextReader& rd, Dof& d, const std::string& w) {
-  d.v0 = rd.number("v0" + w);
-  d.v = rd.number("v" + w);
-  d.inv_mass = rd.non_negative("inv_mass" + w);
-  d.scale = rd.number("scale" + w);
+
+// Reads what write_dofs wrote, after `after`: at most max_dofs dofs, rows
+// in [0, nr), each row line `tokens_each` tokens (the row and its
+// coefficients). head(dof, w) reads (and checks) the dimension's own fields,
+// coefficients(dof, w) appends one row's; `w` names the dof in messages.
+template <class Dof, class Head, class Coefficients>
+std::vector<Dof> read_dofs(TextReader& rd, const std::string& after, long long max_dofs, long long nr,
+                           long long tokens_each, Head&& head, Coefficients&& coefficients) {
+  rd.expect("dofs", after);
+  const long long nd = rd.count("the number of dofs", max_dofs, 5);
+  std::vector<Dof> dofs(nd);
+  for (long long d = 0; d < nd; ++d) {
+    Dof& D = dofs[d];
+    const std::string w = fmt::format(" of dof {}", d);
+    D.v0 = rd.number("v0" + w);
+    D.v = rd.number("v" + w);
+    D.inv_mass = rd.non_negative("inv_mass" + w);
+    D.scale = rd.number("scale" + w);
+    head(D, w);
+    const long long m = rd.count("the number of rows" + w, nr, tokens_each);
+    D.rows.resize(m);
+    for (long long j = 0; j < m; ++j) {
+      D.rows[j] = static_cast<std::int32_t>(rd.integer("a row" + w, 0, nr - 1));
+      coefficients(D, w);
+    }
+  }
+  return dofs;
+}
+
+// The file at `path` read by read(stream), or std::runtime_error naming it.
+template <class Read>
+auto read_path(const std::string& path, Read&& read) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open for reading", path));
+  return read(in);
+}
+
+// The file at `path` written by write(stream), or std::runtime_error naming it.
+template <class Write>
+void write_path(const std::string& path, Write&& write) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
+  write(out);
+  if (!out.flush()) throw std::runtime_error(fmt::format("{}: write failed", path));
 }
 
 }  // namespace cd::problem_file

@@ -3,13 +3,13 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "problem_file.hpp"
 #include "text_reader.hpp"
 
 namespace cd {
@@ -184,9 +184,7 @@ SiconosDat read_siconos_dat(std::istream& in, const std::string& name, int dim) 
 }
 
 SiconosDat read_siconos_dat(const std::string& path, int dim) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot open for reading", path));
-  return read_siconos_dat(in, path, dim);
+  return problem_file::read_path(path, [&](std::istream& in) { return read_siconos_dat(in, path, dim); });
 }
 
 }  // namespace cd
