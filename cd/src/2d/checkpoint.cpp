@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "output.hpp"
+#include "world_checkpoint.hpp"
 
 namespace cd {
 
@@ -82,45 +83,27 @@ void check_cell(const ckpt::Reader& in, const CellState& c) {
   in.finite("cell", 0, "strain", c.strain);
 }
 
+constexpr ckpt::WorldFile kFile{2, "warm.keys", "warm.p"};
+
 }  // namespace
 
 void save_checkpoint(const std::string& path, const World& w, std::uint64_t scene_key,
                      const RunTotals& totals) {
-  ckpt::Writer o;
-  ckpt::begin(o, 2, scene_key, static_cast<std::int64_t>(w.steps), w.time, w.times);
-  ckpt::for_each_array(kBodiesArrays, w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
-  o.array("warm.keys", w.warm_start().keys);
-  o.array("warm.p", w.warm_start().p);
-  o.array("cell", std::vector<CellState>{w.cell});
-  ckpt::finish(o, totals, path);
+  ckpt::save_world(path, w, kFile, kBodiesArrays, scene_key, totals,
+                   [&](ckpt::Writer& o) { o.array("cell", std::vector<CellState>{w.cell}); });
 }
 
 std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* totals) {
-  std::string data;
-  ckpt::Reader in{path, {}};
-  const ckpt::Header h = ckpt::open(path, data, in, 2, totals != nullptr);
-  Bodies b;
-  ckpt::for_each_array(kBodiesArrays, b, [&](std::string_view name, auto& v) { in.array(name, v); });
-  check_bodies(in, b);
-  World::WarmStart warm;
-  in.array("warm.keys", warm.keys);
-  in.array("warm.p", warm.p);
-  ckpt::check_warm(in, "warm.keys", warm.keys, "warm.p", warm.p);
-  std::vector<CellState> cell;
-  in.array("cell", cell);
-  if (cell.size() != 1) in.fail(fmt::format("is corrupt: 'cell' holds {} elements (must be 1)", cell.size()));
-  check_cell(in, cell[0]);
-  const RunTotals tot = ckpt::close(in, h);
-  ckpt::check_count(in, b.size(), w.bodies.size());
-
-  w.bodies = std::move(b);
-  w.steps = h.steps;
-  w.time = h.time;
-  w.times = h.times;
-  w.set_warm_start(std::move(warm));
-  w.cell = cell[0];
-  if (totals) *totals = tot;
-  return h.key;
+  return ckpt::load_world(
+      path, w, kFile, kBodiesArrays, totals, check_bodies,
+      [](ckpt::Reader& in) {
+        std::vector<CellState> cell;
+        in.array("cell", cell);
+        if (cell.size() != 1) in.fail(fmt::format("is corrupt: 'cell' holds {} elements (must be 1)", cell.size()));
+        check_cell(in, cell[0]);
+        return cell[0];
+      },
+      [](World& w, const CellState& c) { w.cell = c; });
 }
 
 }  // namespace cd

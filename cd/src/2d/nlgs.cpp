@@ -43,23 +43,19 @@ void law_residuals(const ContactProblem& p, const SolverParams& prm, SolveStats&
 }
 
 double update_dof(BoundaryDof& d, ContactRow* rows) {
-  // The damped step of core/cell_dof.hpp (why damped: there).
-  double s = 0.0, k = 0.0;
-  const std::size_t m = d.rows.size();
-  for (std::size_t i = 0; i < m; ++i) {
-    const ContactRow& r = rows[d.rows[i]];
-    s += d.an[i] * r.pn + d.at[i] * r.pt;
-    if (r.pn + r.adh > 0.0) k += d.an[i] * d.an[i] / r.wnn + d.at[i] * d.at[i] / r.wtt;
-  }
-  double res;
-  const double dv = cell_dof::damped_step(d.v0, d.v, d.inv_mass, s, k, res);
-  for (std::size_t i = 0; i < m; ++i) {
-    ContactRow& r = rows[d.rows[i]];
-    r.bn += d.an[i] * dv;
-    r.bt += d.at[i] * dv;
-  }
-  d.v += dv;
-  return std::abs(res) / (d.inv_mass * d.scale);
+  // core/cell_dof.hpp's damped update (why damped: there).
+  return cell_dof::update(
+      d,
+      [&](std::size_t i, double& s, double& k) {
+        const ContactRow& r = rows[d.rows[i]];
+        s += d.an[i] * r.pn + d.at[i] * r.pt;
+        if (r.pn + r.adh > 0.0) k += d.an[i] * d.an[i] / r.wnn + d.at[i] * d.at[i] / r.wtt;
+      },
+      [&](std::size_t i, double dv) {
+        ContactRow& r = rows[d.rows[i]];
+        r.bn += d.an[i] * dv;
+        r.bt += d.at[i] * dv;
+      });
 }
 
 SolveStats nlgs_solve(ContactProblem& p, const SolverParams& prm, const SweepObserver& observer) {

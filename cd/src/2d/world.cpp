@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <numeric>
 #include <type_traits>
 #include <variant>
 
@@ -58,8 +57,7 @@ void World::step() {
   }
   std::visit([&](const auto& b) { b.begin_step(*this); }, boundary_);
   run_stages(*this, kTable, times);
-  ++steps;
-  time = static_cast<double>(steps) * prm_.dt;  // not a running sum: no drift
+  count_step(prm_.dt);
 }
 
 void World::predict() {
@@ -113,11 +111,9 @@ void World::build() {
   // Warm start from the previous step's impulses, matched by contact key.
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t k = 0; k < nr; ++k) {
-    const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
-    if (it != warm_.keys.end() && *it == info_[k].key) {
-      const auto& p = warm_.p[it - warm_.keys.begin()];
-      prob_.rows[k].pn = p.first;
-      prob_.rows[k].pt = p.second;
+    if (const auto* p = warm_.find(info_[k].key)) {
+      prob_.rows[k].pn = p->first;
+      prob_.rows[k].pt = p->second;
     }
   }
 }
@@ -158,43 +154,16 @@ void World::external() {
 }
 
 void World::colour() {
-  // Colour and permute rows so that each colour is contiguous.
-  prob_.colouring = colour_rows(prob_.rows, bodies);
-  const Colouring& col = prob_.colouring;
-  std::vector<ContactRow> r(prob_.rows.size());
-  std::vector<ContactInfo> f(info_.size());
-#pragma omp parallel for schedule(static) if (static_cast<int>(prob_.rows.size()) >= prm_.solver.min_parallel)
-  for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
-    r[k] = prob_.rows[col.perm[k]];
-    f[k] = info_[col.perm[k]];
-  }
-  prob_.rows.swap(r);
-  info_.swap(f);
+  colour_and_permute(static_cast<int>(prob_.rows.size()) >= prm_.solver.min_parallel);
 }
 
 void World::solve() {
   if (gravity_on_ || forces_on_) external();
   apply_impulses(prob_.rows, bodies.vel, prm_.rotation);
   std::visit([&](const auto& b) { b.set_dofs(*this); }, boundary_);
-  // The problem takes the velocities for the solve and gives them back.
-  prob_.vel.swap(bodies.vel);
-  if (hook_) hook_(prob_, prm_.solver);
-  last_.solve = solver_ ? solver_(prob_, prm_.solver) : nlgs_solve(prob_, prm_.solver);
-  prob_.vel.swap(bodies.vel);
+  solve_problem(prm_.solver, [](ContactProblem& p, const SolverParams& s) { return nlgs_solve(p, s); });
   std::visit([&](const auto& b) { b.take_dofs(*this); }, boundary_);
-
-  // Keep the impulses for the next step's warm start.
-  const std::size_t nr = prob_.rows.size();
-  std::vector<std::size_t> idx(nr);
-  std::iota(idx.begin(), idx.end(), 0);
-  std::sort(idx.begin(), idx.end(),
-            [&](std::size_t a, std::size_t b) { return info_[a].key < info_[b].key; });
-  warm_.keys.resize(nr);
-  warm_.p.resize(nr);
-  for (std::size_t k = 0; k < nr; ++k) {
-    warm_.keys[k] = info_[idx[k]].key;
-    warm_.p[k] = {prob_.rows[idx[k]].pn, prob_.rows[idx[k]].pt};
-  }
+  keep_warm([&](std::size_t k) { return std::pair{prob_.rows[k].pn, prob_.rows[k].pt}; });
 }
 
 void World::observe() {

@@ -12,7 +12,9 @@
 //   integrate  r+ = r_m + dt/2 U+, and the cell
 //   observe    the step's quality figures (contacts, overlaps, work)
 // Work a scene does not need is not done; the law and the boundary
-// protocol (boundary.hpp) are fixed once per scene.
+// protocol (boundary.hpp) are fixed once per scene. What World shares with
+// World3 (bodies, clock, solver slot, warm start, colour stage) is
+// core/world_shell.hpp.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -28,6 +30,7 @@
 #include "nlgs.hpp"
 #include "observables.hpp"
 #include "stages.hpp"
+#include "world_shell.hpp"
 
 namespace cd {
 
@@ -95,14 +98,12 @@ struct CellState {
   double strain = 0.0;               // integral of the shear rate
 };
 
-class World {
+// The shell (bodies, clock, timers, the last step's problem and records,
+// solver slot, warm-start memory of (p_n, p_t), colour stage) is
+// core/world_shell.hpp's, shared with World3.
+class World : public WorldShell<Bodies, ContactProblem, ContactInfo, std::pair<double, double>> {
  public:
   explicit World(const WorldParams& p) : prm_(p) { configure(); }
-
-  Bodies bodies;
-  double time = 0.0;
-  std::int64_t steps = 0;
-  StageTimes times;
 
   const WorldParams& params() const { return prm_; }
   // Re-reads the parameters (call after changing them).
@@ -112,22 +113,7 @@ class World {
   }
 
   void step();
-  const StepStats& last() const { return last_; }
-  const std::vector<ContactRow>& rows() const { return prob_.rows; }
-  // The contact problem of the last step (solved), in colour order; its
-  // `vel` is empty outside the solve stage (the velocities are in bodies).
-  const ContactProblem& problem() const { return prob_; }
   const LocalLaw& law() const { return prob_.law; }
-
-  // The solve stage's solver (default nlgs_solve): a study may put another
-  // one in (cd/bench), the rest of the step unchanged.
-  using Solver = std::function<SolveStats(ContactProblem&, const SolverParams&)>;
-  void set_solver(Solver s) { solver_ = std::move(s); }
-  // Called with the problem just before it is solved (its impulses the warm
-  // start, already in its velocities): --dump-problem writes it out.
-  using ProblemHook = std::function<void(const ContactProblem&, const SolverParams&)>;
-  void set_problem_hook(ProblemHook h) { hook_ = std::move(h); }
-  const std::vector<ContactInfo>& infos() const { return info_; }
 
   // Periodic cell (LeesEdwards) or gap between the walls (Walls).
   CellState cell;
@@ -157,15 +143,6 @@ class World {
 
   // Status of a solved row: open, stick or slide.
   ContactStatus status(std::size_t k) const;
-
-  // Warm-start memory: the previous step's impulses by contact key (sorted).
-  // Part of the state a bit-identical restart must restore.
-  struct WarmStart {
-    std::vector<std::uint64_t> keys;
-    std::vector<std::pair<double, double>> p;
-  };
-  const WarmStart& warm_start() const { return warm_; }
-  void set_warm_start(WarmStart w) { warm_ = std::move(w); }
 
  private:
   friend struct LeesEdwardsCell;
@@ -198,16 +175,10 @@ class World {
   std::vector<std::uint8_t> on_top_;  // WallShear: body is glued to the top wall
   bool forces_on_ = false, prepared_ = false;  // forces_on_: some body has an applied force
   double alert_ = 0.0;
-  StepStats last_;
   std::vector<Vec2> xm_;
   std::vector<double> thm_;
   ContactProblem proj_;    // project_overlaps' pseudo-velocity problem
-  ContactProblem prob_;  // rows, colouring, dofs, law (velocities during the solve)
-  std::vector<ContactInfo> info_;
   CellGrid grid_;
-  WarmStart warm_;
-  Solver solver_;
-  ProblemHook hook_;
 };
 
 }  // namespace cd

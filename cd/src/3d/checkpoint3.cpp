@@ -8,6 +8,8 @@
 #include <fmt/format.h>
 #include <utility>
 
+#include "world_checkpoint.hpp"
+
 namespace cd {
 
 namespace {
@@ -68,68 +70,51 @@ void check_bodies3(const ckpt::Reader& in, const Bodies3& b) {
   }
 }
 
+constexpr ckpt::WorldFile kFile{3, "3d.warm.keys", "3d.warm.p"};
+
 }  // namespace
 
 void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
                       const RunTotals& totals) {
-  ckpt::Writer o;
-  ckpt::begin(o, 3, scene_key, static_cast<std::int64_t>(w.steps), w.time, w.times);
-  ckpt::for_each_array(kBodies3Arrays, w.bodies, [&](std::string_view name, const auto& v) { o.array(name, v); });
-  o.array("3d.warm.keys", w.warm_start().keys);
-  o.array("3d.warm.p", w.warm_start().p);
-  const WorldParams3& p = w.params();
-  const CellState3& c = w.cell();
-  o.array("3d.cell", std::vector<double>{c.size.x(), c.size.y(), c.size.z(), c.le_offset, double(p.periodic[0]),
-                                         double(p.periodic[1]), double(p.periodic[2]), c.rate.x(), c.rate.y(),
-                                         c.rate.z(), c.strain});
-  ckpt::finish(o, totals, path);
+  ckpt::save_world(path, w, kFile, kBodies3Arrays, scene_key, totals, [&](ckpt::Writer& o) {
+    const WorldParams3& p = w.params();
+    const CellState3& c = w.cell();
+    o.array("3d.cell", std::vector<double>{c.size.x(), c.size.y(), c.size.z(), c.le_offset, double(p.periodic[0]),
+                                           double(p.periodic[1]), double(p.periodic[2]), c.rate.x(), c.rate.y(),
+                                           c.rate.z(), c.strain});
+  });
 }
 
 std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals) {
-  std::string data;
-  ckpt::Reader in{path, {}};
-  const ckpt::Header h = ckpt::open(path, data, in, 3, totals != nullptr);
-  Bodies3 b;
-  ckpt::for_each_array(kBodies3Arrays, b, [&](std::string_view name, auto& v) { in.array(name, v); });
-  check_bodies3(in, b);
-  World3::WarmStart warm;
-  in.array("3d.warm.keys", warm.keys);
-  in.array("3d.warm.p", warm.p);
-  ckpt::check_warm(in, "3d.warm.keys", warm.keys, "3d.warm.p", warm.p);
-  std::vector<double> cell;
-  in.array("3d.cell", cell);
-  // 7 numbers: written before the cell had rates and a strain (both 0).
-  if (cell.size() != 7 && cell.size() != 11)
-    in.fail(fmt::format("is corrupt: '3d.cell' holds {} numbers (must be 7 or 11)", cell.size()));
-  for (std::size_t c = 0; c < cell.size(); ++c) in.finite("3d.cell", c, "", cell[c]);
-  const WorldParams3& p = w.params();
-  for (int a = 0; a < 3; ++a)
-    if ((cell[4 + a] != 0.0) != p.periodic[a])
-      in.fail(fmt::format("holds a cell periodic along (x, y, z) = ({:d}, {:d}, {:d}); this scene's is ({:d}, "
-                          "{:d}, {:d})", cell[4] != 0.0, cell[5] != 0.0, cell[6] != 0.0, p.periodic[0],
-                          p.periodic[1], p.periodic[2]));
-  const RunTotals tot = ckpt::close(in, h);
-  ckpt::check_count(in, b.size(), w.bodies.size());
-
-  CellState3 c;
-  c.size = Vec3(cell[0], cell[1], cell[2]);
-  c.le_offset = cell[3];
-  c.rate = cell.size() == 11 ? Vec3(cell[7], cell[8], cell[9]) : Vec3::Zero();
-  c.strain = cell.size() == 11 ? cell[10] : 0.0;
-  try {
-    World3 probe(p);  // checks the cell without touching w
-    probe.set_cell(c);
-  } catch (const std::invalid_argument& e) {
-    in.fail(fmt::format("holds a cell this scene cannot take ({})", e.what()));
-  }
-  w.set_cell(c);
-  w.bodies = std::move(b);
-  w.steps = h.steps;
-  w.time = h.time;
-  w.times = h.times;
-  w.set_warm_start(std::move(warm));
-  if (totals) *totals = tot;
-  return h.key;
+  return ckpt::load_world(
+      path, w, kFile, kBodies3Arrays, totals, check_bodies3,
+      [&](ckpt::Reader& in) {
+        std::vector<double> cell;
+        in.array("3d.cell", cell);
+        // 7 numbers: written before the cell had rates and a strain (both 0).
+        if (cell.size() != 7 && cell.size() != 11)
+          in.fail(fmt::format("is corrupt: '3d.cell' holds {} numbers (must be 7 or 11)", cell.size()));
+        for (std::size_t c = 0; c < cell.size(); ++c) in.finite("3d.cell", c, "", cell[c]);
+        const WorldParams3& p = w.params();
+        for (int a = 0; a < 3; ++a)
+          if ((cell[4 + a] != 0.0) != p.periodic[a])
+            in.fail(fmt::format("holds a cell periodic along (x, y, z) = ({:d}, {:d}, {:d}); this scene's is "
+                                "({:d}, {:d}, {:d})", cell[4] != 0.0, cell[5] != 0.0, cell[6] != 0.0,
+                                p.periodic[0], p.periodic[1], p.periodic[2]));
+        CellState3 c;
+        c.size = Vec3(cell[0], cell[1], cell[2]);
+        c.le_offset = cell[3];
+        c.rate = cell.size() == 11 ? Vec3(cell[7], cell[8], cell[9]) : Vec3::Zero();
+        c.strain = cell.size() == 11 ? cell[10] : 0.0;
+        try {
+          World3 probe(p);  // checks the cell without touching w
+          probe.set_cell(c);
+        } catch (const std::invalid_argument& e) {
+          in.fail(fmt::format("holds a cell this scene cannot take ({})", e.what()));
+        }
+        return c;
+      },
+      [](World3& w, const CellState3& c) { w.set_cell(c); });
 }
 
 }  // namespace cd

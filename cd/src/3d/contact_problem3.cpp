@@ -14,28 +14,24 @@
 namespace cd {
 
 double update_dof(CellDof3& d, SphereRow* rows) {
-  // core/cell_dof.hpp's damped step, with the 3D rows' impulses and
+  // core/cell_dof.hpp's damped update, with the 3D rows' impulses and
   // responses (W = diag(W_nn, W_tt, W_tt)).
-  double s = 0.0, k = 0.0;
-  const std::size_t m = d.rows.size();
-  for (std::size_t i = 0; i < m; ++i) {
-    const SphereRow& r = rows[d.rows[i]];
-    const Vec3& a = d.a[i];
-    s += a.dot(r.r);
-    if (r.r[0] + r.adh > 0.0) k += a[0] * a[0] / r.wnn + (a[1] * a[1] + a[2] * a[2]) / r.wtt;
-  }
-  double res;
-  const double dv = cell_dof::damped_step(d.v0, d.v, d.inv_mass, s, k, res);
-  for (std::size_t i = 0; i < m; ++i) {
-    const std::int32_t j = d.rows[i];
-    rows[j].bn += d.a[i][0] * dv;
-    if (d.extra) {
-      d.extra[j].bt1 += d.a[i][1] * dv;
-      d.extra[j].bt2 += d.a[i][2] * dv;
-    }
-  }
-  d.v += dv;
-  return std::abs(res) / (d.inv_mass * d.scale);
+  return cell_dof::update(
+      d,
+      [&](std::size_t i, double& s, double& k) {
+        const SphereRow& r = rows[d.rows[i]];
+        const Vec3& a = d.a[i];
+        s += a.dot(r.r);
+        if (r.r[0] + r.adh > 0.0) k += a[0] * a[0] / r.wnn + (a[1] * a[1] + a[2] * a[2]) / r.wtt;
+      },
+      [&](std::size_t i, double dv) {
+        const std::int32_t j = d.rows[i];
+        rows[j].bn += d.a[i][0] * dv;
+        if (d.extra) {
+          d.extra[j].bt1 += d.a[i][1] * dv;
+          d.extra[j].bt2 += d.a[i][2] * dv;
+        }
+      });
 }
 
 SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer) {

@@ -4,12 +4,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <numeric>
 #include <stdexcept>
 #include <variant>
 
 #include "cell_dof.hpp"
-#include "colour_rows.hpp"
 #include "coupling3.hpp"
 
 namespace cd {
@@ -96,8 +94,7 @@ void World3::step() {
       {Stage::Observe, &World3::observe},
   }};
   run_stages(*this, kTable, times);
-  ++steps;
-  time = static_cast<double>(steps) * prm_.dt;  // not a running sum: no drift
+  count_step(prm_.dt);
 }
 
 void World3::predict() {
@@ -187,31 +184,15 @@ void World3::build_rows([[maybe_unused]] const B& b) {
       }
     }
     // Warm start: the previous impulse by contact key, on the new frame.
-    const auto it = std::lower_bound(warm_.keys.begin(), warm_.keys.end(), info_[k].key);
-    if (it != warm_.keys.end() && *it == info_[k].key) {
-      r.r = r.to_frame(warm_.p[it - warm_.keys.begin()]);
+    if (const Vec3* p = warm_.find(info_[k].key)) {
+      r.r = r.to_frame(*p);
       if (!friction_on_) r.r[1] = r.r[2] = 0.0;
     }
   }
 }
 
 void World3::colour() {
-  prob_.colouring = colour_by_bodies(
-      static_cast<int>(prob_.rows.size()), bodies.size(), [&](int i) { return prob_.rows[i].b1; },
-      [&](int i) { return prob_.rows[i].b2; }, [&](std::int32_t b) { return bodies.is_dynamic(b); });
-  const std::vector<std::int32_t>& perm = prob_.colouring.perm;
-  std::vector<SphereRow> r(prob_.rows.size());
-  std::vector<ContactInfo3> f(info_.size());
-  std::vector<RowExtra3> e(prob_.extra.size());
-#pragma omp parallel for schedule(static) if (static_cast<int>(prob_.rows.size()) >= prm_.solver.min_parallel)
-  for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
-    r[k] = prob_.rows[perm[k]];
-    f[k] = info_[perm[k]];
-    if (!e.empty()) e[k] = prob_.extra[perm[k]];
-  }
-  prob_.rows.swap(r);
-  info_.swap(f);
-  prob_.extra.swap(e);
+  colour_and_permute(static_cast<int>(prob_.rows.size()) >= prm_.solver.min_parallel, prob_.extra);
 }
 
 void World3::solve() {
@@ -226,25 +207,11 @@ void World3::solve() {
   }
   // Warm-start impulses into the velocities (sequential: bodies are shared).
   apply_impulses(prob_.rows, V);
-  // The problem takes the velocities for the solve and gives them back.
-  prob_.vel.swap(V);
-  if (hook_) hook_(prob_, prm_.solver);
-  last_.solve = solver_ ? solver_(prob_, prm_.solver) : nlgs_solve3(prob_, prm_.solver);
-  prob_.vel.swap(V);
+  solve_problem(prm_.solver, [](ContactProblem3& p, const SolverParams& s) { return nlgs_solve3(p, s); });
   for (const CellDof3& d : prob_.dofs) cell_.rate[d.axis] = d.v;
   if (prm_.overlap_projection > 0.0) project_overlaps();
-
-  // Keep the impulses (world frame) for the next step's warm start.
-  const std::size_t nr = prob_.rows.size();
-  std::vector<std::size_t> idx(nr);
-  std::iota(idx.begin(), idx.end(), 0);
-  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return info_[a].key < info_[b].key; });
-  warm_.keys.resize(nr);
-  warm_.p.resize(nr);
-  for (std::size_t k = 0; k < nr; ++k) {
-    warm_.keys[k] = info_[idx[k]].key;
-    warm_.p[k] = prob_.rows[idx[k]].to_world(prob_.rows[idx[k]].r);
-  }
+  // The impulses, in the world frame, for the next step's warm start.
+  keep_warm([&](std::size_t k) { return prob_.rows[k].to_world(prob_.rows[k].r); });
 }
 
 // One dof per controlled length (as 2D's LeesEdwardsCell::set_dofs): its

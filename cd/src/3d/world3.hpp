@@ -35,6 +35,7 @@
 #include "observables.hpp"
 #include "solver.hpp"
 #include "stages.hpp"
+#include "world_shell.hpp"
 
 namespace cd {
 
@@ -119,15 +120,15 @@ struct CellState3 {
   double strain = 0.0;
 };
 
-class World3 {
+// The shell (bodies, clock, timers, the last step's problem and records,
+// solver slot, warm-start memory, colour stage) is core/world_shell.hpp's,
+// shared with the 2D World. The warm-start memory holds the impulses in the
+// world frame, on body 2: re-projected on the new frame when reused, so
+// that a turning frame does not rotate the remembered friction.
+class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
  public:
   // The cell starts from the parameters' lengths and offset, at rest.
   explicit World3(const WorldParams3& p) : prm_(p), cell_{p.cell, p.le_offset} { configure(); }
-
-  Bodies3 bodies;
-  double time = 0.0;
-  std::int64_t steps = 0;
-  StageTimes times;
 
   // The parameters are constant during the run; set_params replaces them
   // (a study's or a test's change), the cell's state kept.
@@ -146,25 +147,9 @@ class World3 {
   }
 
   void step();
-  const StepStats& last() const { return last_; }
-  // The last step's rows (solved) and their records, in colour order
-  // (extras: empty unless the scene has tangential offsets or an
-  // orthotropic cone).
-  const std::vector<SphereRow>& rows() const { return prob_.rows; }
+  // The last step's row extras, in colour order (empty unless the scene
+  // has tangential offsets or an orthotropic cone).
   const std::vector<RowExtra3>& row_extras() const { return prob_.extra; }
-  // The contact problem of the last step (solved), in colour order; its
-  // `vel` is empty outside the solve stage (the velocities are in bodies).
-  const ContactProblem3& problem() const { return prob_; }
-
-  // The solve stage's solver (default nlgs_solve3): a study may put another
-  // one in (cd/bench), the rest of the step unchanged.
-  using Solver = std::function<SolveStats(ContactProblem3&, const SolverParams&)>;
-  void set_solver(Solver s) { solver_ = std::move(s); }
-  // Called with the problem just before it is solved (its impulses the warm
-  // start, already in its velocities): --dump-problem writes it out.
-  using ProblemHook = std::function<void(const ContactProblem3&, const SolverParams&)>;
-  void set_problem_hook(ProblemHook h) { hook_ = std::move(h); }
-  const std::vector<ContactInfo3>& infos() const { return info_; }
 
   double kinetic_energy() const;    // translational + rotational, dynamic bodies
   double potential_energy() const;  // -m g.x summed over dynamic bodies
@@ -192,17 +177,6 @@ class World3 {
   // minus its mass mean (gd = shear_rate(): the mean shear flow removed);
   // zero without a tri-periodic cell.
   Eigen::Matrix3d kinetic_stress() const;
-
-  // Warm-start memory: the previous step's impulses (world frame, on body
-  // 2) by contact key (sorted). Re-projected on the new frame when reused,
-  // so that a turning frame does not rotate the remembered friction.
-  struct WarmStart {
-    std::vector<std::uint64_t> keys;
-    std::vector<Vec3> p;
-  };
-  const WarmStart& warm_start() const { return warm_; }
-  // Restores the warm-start memory (a checkpoint; checkpoint3.cpp).
-  void set_warm_start(WarmStart w) { warm_ = std::move(w); }
 
  private:
   friend struct NoBoundary3;
@@ -233,17 +207,11 @@ class World3 {
        dofs_on_ = false, friction_on_ = false;
   double alert_ = 0.0;
   double le_velocity_ = 0.0;  // V of the step (LeesEdwardsCell3)
-  StepStats last_;
   std::vector<Vec3> xm_;
   std::vector<Quat> qm_;
   ContactProblem3 proj_;  // project_overlaps' pseudo-velocity problem
-  ContactProblem3 prob_;  // rows, extras (empty unless extras_on_), colouring, dofs, law
-  std::vector<ContactInfo3> info_;
   CellGrid3 grid_;
-  WarmStart warm_;
   Vec3 cm_ = Vec3::Zero();  // the cell's lengths at the step's midpoint
-  Solver solver_;
-  ProblemHook hook_;
 };
 
 }  // namespace cd

@@ -2,12 +2,13 @@
 // (method.md section 9), the arithmetic 2D (2d/boundary.cpp) and 3D
 // (3d/world3.cpp) share: the free velocity of a length under its load, the
 // compaction brake, and the damped Gauss-Seidel update of the dof between
-// sweeps. Each dimension keeps its own row coupling (which rows cross the
+// sweeps (update: its loop, over the engine's rows). Each dimension keeps its own row coupling (which rows cross the
 // boundary, with which coefficients); the numbers those give go through
 // these functions, so the two cells answer a pressure the same way.
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 namespace cd::cell_dof {
@@ -45,6 +46,24 @@ inline double free_velocity(double v_start, double load, double M, double dt, do
 inline double damped_step(double v0, double v, double inv_mass, double s, double k, double& res) {
   res = v0 + inv_mass * s - v;
   return res / (1.0 + inv_mass * k);
+}
+
+// One update of a dof between sweeps, the engines' update_dof (called by
+// core/sweep.hpp): load(i, s, k) adds the i-th coupled row's impulse along
+// the dof to s and, if the row is active, its response a^2 / W to k;
+// push(i, dv) adds the dof's change dv, times the row's coefficients, to its
+// offsets. Dof: rows, v0, v, inv_mass, scale. Returns the residual of the
+// dof's equation relative to its imposed impulse (the sweep's stopping test).
+template <class Dof, class Load, class Push>
+double update(Dof& d, Load&& load, Push&& push) {
+  double s = 0.0, k = 0.0;
+  const std::size_t m = d.rows.size();
+  for (std::size_t i = 0; i < m; ++i) load(i, s, k);
+  double res;
+  const double dv = damped_step(d.v0, d.v, d.inv_mass, s, k, res);
+  for (std::size_t i = 0; i < m; ++i) push(i, dv);
+  d.v += dv;
+  return std::abs(res) / (d.inv_mass * d.scale);
 }
 
 // The velocity profile a controlled length's kinetic stress is taken about:
