@@ -410,8 +410,9 @@ $(manifest_checks): $(CAMPAIGNS)/%/.manifest-check:
 goal_manifests = $(foreach c,$(filter-out list prep-of status,$(patsubst campaign-%,%,$(filter campaign-%,$(MAKECMDGOALS)))),$(CAMPAIGNS)/$(c)/.manifest-check)
 
 # Compacted samples: disks (ns_0) or n-gons, N grains, isotropic at P
-# (3D: spheres, compacted at 0.05 / t_p for 50 t_p; PREP_SET adds settings).
-PREP_SET ?= $(if $(dim3),$(PREP3_FAST))
+# (3D: spheres, compacted at 0.05 / t_p until jammed at p, the scene's stop
+# rule shear.settle_*; PREP_SET adds settings).
+PREP_SET ?=
 $(CAMPAIGNS)/prep/ns_%/.done: | programs $(CAMPAIGNS)/prep/.manifest-check $(goal_manifests)
 	$(CDSIM) $(PREP_SCENE) --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_strain=0 \
 	  --set output.snapshot_interval=0 \
@@ -641,8 +642,6 @@ REGRESS_DIR ?= outputs/regress
 REGRESS_I := 0.01 0.02 0.05 0.1 0.2 0.3 0.4
 REGRESS3_DIR ?= outputs/regress3d
 REGRESS3_I := 0.02 0.05 0.1 0.2 0.3 0.5 1
-# The 3D sample is compacted at 0.05 / t_p for 50 t_p (docs/3d.md).
-PREP3_FAST := --set shear.compaction_rate=0.05 --set time.duration=0.008
 .PHONY: regress regress-campaign regress3-campaign
 regress: regress-campaign regress3-campaign
 	$(CDA) fit mu-i $(REGRESS_DIR)/inertial --window 1:3 --toml $(REGRESS_DIR)/mu_i.toml

@@ -149,6 +149,16 @@ int main(int argc, char** argv) {
                  "diameter (> {}): see the series' max_overlap_small column; a smaller time step "
                  "or tolerance reduces it\n",
                  s.max_overlap_small, kOverlapWarn);
+    if (s.settled)
+      fmt::print("cdsim: settled at step {} of the scene's {} (shear.settle_*: contact stress within {:.2g} p of p, "
+                 "packing fraction within {:.2g}, over the last shear.settle_time); checkpoint written\n",
+                 s.last_step, s.total_steps, s.settle_stress_dev, s.settle_phi_range);
+    else if (s.settle_on && s.status == "done")
+      fmt::print(stderr,
+                 "cdsim: warning: the compaction did not settle within time.duration (shear.settle_*): over "
+                 "the last window the contact stress was within {:.2g} p of p and the packing fraction within "
+                 "{:.2g}; the sample may not be jammed at p\n",
+                 s.settle_stress_dev, s.settle_phi_range);
     if (s.stopped_at_max_steps)
       fmt::print("cdsim: stopped after --max-steps {} (step {} of the scene's {})\n", max_steps,
                  s.first_step + s.steps, s.total_steps);

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -130,6 +131,14 @@ Series::Series(const std::string& path) : path_(path) {
   ::close(fd);
 }
 
+std::string series_text(double v) {
+  // Counts (step, contacts) print as integers; 2^53 bounds exact integers.
+  if (v == std::trunc(v) && std::abs(v) < 9007199254740992.0) return fmt::format("{:.0f}", v);
+  return fmt::format("{:.10g}", v);
+}
+
+double as_written(double v) { return std::strtod(series_text(v).c_str(), nullptr); }
+
 void Series::row(const std::vector<std::pair<std::string, double>>& cols) {
   if (names_.empty()) {
     if (cols.empty()) throw std::logic_error("Series::row: no columns");
@@ -147,11 +156,7 @@ void Series::row(const std::vector<std::pair<std::string, double>>& cols) {
   for (std::size_t c = 0; c < cols.size(); ++c) {
     const double v = cols[c].second;
     if (c) buf_ += ',';
-    // Counts (step, contacts) print as integers; 2^53 bounds exact integers.
-    if (v == std::trunc(v) && std::abs(v) < 9007199254740992.0)
-      buf_ += fmt::format("{:.0f}", v);
-    else
-      buf_ += fmt::format("{:.10g}", v);
+    buf_ += series_text(v);
   }
   buf_ += '\n';
 }

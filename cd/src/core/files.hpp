@@ -63,6 +63,13 @@ void write_file_atomic(const std::string& path, const std::string& text);
 // series.csv: one row per output interval, columns named by the first row.
 // Rows are written whole: a flush that fails part-way (disk full) cuts the
 // file back to its length before it and throws WriteError.
+// A value as series.csv writes it (integers whole, others to 10 significant
+// digits): what a reader of the file gets back, exactly. The stop rule of
+// core/settle.hpp decides on these, so that a resumed run, which reads the
+// rows back, decides as the run never stopped did.
+std::string series_text(double v);
+double as_written(double v);
+
 class Series {
  public:
   explicit Series(const std::string& path);

@@ -114,7 +114,7 @@ std::string summary_toml(const RunSummary& s) {
   std::string o =
       "# The cost of this run, over every session (cdsim call) that ran it: docs/outputs.md\n";
   o += line(fmt::format("cdlab_version = \"{}\"", version()), "git describe of the build; \"unknown\" outside a clone");
-  o += line(fmt::format("status = \"{}\"", s.status), "done, stopped (signal), max-steps, diverged");
+  o += line(fmt::format("status = \"{}\"", s.status), "done, settled (shear.settle_*), stopped (signal), max-steps, diverged");
   o += line(fmt::format("steps = {}", s.last_step), "the last step taken (series.csv's last row)");
   o += line(fmt::format("total_steps = {}", s.total_steps), "the scene's steps");
   o += line(fmt::format("sessions = {}", std::llround(t.sessions)), "cdsim calls that took steps (1 + resumes)");
@@ -189,6 +189,11 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     }
   }
   const std::int64_t k0 = resume ? w.steps() : 0;
+  // The compaction's stop rule; a resumed run reads its rows back, and one
+  // that had settled at its checkpoint takes no more steps.
+  SettleRule settle = plan.settle;
+  if (resume) settle.resume(series_path);
+  const std::int64_t k_last = resume && settle.settled() ? k0 : nsteps;
   w.start();
 
   // An interval as long as the run writes no checkpoint before the end.
@@ -225,7 +230,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   sum.load_start = load_average();
   auto last_print = start, last_ckpt = start, last_line = start;
   long iter_total = 0;
-  if (k0 < nsteps) tot.sessions += 1;
+  if (k0 < k_last) tot.sessions += 1;
   // The totals as they stand now: the wall and CPU time of this session added.
   const auto totals_now = [&] {
     RunTotals t = tot;
@@ -260,9 +265,10 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   };
   if (every_snap && !resume) timed_output([&] { w.write_snapshot(); });
 
-  std::int64_t k_end = nsteps;  // the last step taken (earlier if stopped by a signal)
+  std::int64_t k_end = k_last;  // the last step taken (earlier if stopped by a signal or settled)
   bool stop_seen = false;       // a signal's stop was announced
-  for (std::int64_t k = k0 + 1; k <= nsteps; ++k) {
+  bool settled = k_last < nsteps;
+  for (std::int64_t k = k0 + 1; k <= k_last; ++k) {
     try {
       w.step();
     } catch (const std::runtime_error& e) {
@@ -345,6 +351,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
                                           "series.csv holds the rows before it", k, w.time(), name, x));
         series.row(cols);
         series.flush();
+        settle.add(cols);
         if (timings) {
           timings->row(tcols);
           timings->flush();
@@ -352,6 +359,10 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       });
       iv = Interval{};
       iv.t0 = w.times();
+      if (settle.settled() && k < nsteps) {
+        settled = true;
+        k_end = k;
+      }
     }
     if (every_snap && k % every_snap == 0) timed_output([&] { w.write_snapshot(); });
     // After this step's outputs, so that a restart has them all. A resumed
@@ -359,7 +370,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     const bool wall_due = ckpt_wall > 0 && k % every_row == 0 &&
                           std::chrono::duration<double>(Clock::now() - last_ckpt).count() >= ckpt_wall;
     if ((every_ckpt && k % every_ckpt == 0) || (every_ckpt_strain && k % every_ckpt_strain == 0) ||
-        wall_due || ((k == nsteps || stopping) && (checkpoints || resume))) {
+        wall_due || ((k == nsteps || stopping || settled) && (checkpoints || resume))) {
       timed_output([&] { w.save(ckpt, key, totals_now()); });
       last_ckpt = Clock::now();
     }
@@ -368,6 +379,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       sum.stopped_at_max_steps = at_limit && !g_stop;
       break;
     }
+    if (settled) break;
 
     if (opt.progress_every > 0 && k < nsteps) {
       const auto now = Clock::now();
@@ -400,7 +412,15 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   sum.mean_iterations = sum.steps ? double(iter_total) / sum.steps : 0.0;
   sum.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
   sum.kinetic_energy = w.kinetic_energy();
-  write_summary(sum.stop_signal ? "stopped" : sum.stopped_at_max_steps ? "max-steps" : "done", k_end);
+  sum.settled = settled;
+  sum.settle_on = settle.on();
+  sum.settle_stress_dev = settle.stress_dev();
+  sum.settle_phi_range = settle.phi_range();
+  write_summary(sum.stop_signal              ? "stopped"
+                : sum.stopped_at_max_steps ? "max-steps"
+                : settled                  ? "settled"
+                                           : "done",
+                k_end);
   return sum;
 }
 

@@ -53,6 +53,10 @@ void install_stop_handlers();
 struct RunSummary {
   int stop_signal = 0;          // > 0: stopped early by this signal
   bool stopped_at_max_steps = false;
+  // The stop rule (shear.settle_*, core/settle.hpp): on, met (the run ended
+  // at the row that met it), and what the last window measured.
+  bool settle_on = false, settled = false;
+  double settle_stress_dev = 0, settle_phi_range = 0;
   std::int64_t total_steps = 0;  // the scene's steps
   std::int64_t first_step = 0;  // > 0: resumed from a checkpoint at this step
   std::int64_t steps = 0;       // steps run by this call
@@ -66,7 +70,7 @@ struct RunSummary {
   double kinetic_energy = 0;
 
   // The whole run, every session (what summary.toml holds).
-  std::string status;           // "done", "stopped" (signal), "max-steps", "diverged"
+  std::string status;           // "done", "settled", "stopped" (signal), "max-steps", "diverged"
   std::int64_t last_step = 0;   // the last step taken
   RunTotals totals;             // summed over sessions (checkpoint_io.hpp)
   int threads = 0;              // OpenMP threads of this session

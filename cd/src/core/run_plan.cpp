@@ -40,6 +40,7 @@ RunPlan plan_of(const Scene& s, double dt) {
   p.checkpoint_interval = s.checkpoint_interval;
   p.checkpoint_strain = s.checkpoint_strain;
   p.key = scene_key(s);
+  p.settle = SettleRule(s);
   return p;
 }
 

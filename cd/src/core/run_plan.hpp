@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "scene.hpp"
+#include "settle.hpp"
 
 namespace cd {
 
@@ -19,6 +20,7 @@ struct RunPlan {
   double ckpt_wall = 0;                // s of wall clock; 0: none
   double checkpoint_interval = 0, checkpoint_strain = 0;  // as given (for messages)
   std::uint64_t key = 0;               // scene key a checkpoint must match
+  SettleRule settle;                   // the compaction's stop rule (off unless shear.settle_*)
   bool checkpoints() const { return every_ckpt || every_ckpt_strain || ckpt_wall > 0; }
 };
 

@@ -175,6 +175,9 @@ const std::vector<Param<Scene>>& scene_params() {
       {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width; 3D: and depth) degree of freedom, in units of the particles' total mass; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"shear", "isotropic", &Scene::isotropic, "", any(), "compaction: the width (3D: and the depth) is a degree of freedom too, at sigma_xx (= sigma_zz) = pressure (periodic, inertial_number = 0)"},
       {"shear", "compaction_rate", &Scene::compaction_rate, "1/t_p", in(0, 1), "periodic cell at imposed pressure: its height (and, isotropic, width) shrinks at most at this strain rate, -(dL/dt)/L <= compaction_rate / t_p, and by at most a quarter of the alert distance a step (a brake on the pressure-driven collapse; the inertial number of the compaction); 0: no bound"},
+      {"shear", "settle_stress", &Scene::settle_stress, "p", in(0, 1), "stop rule of a compaction (periodic, shear.pressure > 0, shear.inertial_number 0): the run ends, with its checkpoint, at the first series row where over the last shear.settle_time every row's mean contact stress sigma_aa, on each axis at imposed stress, was within this fraction of p, and the packing fraction moved by at most shear.settle_phi; time.duration is then a limit (summary.toml status \"settled\" or, if never met, \"done\" with a warning); 0: off"},
+      {"shear", "settle_phi", &Scene::settle_phi, "", in(0, 1), "the stop rule's bound on the packing fraction's range (largest minus smallest) over the window, the rows of the last shear.settle_time and the row before them (needs shear.settle_stress)"},
+      {"shear", "settle_time", &Scene::settle_time, "t_p", ge(0), "the stop rule's window, in t_p = d sqrt(rho/p): at least this much time between the row before the window and the row that ends it (needs shear.settle_stress)"},
       {"shear", "strain", &Scene::strain, "", ge(0), "run until this shear strain (overrides time.duration); 0: use time.duration"},
       {"shear", "dt_tp", &Scene::dt_tp, "t_p", ge(0), "time step in units of t_p = d sqrt(rho/p) (overrides time.dt); 0: use time.dt; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"shear", "start", &Scene::start, "", any(), "checkpoint.bin to start from (same particles): of a preparation run (the cell it reached, from rest) or of a shear run (continued: its Lees-Edwards offset and cell rates kept, its mean flow replaced by this run's rate; strain counted from 0); \"\": generate particles"},
@@ -585,6 +588,17 @@ Scene read_scene(const toml::value& root, const std::string& path) {
     out.add(child(root, "box"), "box",
             fmt::format("box.width = {}, box.height = {}: must be both 0 (no box) or both > 0",
                         text(s.box_width, false), text(s.box_height, false)));
+  // The stop rule: its three keys together (the protocol it needs:
+  // check_derived, derived.cpp).
+  if (s.settle_stress > 0 || s.settle_phi > 0 || s.settle_time > 0) {
+    const auto at = [&](const char* k) { return child(child(root, "shear"), k); };
+    const char* key = s.settle_stress > 0 ? "settle_stress" : s.settle_phi > 0 ? "settle_phi" : "settle_time";
+    if (!(s.settle_stress > 0 && s.settle_phi > 0 && s.settle_time > 0))
+      out.add(at(key), key,
+              fmt::format("shear.settle_stress = {}, settle_phi = {}, settle_time = {}: the stop rule needs all "
+                          "three > 0 (or all 0: off)", text(s.settle_stress, false), text(s.settle_phi, false),
+                          text(s.settle_time, false)));
+  }
   for (std::size_t i = 0; i < s.walls.size(); ++i)
     if (s.walls[i].a == s.walls[i].b)
       out.add(child(root, "wall").as_array().at(i), "wall",

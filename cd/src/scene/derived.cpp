@@ -158,6 +158,13 @@ void check_derived(const Scene& s) {
                        "(particles.d_mean, particles.density, shear.pressure, shear.inertial_number)",
                        tp, gd));
   }
+  // The stop rule settles a compaction (core/settle.hpp): a periodic cell
+  // at imposed pressure, not sheared.
+  if (s.settle_stress > 0 && (s.shear_mode != ShearMode::Periodic || s.pressure <= 0 || s.inertial_number != 0))
+    fail(fmt::format("shear.settle_stress = {}: the stop rule settles a compaction: it needs shear.mode = "
+                     "\"periodic\", shear.pressure > 0 and shear.inertial_number = 0 (here shear.pressure = {}, "
+                     "shear.inertial_number = {}{})", s.settle_stress, s.pressure, s.inertial_number,
+                     s.shear_mode == ShearMode::Periodic ? "" : ", another shear.mode"));
   if (s.adhesion > 0 || s.cohesion_number > 0) {
     const double fa = pull_off_force(s);
     if (!std::isfinite(fa))

@@ -130,6 +130,13 @@ struct Scene {
   double cell_mass = 0.1;           // mass of the height (width) dof, in total particle mass
   bool isotropic = false;           // compaction: the width is a dof too (periodic, I = 0)
   double compaction_rate = 0.0;     // > 0: cell lengths shrink at most at this rate x 1/t_p
+  // The stop rule of a compaction (core/settle.hpp): the run ends at the first
+  // series row where, over the last settle_time t_p, every controlled axis's
+  // contact stress was within settle_stress p of p and the packing fraction
+  // moved by at most settle_phi. settle_stress 0: off (run time.duration).
+  double settle_stress = 0.0;
+  double settle_phi = 0.0;
+  double settle_time = 0.0;         // t_p
   double strain = 0.0;              // > 0: run until this shear strain (overrides duration)
   double dt_tp = 0.0;               // > 0: dt = dt_tp x t_p, t_p = d sqrt(rho/p)
   std::string start;                // checkpoint.bin of a preparation run to start from
