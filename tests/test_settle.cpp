@@ -192,6 +192,7 @@ TEST(Settle3, PreparationSettlesJammedAtThePressure) {
   const auto r = prep3(dir, 150);
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("settled at step"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("checkpoint written"), std::string::npos) << r.out;
   EXPECT_EQ(summary_value(dir, "status"), "\"settled\"");
   const long steps = std::stol(summary_value(dir, "steps")), total = std::stol(summary_value(dir, "total_steps"));
   EXPECT_LT(steps, total / 2) << "the rule stopped late, or the run ended at time.duration";

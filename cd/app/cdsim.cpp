@@ -149,10 +149,14 @@ int main(int argc, char** argv) {
                  "diameter (> {}): see the series' max_overlap_small column; a smaller time step "
                  "or tolerance reduces it\n",
                  s.max_overlap_small, kOverlapWarn);
+    const bool checkpoints = scene.checkpoint_interval > 0 || scene.checkpoint_strain > 0 ||
+                             scene.checkpoint_wall > 0 || s.first_step > 0;
     if (s.settled)
       fmt::print("cdsim: settled at step {} of the scene's {} (shear.settle_*: contact stress within {:.2g} p of p, "
-                 "packing fraction within {:.2g}, over the last shear.settle_time); checkpoint written\n",
-                 s.last_step, s.total_steps, s.settle_stress_dev, s.settle_phi_range);
+                 "packing fraction within {:.2g}, over the last shear.settle_time){}\n",
+                 s.last_step, s.total_steps, s.settle_stress_dev, s.settle_phi_range,
+                 checkpoints ? "; checkpoint written: the sample"
+                             : " (no checkpoint: output.checkpoint_interval, _strain and _wall are 0)");
     else if (s.settle_on && s.status == "done")
       fmt::print(stderr,
                  "cdsim: warning: the compaction did not settle within time.duration (shear.settle_*): over "
@@ -165,8 +169,7 @@ int main(int argc, char** argv) {
     if (s.stop_signal) {
       fmt::print("cdsim: stopped by signal {} after step {}{}\n", s.stop_signal,
                  s.first_step + s.steps,
-                 scene.checkpoint_interval > 0 || scene.checkpoint_strain > 0 ||
-                         scene.checkpoint_wall > 0 || s.first_step > 0
+                 checkpoints
                      ? "; checkpoint written: the same command resumes"
                      : " (no checkpoint: output.checkpoint_interval, _strain and _wall are 0)");
       return 128 + s.stop_signal;
