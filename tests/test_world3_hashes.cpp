@@ -10,7 +10,12 @@
 // and the comment beside the value says which fix. Changed so far: the
 // "orthotropic mu = 0" scene (0x05e69d0165f636ff before), when the build
 // stage stopped zeroing the tangential warm start of an orthotropic cone
-// with mu = 0 and mu_b > 0 (one friction decision, World3::configure).
+// with mu = 0 and mu_b > 0 (one friction decision, World3::configure); all
+// six for a change of round-off only, when the sweep went over
+// contact3.hpp's SweepRow3 (issue 30; before: 0x28a4504330a780d8,
+// 0x565a602263430743, 0xb149e53c4568edb4, 0xb01270695a1cd9b4,
+// 0xe5c9f72700140155, 0x91302f7e2690f82c), checked by frozen steps of
+// every law solved both ways (impulses within 1.2e-14 of the largest).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -102,8 +107,8 @@ TEST(World3Hashes, OptionalPhysicsBitIdentical) {
       }),
   };
   const Case expect[] = {
-      {"restitution pile", 0x28a4504330a780d8ull},  {"orthotropic pile", 0x565a602263430743ull}, {"orthotropic mu = 0", 0xb149e53c4568edb4ull},
-      {"compaction", 0xb01270695a1cd9b4ull},        {"shear", 0xe5c9f72700140155ull},            {"cohesive shear", 0x91302f7e2690f82cull},
+      {"restitution pile", 0x27157c3cb93605a5ull},  {"orthotropic pile", 0xc86587e9cb6d2b7aull}, {"orthotropic mu = 0", 0xcf3f3f85076a9a14ull},
+      {"compaction", 0xf891bdaaa6473a1dull},        {"shear", 0x40f59cb3edb6a004ull},            {"cohesive shear", 0x95fc1568ef1f1d04ull},
   };
   for (std::size_t k = 0; k < std::size(got); ++k) {
     std::printf("[ state hash ] %-20s 0x%016llxull\n", expect[k].name, static_cast<unsigned long long>(got[k]));

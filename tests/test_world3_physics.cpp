@@ -35,9 +35,15 @@ constexpr double kG = 9.81;
 // Scenes without the options compute what they computed before the options
 // existed, bit for bit: hashes recorded on commit cb1c628 (a standalone
 // build of its cd/src/3d with the same -O2 flags; tests/world3_hash.hpp).
+// Re-recorded once since, for a change of round-off only: the sweep's rows
+// as contact3.hpp's SweepRow3 (issue 30; before: 0xd9c05964c76f154e,
+// 0xab0eb47c9521ec65, 0x81f8628b9153b7c9, 0x7069d1e47d13c479), checked by
+// frozen steps of every law solved both ways (impulses within 1.2e-14 of
+// the largest after 3000 sweeps) and pile runs agreeing to 9 digits over
+// 150 steps.
 TEST(World3Options, OffLeavesTheDefaultPathBitIdentical) {
-  const std::uint64_t expect[4] = {0xd9c05964c76f154eull, 0xab0eb47c9521ec65ull, 0x81f8628b9153b7c9ull,
-                                   0x7069d1e47d13c479ull};
+  const std::uint64_t expect[4] = {0x3ef6f60f46f8baf7ull, 0xd265802c13d6ad6bull, 0xb5225d8fd73317f4ull,
+                                   0x5f0fca0280d94942ull};
   for (int k = 0; k < 4; ++k) EXPECT_EQ(cdtest::world3_scene_hash(k), expect[k]) << "scene " << k;
 }
 

@@ -60,6 +60,34 @@ struct RowExtra3 {
   double mu_b = 0.0;            // friction along t2 (= mu for a round cone)
 };
 
+// The row as the NLGS sweep streams it (coupling3.hpp; made from a
+// SphereRow and its bodies once per solve by contact_problem3.cpp's
+// nlgs_solve3, the impulse and b_n given back after). For spheres the lever
+// arms are along n, c_i = l_i n with l_i = c_i.n (l1 > 0, l2 < 0 between
+// spheres), so with dv = v2 - v1 and om = l2 w2 - l1 w1 the relative
+// velocity in the frame is
+//     u = (n.dv, t1.dv + t2.om, t2.dv - t1.om)      (n x t1 = t2)
+// (w x c = l w x n, and t1.(w x n) = w.t2, t2.(w x n) = -w.t1), and an
+// impulse change dr (frame components) on body 2, -dr on body 1, changes
+// body 2 by (inv_m2 P, inv_I2 l2 T) and body 1 by -(inv_m1 P, inv_I1 l1 T),
+//     P = dr_n n + dr_t1 t1 + dr_t2 t2,   T = n x P = dr_t1 t2 - dr_t2 t1:
+// 5 dot products and 2 vector updates in place of 2 cross products, 3 dot
+// products and 2 cross products again (the same quantities to round-off).
+// The block enters through its reciprocals (the stick trial is r - W^-1 u).
+// A plane's lever arm is not along n, but a plane neither turns nor is
+// turned (w = 0, inv_I = 0): its l is never used (make_sweep_row3 checks).
+// 160 bytes against SphereRow's 192; the frame stays stored (rebuilding it
+// from n costs a division, and orthotropic scenes turn it).
+struct SweepRow3 {
+  Vec3 n, t1, t2;
+  double l1, l2;      // c1.n, c2.n
+  double iwnn, iwtt;  // 1 / W_nn, 1 / W_tt
+  double bn, mu;
+  std::int32_t b1, b2;
+  Vec3 r;
+  double adh;
+};
+
 // Cold record, same index as the row.
 struct ContactInfo3 {
   std::uint64_t key;  // (b1, b2): one contact a pair of spheres or sphere and plane

@@ -1,5 +1,6 @@
 #include "contact_problem3.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <stdexcept>
@@ -13,16 +14,16 @@
 
 namespace cd {
 
-double update_dof(CellDof3& d, SphereRow* rows) {
+double update_dof(CellDof3& d, SweepRow3* rows) {
   // core/cell_dof.hpp's damped update, with the 3D rows' impulses and
   // responses (W = diag(W_nn, W_tt, W_tt)).
   return cell_dof::update(
       d,
       [&](std::size_t i, double& s, double& k) {
-        const SphereRow& r = rows[d.rows[i]];
+        const SweepRow3& r = rows[d.rows[i]];
         const Vec3& a = d.a[i];
         s += a.dot(r.r);
-        if (r.r[0] + r.adh > 0.0) k += a[0] * a[0] / r.wnn + (a[1] * a[1] + a[2] * a[2]) / r.wtt;
+        if (r.r[0] + r.adh > 0.0) k += a[0] * a[0] * r.iwnn + (a[1] * a[1] + a[2] * a[2]) * r.iwtt;
       },
       [&](std::size_t i, double dv) {
         const std::int32_t j = d.rows[i];
@@ -35,16 +36,35 @@ double update_dof(CellDof3& d, SphereRow* rows) {
 }
 
 SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer) {
+  // The rows as the sweep streams them, made once per solve (a few percent
+  // of one sweep), given back after: the impulses and b_n (the dofs move it).
+  const int n = static_cast<int>(p.rows.size());
+  std::vector<SweepRow3> rows(n);
+  int bad = n;
+#pragma omp parallel for schedule(static) reduction(min : bad) if (n >= prm.min_parallel)
+  for (int k = 0; k < n; ++k)
+    if (!make_sweep_row3(p.rows[k], p.vel.data(), rows[k])) bad = std::min(bad, k);
+  if (bad < n)
+    throw std::invalid_argument(fmt::format(
+        "3D contact problem, row {}: not a sphere's row (a lever arm off the normal of a body that turns, or a "
+        "frame (n, t1, t2) that is not orthonormal and right-handed)",
+        bad));
   RowExtra3* extra = p.extra.empty() ? nullptr : p.extra.data();
   for (CellDof3& d : p.dofs) d.extra = extra;
   std::vector<CellDof3>* dofs = p.dofs.empty() ? nullptr : &p.dofs;
-  return std::visit(
+  const SolveStats st = std::visit(
       [&](auto law) {
         using L = decltype(law);
-        sweep::BodyCoupling3 c{p.vel.data(), extra, p.rows.data()};
-        return sweep::solve<L>(p.rows, p.colouring, c, prm, dofs, observer);
+        sweep::BodyCoupling3 c{p.vel.data(), extra, rows.data()};
+        return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
       },
       p.law);
+#pragma omp parallel for schedule(static) if (n >= prm.min_parallel)
+  for (int k = 0; k < n; ++k) {
+    p.rows[k].r = rows[k].r;
+    p.rows[k].bn = rows[k].bn;
+  }
+  return st;
 }
 
 void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& vel) {

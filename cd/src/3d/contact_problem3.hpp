@@ -44,7 +44,7 @@ struct CellDof3 {
   std::vector<Vec3> a;  // coefficients in the row's frame (n, t1, t2)
   RowExtra3* extra = nullptr;  // the problem's extras (set by nlgs_solve3), or null
 };
-double update_dof(CellDof3& d, SphereRow* rows);
+double update_dof(CellDof3& d, SweepRow3* rows);
 
 struct ContactProblem3 {
   std::vector<SphereRow> rows;
@@ -57,7 +57,9 @@ struct ContactProblem3 {
 
 // Solves the problem in place (impulses, velocities, dofs) from the impulses
 // held in the rows, which must already be in the velocities. The law is
-// resolved here, once, into a template instance of core/sweep.hpp.
+// resolved here, once, into a template instance of core/sweep.hpp, which
+// sweeps the rows as contact3.hpp's SweepRow3. Throws std::invalid_argument
+// naming the row when a row is not a sphere's (see SweepRow3).
 SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer = {});
 
 // Adds the impulses held in the rows to the body velocities (warm start);

@@ -22,10 +22,10 @@ namespace cd {
 // constant terms b_t into the tangential velocity the law sees; without them
 // b_t is never read, so such scenes compute exactly what they did before),
 // round or orthotropic cone (Orthotropic: |(s_t1/mu, s_t2/mu_b)| <= s_n,
-// solve_sphere3_ortho). Offsets and mu_b live in the row's RowExtra3 (e,
+// project_sphere3_ortho). Offsets and mu_b live in the row's RowExtra3 (e,
 // null for the instances that read neither). The local solve is law3's
-// exact solver for the sphere block diag(W_nn, W_tt, W_tt); u = W r + q with
-// q the velocity the others leave.
+// exact solver for the sphere block diag(W_nn, W_tt, W_tt), from the stick
+// trial g = r - W^-1 u (u the velocity at the row's current impulse r).
 template <bool Friction, bool Cohesion, bool Offsets = false, bool Orthotropic = false>
 struct SphereLaw3 {
   static constexpr bool tangential = Friction;
@@ -33,14 +33,14 @@ struct SphereLaw3 {
   static constexpr bool orthotropic = Orthotropic && Friction;
   static constexpr bool extra = offsets || orthotropic;  // reads RowExtra3
   static constexpr bool cohesive = Cohesion;
-  static void solve(const SphereRow& r, [[maybe_unused]] const RowExtra3* e, const Vec3& q, Vec3& out) {
+  static void solve(const SweepRow3& r, [[maybe_unused]] const RowExtra3* e, const Vec3& g, Vec3& out) {
     const double a = Cohesion ? r.adh : 0.0;
     if constexpr (orthotropic) {
-      solve_sphere3_ortho(r.wnn, r.wtt, q, r.mu, e->mu_b, a, out);
+      project_sphere3_ortho(g, r.mu, e->mu_b, a, out);
     } else if constexpr (Friction) {
-      solve_sphere3(r.wnn, r.wtt, q, r.mu, a, out);
+      project_sphere3(g, r.mu, a, out);
     } else {
-      out = Vec3(std::max(-a, -q[0] / r.wnn), 0.0, 0.0);
+      out = Vec3(std::max(-a, g[0]), 0.0, 0.0);
     }
   }
 };
@@ -89,10 +89,59 @@ inline std::string law_name3(const LocalLaw3& l) {
       l);
 }
 
-inline double impulse_norm(const SphereRow& r) { return r.r.norm(); }
+// A lever arm the sweep may take as l n (contact3.hpp's SweepRow3): along n
+// to round-off, or of a body that neither turns nor is turned (a plane).
+// Round-off in c = p - x_j grows with |x_j| / |c|; 1e-6 leaves room for
+// positions 1e9 radii from the origin and still refuses a lever arm that is
+// not a sphere's.
+inline bool lever_along_n(const Vec3& c, double l, const Vec3& n, const BodyVel3& b) {
+  if (b.inv_I == 0.0 && b.w == Vec3::Zero()) return true;
+  return (c - l * n).norm() <= 1e-6 * c.norm();
+}
+
+// The sweep's row (contact3.hpp's SweepRow3) of a problem row, or false when
+// the row is not a sphere's: a lever arm off the normal, a frame that is not
+// orthonormal and right-handed.
+inline bool make_sweep_row3(const SphereRow& r, const BodyVel3* vel, SweepRow3& s) {
+  s.n = r.n;
+  s.t1 = r.t1;
+  s.t2 = r.t2;
+  s.l1 = r.c1.dot(r.n);
+  s.l2 = r.c2.dot(r.n);
+  s.iwnn = 1.0 / r.wnn;
+  s.iwtt = 1.0 / r.wtt;
+  s.bn = r.bn;
+  s.mu = r.mu;
+  s.b1 = r.b1;
+  s.b2 = r.b2;
+  s.r = r.r;
+  s.adh = r.adh;
+  const bool frame = std::abs(r.n.squaredNorm() - 1.0) <= 1e-6 && std::abs(r.t1.squaredNorm() - 1.0) <= 1e-6 &&
+                     std::abs(r.n.dot(r.t1)) <= 1e-6 && (r.n.cross(r.t1) - r.t2).norm() <= 1e-6;
+  return frame && lever_along_n(r.c1, s.l1, r.n, vel[r.b1]) && lever_along_n(r.c2, s.l2, r.n, vel[r.b2]);
+}
+
+inline double impulse_norm(const SweepRow3& r) { return r.r.norm(); }
 
 // The velocity change of a row's bodies under an impulse dr (frame
-// components) on body 2 and -dr on body 1 (the warm start, Anderson's mix).
+// components) on body 2 and -dr on body 1 (contact3.hpp's SweepRow3: P and
+// T = n x P); body 1 only when Write1 (false: driven, never written).
+template <bool Write1 = true>
+inline void push_impulse(const SweepRow3& r, const Vec3& dr, BodyVel3* vel) {
+  const Vec3 P = dr[0] * r.n + dr[1] * r.t1 + dr[2] * r.t2;
+  const Vec3 T = dr[1] * r.t2 - dr[2] * r.t1;
+  BodyVel3& B = vel[r.b2];
+  B.v += B.inv_m * P;
+  B.w += (B.inv_I * r.l2) * T;
+  if constexpr (Write1) {
+    BodyVel3& A = vel[r.b1];
+    A.v -= A.inv_m * P;
+    A.w -= (A.inv_I * r.l1) * T;
+  }
+}
+
+// The velocity change of a row's bodies under an impulse dr (frame
+// components) on body 2 and -dr on body 1, any lever arms (the warm start).
 inline void push_impulse(const SphereRow& r, const Vec3& dr, BodyVel3* vel) {
   const Vec3 P = r.to_world(dr);
   BodyVel3& A = vel[r.b1];
@@ -111,19 +160,28 @@ struct BodyCoupling3 {
   // The rows' RowExtra3, same index as the rows from `base` (null in scenes
   // without them).
   const RowExtra3* extra = nullptr;
-  const SphereRow* base = nullptr;
+  const SweepRow3* base = nullptr;
 
-  const RowExtra3* extra_of(const SphereRow& r) const { return extra ? extra + (&r - base) : nullptr; }
+  const RowExtra3* extra_of(const SweepRow3& r) const { return extra ? extra + (&r - base) : nullptr; }
 
-  // The row's relative velocity in its frame, with the law's offsets.
-  Vec3 velocity(const SphereRow& r) const {
-    const Vec3 du = relative_velocity(r, vel[r.b1], vel[r.b2]);
-    Vec3 u(r.n.dot(du) + r.bn, r.t1.dot(du), r.t2.dot(du));
-    if (const RowExtra3* e = extra_of(r)) {
+  // The row's relative velocity in its frame (contact3.hpp's SweepRow3),
+  // with the law's offsets when L reads them.
+  template <bool Offsets>
+  [[gnu::always_inline]] Vec3 velocity(const SweepRow3& r, const RowExtra3* e) const {
+    const BodyVel3& A = vel[r.b1];
+    const BodyVel3& B = vel[r.b2];
+    const Vec3 dv = B.v - A.v;
+    const Vec3 om = r.l2 * B.w - r.l1 * A.w;
+    Vec3 u(r.n.dot(dv) + r.bn, r.t1.dot(dv) + r.t2.dot(om), r.t2.dot(dv) - r.t1.dot(om));
+    if constexpr (Offsets) {
       u[1] += e->bt1;
       u[2] += e->bt2;
     }
     return u;
+  }
+  Vec3 velocity(const SweepRow3& r) const {
+    const RowExtra3* e = extra_of(r);
+    return e ? velocity<true>(r, e) : velocity<false>(r, nullptr);
   }
 
   // For the sweep's Anderson acceleration (core/sweep.hpp): a row's impulse
@@ -131,50 +189,51 @@ struct BodyCoupling3 {
   // thread; a driven body has zero inverse mass and inertia, so it is not
   // moved).
   static constexpr int kImpulseDim = 3;
-  void read_impulse(const SphereRow& r, double* x) const {
+  void read_impulse(const SweepRow3& r, double* x) const {
     x[0] = r.r[0];
     x[1] = r.r[1];
     x[2] = r.r[2];
   }
-  void add_impulse(SphereRow& r, const double* dx) const {
+  void add_impulse(SweepRow3& r, const double* dx) const {
     const Vec3 d(dx[0], dx[1], dx[2]);
     r.r += d;
     push_impulse(r, d, vel);
   }
 
-  // One row update. Write1 = false when body 1 is driven (a wall): read,
-  // never written, so rows of one colour may share it without a data race.
+  // One row update: the stick trial g = r - W^-1 u from the velocity at
+  // the current impulse, the law's projection, the change into the bodies.
+  // Write1 = false when body 1 is driven (a wall): read, never written, so
+  // rows of one colour may share it without a data race. Inlined whole
+  // (flatten): at -O2 the small Eigen operations would otherwise stay calls.
   template <class L, bool Write1>
-  [[gnu::flatten]] void update(SphereRow& r, double& dp2, double& pabs) const {
-    BodyVel3& A = vel[r.b1];
-    BodyVel3& B = vel[r.b2];
+  [[gnu::flatten]] void update(SweepRow3& r, double& dp2, double& pabs) const {
     const RowExtra3* e = nullptr;
     if constexpr (L::extra) e = extra + (&r - base);
-    const Vec3 du = relative_velocity(r, A, B);
-    Vec3 q;
-    q[0] = r.n.dot(du) + r.bn - r.wnn * r.r[0];
+    const Vec3 u = velocity<L::offsets>(r, e);
+    Vec3 g;
+    g[0] = r.r[0] - u[0] * r.iwnn;
     if constexpr (L::tangential) {
-      q[1] = r.t1.dot(du) - r.wtt * r.r[1];
-      q[2] = r.t2.dot(du) - r.wtt * r.r[2];
-      if constexpr (L::offsets) {
-        q[1] += e->bt1;
-        q[2] += e->bt2;
-      }
+      g[1] = r.r[1] - u[1] * r.iwtt;
+      g[2] = r.r[2] - u[2] * r.iwtt;
     } else {
-      q[1] = q[2] = 0.0;
+      g[1] = g[2] = 0.0;
     }
     Vec3 rn;
-    L::solve(r, e, q, rn);
+    L::solve(r, e, g, rn);
     const Vec3 dr = rn - r.r;
     r.r = rn;
     dp2 = dr.squaredNorm();
     pabs = rn.norm();
-    const Vec3 P = r.to_world(dr);
-    B.v += B.inv_m * P;
-    B.w += B.inv_I * r.c2.cross(P);
-    if constexpr (Write1) {
-      A.v -= A.inv_m * P;
-      A.w -= A.inv_I * r.c1.cross(P);
+    if constexpr (L::tangential) {
+      push_impulse<Write1>(r, dr, vel);
+    } else {  // a normal impulse through the centres turns nothing
+      const Vec3 P = dr[0] * r.n;
+      BodyVel3& B = vel[r.b2];
+      B.v += B.inv_m * P;
+      if constexpr (Write1) {
+        BodyVel3& A = vel[r.b1];
+        A.v -= A.inv_m * P;
+      }
     }
   }
 };
@@ -183,9 +242,9 @@ struct BodyCoupling3 {
 
 // The law residual of a row (law3.hpp, rho = 1/W_nn) at the velocity its
 // coupling gives, with its RowExtra3 when the scene has them.
-inline double row_residual(const sweep::BodyCoupling3& c, const SphereRow& r) {
+inline double row_residual(const sweep::BodyCoupling3& c, const SweepRow3& r) {
   const RowExtra3* e = c.extra_of(r);
-  return law_residual3(c.velocity(r), r.r, Cone3{r.mu, e ? e->mu_b : r.mu}, r.adh, 1.0 / r.wnn);
+  return law_residual3(c.velocity(r), r.r, Cone3{r.mu, e ? e->mu_b : r.mu}, r.adh, r.iwnn);
 }
 
 }  // namespace cd

@@ -233,30 +233,39 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
 // The exact local solve for a block W = diag(W_nn, W_tt, W_tt) and a round
 // cone (spheres: the lever arms are along n, so rotation adds to W_tt only
 // and there is no normal-tangential coupling). solve_local3's enumeration
-// then has a closed form: the normal impulse decouples, s_n = max(0,
-// s_n-trial), and the sliding impulse is the stick trial -q_t / W_tt
-// projected radially onto the disk of radius mu s_n (u_t = W_tt r_t + q_t is
-// then parallel to -r_t, as maximal dissipation wants). Adhesion a shifts the
-// normal impulse as in solve_local3. tests/test_world3.cpp checks it against
-// solve_local3 on such blocks.
-inline Branch3 solve_sphere3(double wnn, double wtt, const Vec3& q, double mu, double a, Vec3& r) {
-  const double sn = std::max(0.0, a - q[0] / wnn);  // shifted normal impulse
+// then has a closed form in the stick trial g = -W^-1 q (the impulse that
+// zeroes u = W r + q): the normal impulse decouples, s_n = max(0, a + g_n),
+// and the sliding impulse is g_t projected radially onto the disk of radius
+// mu s_n (u_t = W_tt (r_t - g_t) is then parallel to -r_t, as maximal
+// dissipation wants). Adhesion a shifts the normal impulse as in
+// solve_local3. The sweep (coupling3.hpp) forms g from the current impulse,
+// g = r - W^-1 u, and calls project_sphere3; tests/test_world3.cpp checks
+// solve_sphere3 against solve_local3 on such blocks.
+//
+// |g_t| is sqrt(g_t1^2 + g_t2^2), not std::hypot (a libm call, 18 % of a
+// 3D row update): impulses are far from the 1e+-154 where the squares
+// leave the double range (the scene magnitude rule).
+inline Branch3 project_sphere3(const Vec3& g, double mu, double a, Vec3& r) {
+  const double sn = std::max(0.0, a + g[0]);  // shifted normal impulse
   r[0] = sn - a;
   if (sn == 0.0) {
     r[1] = r[2] = 0.0;
     return Branch3::Open;
   }
-  const double gt1 = -q[1] / wtt, gt2 = -q[2] / wtt;
-  const double gt = std::hypot(gt1, gt2), lim = mu * sn;
+  const double gt = std::sqrt(g[1] * g[1] + g[2] * g[2]), lim = mu * sn;
   if (gt <= lim) {
-    r[1] = gt1;
-    r[2] = gt2;
+    r[1] = g[1];
+    r[2] = g[2];
     return Branch3::Stick;
   }
   const double f = lim / gt;
-  r[1] = f * gt1;
-  r[2] = f * gt2;
+  r[1] = f * g[1];
+  r[2] = f * g[2];
   return Branch3::Slide;
+}
+
+inline Branch3 solve_sphere3(double wnn, double wtt, const Vec3& q, double mu, double a, Vec3& r) {
+  return project_sphere3(Vec3(-q[0] / wnn, -q[1] / wtt, -q[2] / wtt), mu, a, r);
 }
 
 // Euclidean projection of y onto the ellipse {(x1/e1)^2 + (x2/e2)^2 <= 1}
@@ -295,33 +304,37 @@ inline Eigen::Vector2d project_ellipse(const Eigen::Vector2d& y, double e1, doub
 }
 
 // The sphere block diag(W_nn, W_tt, W_tt) with an orthotropic cone
-// |(s_t1/mu_a, s_t2/mu_b)| <= s_n. The normal impulse decouples as in
-// solve_sphere3. Sliding: u_t = W_tt (s_t - g) with g = -q_t / W_tt the stick
-// trial, and maximal dissipation puts -u_t in the normal cone of the ellipse
-// E = {|D^-1 s_t| <= s_n} at s_t, i.e. g - s_t is normal to E there: s_t is
-// the Euclidean projection of g onto E (project_ellipse). Not opposite to
-// u_t unless mu_a = mu_b. A zero coefficient leaves that axis frictionless
-// and the other a 1D clamp. tests/test_world3_physics.cpp checks it against
-// solve_local3.
-inline Branch3 solve_sphere3_ortho(double wnn, double wtt, const Vec3& q, double mu_a, double mu_b,
-                                   double a, Vec3& r) {
-  const double sn = std::max(0.0, a - q[0] / wnn);
+// |(s_t1/mu_a, s_t2/mu_b)| <= s_n, from the stick trial g = -W^-1 q as in
+// project_sphere3: the normal impulse decouples. Sliding: u_t = W_tt (s_t -
+// g_t), and maximal dissipation puts -u_t in the normal cone of the ellipse
+// E = {|D^-1 s_t| <= s_n} at s_t, i.e. g_t - s_t is normal to E there: s_t
+// is the Euclidean projection of g_t onto E (project_ellipse). Not opposite
+// to u_t unless mu_a = mu_b. A zero coefficient leaves that axis
+// frictionless and the other a 1D clamp. tests/test_world3_physics.cpp
+// checks solve_sphere3_ortho against solve_local3.
+inline Branch3 project_sphere3_ortho(const Vec3& g, double mu_a, double mu_b, double a, Vec3& r) {
+  const double sn = std::max(0.0, a + g[0]);
   r[0] = sn - a;
   if (sn == 0.0) {
     r[1] = r[2] = 0.0;
     return Branch3::Open;
   }
-  const Eigen::Vector2d g(-q[1] / wtt, -q[2] / wtt);
+  const Eigen::Vector2d gt(g[1], g[2]);
   if (mu_a == 0.0 || mu_b == 0.0) {
     const double la = mu_a * sn, lb = mu_b * sn;
-    r[1] = std::clamp(g[0], -la, la);
-    r[2] = std::clamp(g[1], -lb, lb);
-    return (r[1] == g[0] && r[2] == g[1]) ? Branch3::Stick : Branch3::Slide;
+    r[1] = std::clamp(gt[0], -la, la);
+    r[2] = std::clamp(gt[1], -lb, lb);
+    return (r[1] == gt[0] && r[2] == gt[1]) ? Branch3::Stick : Branch3::Slide;
   }
-  const Eigen::Vector2d s = project_ellipse(g, mu_a * sn, mu_b * sn);
+  const Eigen::Vector2d s = project_ellipse(gt, mu_a * sn, mu_b * sn);
   r[1] = s[0];
   r[2] = s[1];
-  return (s[0] == g[0] && s[1] == g[1]) ? Branch3::Stick : Branch3::Slide;
+  return (s[0] == gt[0] && s[1] == gt[1]) ? Branch3::Stick : Branch3::Slide;
+}
+
+inline Branch3 solve_sphere3_ortho(double wnn, double wtt, const Vec3& q, double mu_a, double mu_b,
+                                   double a, Vec3& r) {
+  return project_sphere3_ortho(Vec3(-q[0] / wnn, -q[1] / wtt, -q[2] / wtt), mu_a, mu_b, a, r);
 }
 
 // Natural-map residual of the law at (u, r), in impulse units, with De
