@@ -16,15 +16,21 @@
 //                       solve stage, per thread
 //   t_<stage>_ms        per step, by stage (core/stages.hpp)
 // and, at 1e3 on one thread, a converged step (pile3d's tol = 1e-4): its
-// sweeps and time. --out DIR writes
+// sweeps and time, and the sweep alone: one step's contact problem frozen
+// and solved again with exactly kKernelSweeps sweeps, timed in CPU seconds
+// of the process (best of kKernelRuns), so that the figure holds on a
+// loaded machine where the wall clock does not (issue 30's contact update).
+// --out DIR writes
 //   bench3.csv    one line per (N, threads)
 //   summary3.csv  2-thread speedups of the step and the solve, updates/s
-//                 per core, the slope of ms/step against N (log-log)
+//                 per core, the frozen step's updates per CPU second, the
+//                 slope of ms/step against N (log-log)
 //   machine.csv   CPU, cores, compiler, flags, load average (machine.hpp)
 #include <omp.h>
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +47,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr int kSweeps = 50;
+constexpr int kKernelSweeps = 200, kKernelRuns = 5;
 
 struct Threads {  // OpenMP threads for one scope
   int saved;
@@ -117,6 +124,38 @@ Result measure(cd::World3 w, int threads, int steps) {
   return r;
 }
 
+double cpu_seconds() {
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// The sweep alone on one thread: the next step's contact problem of w,
+// frozen, solved kKernelRuns times from its warm start with exactly
+// kKernelSweeps sweeps; contact updates per CPU second, the best run.
+double kernel_updates_per_cpu_s(cd::World3 w) {
+  Threads one(1);
+  cd::ContactProblem3 frozen;
+  cd::SolverParams prm;
+  w.set_problem_hook([&](const cd::ContactProblem3& p, const cd::SolverParams& s) {
+    frozen = p;
+    prm = s;
+  });
+  w.step();
+  prm.tol = 0.0;  // never met: exactly kKernelSweeps sweeps
+  prm.residual_tol = 0.0;
+  prm.max_iter = kKernelSweeps;
+  double best = 0.0;
+  for (int k = 0; k < kKernelRuns; ++k) {
+    cd::ContactProblem3 p = frozen;
+    const double t0 = cpu_seconds();
+    const cd::SolveStats st = cd::nlgs_solve3(p, prm);
+    const double t = cpu_seconds() - t0;
+    best = std::max(best, double(p.rows.size()) * st.iterations / t);
+  }
+  return best;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -146,6 +185,9 @@ int main(int argc, char** argv) {
     std::printf("cdbench3: converged (tol 1e-4) N = 1000, 1 thread: %.2f ms/step, %.0f contacts\n", r.ms_step,
                 r.contacts);
   }
+  const double kernel = kernel_updates_per_cpu_s(base);
+  std::printf("cdbench3: frozen step N = 1000, %d sweeps, 1 thread: %.3g contact updates per CPU second (best of %d)\n",
+              kKernelSweeps, kernel, kKernelRuns);
 
   struct Size {
     int kx, ky;
@@ -173,6 +215,7 @@ int main(int argc, char** argv) {
 
   // Summary: speedups, updates/s/core, slope of ms/step (1 thread) against N.
   std::vector<std::tuple<std::string, double, std::string>> summary;
+  summary.emplace_back("frozen_step_updates_per_cpu_s/1000", kernel, "1/s");
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   int m = 0;
   for (std::size_t i = 0; i + 1 < res.size(); i += 2) {
