@@ -180,7 +180,7 @@ run: deps $(BUILD)/CMakeCache.txt
 	@echo ""
 	@echo "Outputs in $(OUT)/: series.csv (time series, columns in docs/outputs.md), scene.toml"
 	@echo "(resolved scene), shapes.pvd, particles.pvd, contacts.pvd, walls.pvd (VTK collections)."
-	@echo "Open in ParaView:  paraview $(OUT)/shapes.pvd   (grains as drawn; colour by velocity)"
+	@echo "Open in ParaView:  paraview --script=$(OUT)/view.py   (grains and force chains, as the README's picture)"
 	@$(BUILD)/analysis/cdanalysis draw $(OUT) > $(OUT)/picture.log 2>&1 && \
 	  echo "Without ParaView: $$(sed -n 's/^picture: //p' $(OUT)/picture.log)   (last snapshot: grains and force chains)" || \
 	  echo "No picture (cdanalysis draw failed: $(OUT)/picture.log)"

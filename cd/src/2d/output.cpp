@@ -214,6 +214,7 @@ void Snapshots::write(const World& w) {
   write_vtp(shapes(w), (d / ("shapes_" + num + ".vtp")).string());
   // The collections are rewritten only once all files of the frame are in
   // place, so they never list a missing file.
+  if (n_ == 0) write_file_atomic((d / "view.py").string(), paraview_view_script());
   frames_.emplace_back(w.time, num);
   for (const char* stem : {"particles", "contacts", "walls", "shapes"})
     write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd_collection(frames_, stem));

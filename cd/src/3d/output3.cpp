@@ -141,6 +141,7 @@ void Snapshots3::write(const World3& w) {
   write_contacts3_vtp(w, (d / ("contacts_" + num + ".vtp")).string());
   // The collections are rewritten only once all files of the frame are in
   // place, so they never list a missing file.
+  if (n_ == 0) write_file_atomic((d / "view.py").string(), paraview_view_script());
   frames_.emplace_back(w.time, num);
   for (const char* stem : {"spheres", "contacts"})
     write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd_collection(frames_, stem));

@@ -63,7 +63,7 @@ void clear_previous(const std::filesystem::path& dir) {
   if (!fs::is_directory(dir)) return;
   for (const auto& e : fs::directory_iterator(dir)) {
     const std::string f = e.path().filename().string();
-    const bool ours = f == "series.csv" || f == "timings.csv" || f == "scene.toml" || e.path().extension() == ".pvd" ||
+    const bool ours = f == "series.csv" || f == "timings.csv" || f == "scene.toml" || f == "view.py" || e.path().extension() == ".pvd" ||
                       f.starts_with("checkpoint.bin") || f.starts_with("problem_") ||
                     f.starts_with("summary.toml") ||
                       (e.path().extension() == ".vtp" &&

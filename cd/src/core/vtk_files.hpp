@@ -18,4 +18,11 @@ void write_vtp(vtkPolyData* pd, const std::string& path);
 std::string pvd_collection(const std::vector<std::pair<double, std::string>>& frames,
                            const char* stem);
 
+// The text of view.py, the ParaView script that each run folder with
+// snapshots gets (written with the first snapshot): `paraview
+// --script=view.py` opens the last snapshot's grains and force chains styled
+// as the README's picture, `pvbatch view.py out.png` draws it. Generated at
+// build time from docs/figures/chains.py and src/core/paraview/view_main.py.
+const std::string& paraview_view_script();
+
 }  // namespace cd
