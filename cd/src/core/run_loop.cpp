@@ -5,6 +5,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <ctime>
 #include <chrono>
 #include <csignal>
 #include <cmath>
@@ -44,15 +47,31 @@ std::string toml_float(double x) {
 
 // The first SIGINT, SIGTERM or SIGHUP asks the run to stop at its next series
 // row, where a checkpoint falls as it always does, so that the resumed run is
-// the one never stopped; a second one of them ends the process at once, as a
-// kill would (the resume then starts from the last checkpoint).
+// the one never stopped; a second one of them, a second or more later, ends
+// the process at once, as a kill would (the resume then starts from the last
+// checkpoint). One within that second is the same request delivered twice:
+// `timeout` signals the command and then its whole process group, and a
+// shell's job control may do the same, so a single stop asked that way
+// arrives twice within microseconds; before this rule it killed the run.
 volatile std::sig_atomic_t g_stop = 0;
+std::atomic<std::int64_t> g_stop_ns{0};  // CLOCK_MONOTONIC of the first signal
+static_assert(std::atomic<std::int64_t>::is_always_lock_free);  // safe in a handler
+constexpr std::int64_t kRepeatNs = 1'000'000'000;
+
+std::int64_t monotonic_ns() {  // clock_gettime is async-signal-safe (POSIX)
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
 extern "C" void on_stop(int sig) {
   if (g_stop != 0) {
+    if (monotonic_ns() - g_stop_ns.load() < kRepeatNs) return;  // the same request
     std::signal(sig, SIG_DFL);
     std::raise(sig);
     return;
   }
+  g_stop_ns.store(monotonic_ns());
   g_stop = sig;
 }
 
