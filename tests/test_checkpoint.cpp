@@ -46,12 +46,9 @@ namespace {
 
 const std::string kCdsim = CDLAB_BINARY_DIR "/cd/cdsim";
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("cdlab_ckpt_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+// In the build folder (cdtest::scratch_dir), not /tmp: the folders stay
+// with the build instead of piling up in /tmp, one per run of the suite.
+fs::path temp_dir(const std::string& name) { return cdtest::scratch_dir("test_checkpoint", name); }
 
 std::string slurp(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
