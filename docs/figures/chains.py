@@ -1,10 +1,62 @@
-# The force-chain pipeline shared by render.py (2D) and render3d.py (3D):
-# the force-bearing contacts of a contacts.pvd frame (f_n > 0) as tubes from
+# The pipeline pieces shared by render.py (2D), render3d.py (3D) and every
+# run's view.py (cd/src/core/paraview/view_main.py appended to this file):
+# the last frame of a collection, a white view, the grains' styles, and
+# the force chains: the force-bearing contacts of a contacts.pvd frame (f_n > 0) as tubes from
 # centre to centre whose radius grows linearly with f_n, coloured by f_n in
 # mN (light for weak contacts, dark for the chains), with a horizontal
 # colour bar at the bottom of the view.
-from paraview.simple import (Calculator, CellDatatoPointData, ColorBy, ExtractSurface,
-                             GetColorTransferFunction, GetScalarBar, Show, Threshold, Tube)
+import os
+
+from paraview.simple import (Calculator, CellDatatoPointData, ColorBy, ExtractSurface, Glyph,
+                             GetColorTransferFunction, GetScalarBar, OpenDataFile, Show, Sphere,
+                             Threshold, Tube)
+
+
+def last_frame(run, name):
+    """The collection run/name.pvd at its last time, and that time."""
+    src = OpenDataFile(os.path.join(run, name + ".pvd"))
+    ts = list(getattr(src, "TimestepValues", []) or [])
+    t = ts[-1] if ts else 0.0
+    src.UpdatePipeline(t)
+    return src, t
+
+
+def white_view(view):
+    view.OrientationAxesVisibility = 0
+    view.Background = [1.0, 1.0, 1.0]
+    try:  # ParaView >= 5.10 takes the background from the palette unless told
+        view.UseColorPaletteForBackground = 0
+    except AttributeError:
+        pass
+
+
+def show_outlines(view, shapes, walls):
+    """2D grains with their true outlines (flat grey, a backdrop) and the walls."""
+    gd = Show(shapes, view)
+    gd.ColorArrayName = ["POINTS", ""]
+    gd.AmbientColor = gd.DiffuseColor = [0.86, 0.88, 0.90]
+    gd.Ambient, gd.Diffuse = 1.0, 0.0
+    gd.SetRepresentationType("Surface With Edges")
+    gd.EdgeColor = [0.55, 0.57, 0.60]
+    wd = Show(walls, view)
+    wd.ColorArrayName = ["POINTS", ""]
+    wd.AmbientColor = wd.DiffuseColor = [0.1, 0.1, 0.1]
+    wd.LineWidth = 3.0
+    return gd
+
+
+def show_spheres(view, spheres):
+    """3D spheres: glyphs of a unit sphere scaled by each radius, see-through."""
+    ball = Sphere(Radius=1.0, ThetaResolution=24, PhiResolution=16)
+    glyphs = Glyph(Input=spheres, GlyphType=ball)
+    glyphs.ScaleArray = ["POINTS", "radius"]
+    glyphs.ScaleFactor = 1.0
+    glyphs.GlyphMode = "All Points"
+    gd = Show(glyphs, view)
+    gd.ColorArrayName = ["POINTS", ""]
+    gd.AmbientColor = gd.DiffuseColor = [0.80, 0.83, 0.87]
+    gd.Opacity = 0.35
+    return gd
 
 
 def show_chains(view, contacts, radius, radius_factor, fmax, label_step=None):

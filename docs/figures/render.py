@@ -14,49 +14,24 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from chains import show_chains  # noqa: E402
-from paraview.simple import CreateView, OpenDataFile, Render, SaveScreenshot, Show  # noqa: E402
+from chains import last_frame, show_chains, show_outlines, white_view  # noqa: E402
+from paraview.simple import CreateView, Render, SaveScreenshot  # noqa: E402
 
 run, png = sys.argv[1], sys.argv[2]
 W, H = 1200, 840  # pixels; the default pile is 40 d wide and ~27 d high
 
-
-def last_frame(name):
-    src = OpenDataFile(f"{run}/{name}.pvd")
-    ts = list(getattr(src, "TimestepValues", []) or [])
-    t = ts[-1] if ts else 0.0
-    src.UpdatePipeline(t)
-    return src, t
-
-
 view = CreateView("RenderView")
 view.ViewSize = [W, H]
-view.OrientationAxesVisibility = 0
-view.Background = [1.0, 1.0, 1.0]
-try:  # ParaView >= 5.10 takes the background from the palette unless told
-    view.UseColorPaletteForBackground = 0
-except AttributeError:
-    pass
+white_view(view)
 
-shapes, t = last_frame("shapes")
+shapes, t = last_frame(run, "shapes")
 view.ViewTime = t
-grains = Show(shapes, view)
-grains.ColorArrayName = ["POINTS", ""]
-grains.AmbientColor = grains.DiffuseColor = [0.86, 0.88, 0.90]
-grains.Ambient, grains.Diffuse = 1.0, 0.0  # flat: the grains are a backdrop
-grains.SetRepresentationType("Surface With Edges")
-grains.EdgeColor = [0.55, 0.57, 0.60]
-
-walls, _ = last_frame("walls")
-wd = Show(walls, view)
-wd.ColorArrayName = ["POINTS", ""]
-wd.AmbientColor = wd.DiffuseColor = [0.1, 0.1, 0.1]
-wd.LineWidth = 3.0
+show_outlines(view, shapes, last_frame(run, "walls")[0])
 
 # Force-bearing contacts only (f_n > 0), as tubes whose radius grows
 # linearly with f_n: from 0.02 mm for the weakest to 0.3 mm (0.3 d_mean)
 # for the strongest.
-contacts, _ = last_frame("contacts")
+contacts, _ = last_frame(run, "contacts")
 fmax = contacts.CellData["fn"].GetRange()[1]
 show_chains(view, contacts, radius=2e-5, radius_factor=15.0, fmax=fmax, label_step=0.5)
 

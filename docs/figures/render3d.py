@@ -13,32 +13,17 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from chains import show_chains  # noqa: E402
-from paraview.simple import (Clip, CreateView, Glyph, OpenDataFile, Render,  # noqa: E402
-                             SaveScreenshot, Show, Sphere)
+from chains import last_frame, show_chains, show_spheres, white_view  # noqa: E402
+from paraview.simple import Clip, CreateView, Render, SaveScreenshot  # noqa: E402
 
 run, png = sys.argv[1], sys.argv[2]
 W, H = 1200, 900
 
-
-def last_frame(name):
-    src = OpenDataFile(f"{run}/{name}.pvd")
-    ts = list(getattr(src, "TimestepValues", []) or [])
-    t = ts[-1] if ts else 0.0
-    src.UpdatePipeline(t)
-    return src, t
-
-
 view = CreateView("RenderView")
 view.ViewSize = [W, H]
-view.OrientationAxesVisibility = 0
-view.Background = [1.0, 1.0, 1.0]
-try:
-    view.UseColorPaletteForBackground = 0
-except AttributeError:
-    pass
+white_view(view)
 
-spheres, t = last_frame("spheres")
+spheres, t = last_frame(run, "spheres")
 view.ViewTime = t
 x0, x1, y0, y1, z0, z1 = spheres.GetDataInformation().GetBounds()
 ym = 0.5 * (y0 + y1)
@@ -58,18 +43,9 @@ def front_half(src):
     return c
 
 
-# Spheres: glyphs of the sphere source (radius 1) scaled by each radius.
-ball = Sphere(Radius=1.0, ThetaResolution=24, PhiResolution=16)
-glyphs = Glyph(Input=front_half(spheres), GlyphType=ball)
-glyphs.ScaleArray = ["POINTS", "radius"]
-glyphs.ScaleFactor = 1.0
-glyphs.GlyphMode = "All Points"
-gd = Show(glyphs, view)
-gd.ColorArrayName = ["POINTS", ""]
-gd.AmbientColor = gd.DiffuseColor = [0.80, 0.83, 0.87]
-gd.Opacity = 0.35
+show_spheres(view, front_half(spheres))
 
-contacts, _ = last_frame("contacts")
+contacts, _ = last_frame(run, "contacts")
 fmax = contacts.CellData["fn"].GetRange()[1]
 show_chains(view, front_half(contacts), radius=1.5e-4, radius_factor=12.0, fmax=fmax)
 

@@ -11,7 +11,7 @@
 import os
 import sys
 
-from paraview.simple import GetActiveViewOrCreate, Glyph, OpenDataFile, Render, SaveScreenshot, Sphere
+from paraview.simple import GetActiveViewOrCreate, Render, SaveScreenshot
 
 try:
     RUN = os.path.dirname(os.path.abspath(__file__))
@@ -19,52 +19,22 @@ except NameError:  # a console that does not set __file__: run it from the folde
     RUN = os.getcwd()
 
 
-def last_frame(name):
-    src = OpenDataFile(os.path.join(RUN, name + ".pvd"))
-    ts = list(getattr(src, "TimestepValues", []) or [])
-    t = ts[-1] if ts else 0.0
-    src.UpdatePipeline(t)
-    return src, t
-
-
 view = GetActiveViewOrCreate("RenderView")
-view.OrientationAxesVisibility = 0
-view.Background = [1.0, 1.0, 1.0]
-try:  # ParaView >= 5.10 takes the background from the palette unless told
-    view.UseColorPaletteForBackground = 0
-except AttributeError:
-    pass
+white_view(view)
 if os.path.exists(os.path.join(RUN, "shapes.pvd")):  # 2D: true outlines and walls
-    grains, t = last_frame("shapes")
-    gd = Show(grains, view)
-    gd.ColorArrayName = ["POINTS", ""]
-    gd.AmbientColor = gd.DiffuseColor = [0.86, 0.88, 0.90]
-    gd.SetRepresentationType("Surface With Edges")
-    gd.EdgeColor = [0.55, 0.57, 0.60]
-    walls, _ = last_frame("walls")
-    wd = Show(walls, view)
-    wd.ColorArrayName = ["POINTS", ""]
-    wd.AmbientColor = wd.DiffuseColor = [0.1, 0.1, 0.1]
-    wd.LineWidth = 3.0
+    grains, t = last_frame(RUN, "shapes")
+    show_outlines(view, grains, last_frame(RUN, "walls")[0])
     view.InteractionMode = "2D"
 else:  # 3D: spheres of their radius, see-through so that the chains show
-    grains, t = last_frame("spheres")
-    ball = Sphere(Radius=1.0, ThetaResolution=24, PhiResolution=16)
-    glyphs = Glyph(Input=grains, GlyphType=ball)
-    glyphs.ScaleArray = ["POINTS", "radius"]
-    glyphs.ScaleFactor = 1.0
-    glyphs.GlyphMode = "All Points"
-    gd = Show(glyphs, view)
-    gd.ColorArrayName = ["POINTS", ""]
-    gd.AmbientColor = gd.DiffuseColor = [0.80, 0.83, 0.87]
-    gd.Opacity = 0.35
+    grains, t = last_frame(RUN, "spheres")
+    show_spheres(view, grains)
 view.ViewTime = t
 
 # The tubes: from 1/30 of the largest grain's radius for the weakest contact
 # to 15 times that for the strongest.
-contacts, _ = last_frame("contacts")
+contacts, _ = last_frame(RUN, "contacts")
 fmax = contacts.CellData["fn"].GetRange()[1]
-sizes = last_frame("particles" if os.path.exists(os.path.join(RUN, "particles.pvd")) else "spheres")[0]
+sizes = last_frame(RUN, "particles" if os.path.exists(os.path.join(RUN, "particles.pvd")) else "spheres")[0]
 rmax = sizes.PointData["radius"].GetRange()[1]
 if fmax > 0:
     show_chains(view, contacts, radius=rmax / 30, radius_factor=15.0, fmax=fmax)
