@@ -52,6 +52,7 @@ help:
 	@echo "  make accuracy-cost   eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s);"
 	@echo "                       3D: polyhedral-cone Lemke against e and the exact NLGS (outputs/accuracy-cost/3d/)"
 	@echo "  make accuracy-shear  solver settings against steady mu*, phi, z and cost in shear (ACC/; hours)"
+	@echo "  make accuracy-shear3 3D shear settings against a tight reference over 3 samples (A3_DIR; ~2 CPU hours)"
 	@echo "  make tensile         tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
 	@echo "  make compare-liggghts-shear  a 1000-sphere mu(I) point by LIGGGHTS and cdsim, one thread each: CPU per"
 	@echo "                       unit strain, sweeps, mu, phi, z, the ratio (CMP_DIR; QUICK=1: strain 0.3)"
@@ -127,6 +128,7 @@ help:
 	$(call help_var,FS_GAP,steps between its two dumped problems)
 	$(call help_var,FS_PREP_SET,--set options of its preparations)
 	$(call help_var,ACC,make accuracy-shear's folder)
+	$(call help_var,A3_DIR,make accuracy-shear3's folder (A3_SEEDS, A3_I, A3_SETTINGS, A3_STRAIN: the Makefile))
 	$(call help_var,ACC_N,its grains)
 	$(call help_var,ACC_SHAPES,its shapes)
 	$(call help_var,ACC_I,its inertial numbers)
@@ -592,6 +594,59 @@ $(ACC)/ns_$(1)/I_$(2)/$(3)/.done: $(ACC)/prep/ns_$(1)/.done
 	touch $$@
 endef
 $(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(eval $(call acc_rule,$(s),$(i),$(k))))))
+
+# ---- Three samples against a tight reference, 3D (issue 30, target 4) ------
+# make accuracy-shear3 [A3_SEEDS="11 12 13"] [A3_I=0.01] [A3_SETTINGS=...] [A3_STRAIN=1]
+# For each seed: a sample of A3_N spheres (configs/shear3-prep.toml,
+# particles.seed), sheared at I = 0.01 at the policy's settings to
+# gamma = A3_START (the common start: the steady state every setting
+# continues, so that the settings differ only in the solver); then each
+# setting of A3_SETTINGS continues it at I = A3_I for A3_STRAIN, one thread.
+# cd/bench/accuracy_shear3.py prints (and writes to A3_DIR/table.md) per
+# setting the mean over samples of mu, phi, z over continuation strain >=
+# A3_W0, +- the standard error over samples, the difference to the first
+# setting in combined errors, CPU per unit strain, sweeps a step, capped
+# steps, the largest overlap and law residual. Settings (a3_set_<name>):
+a3_set_ref    := --set solver.tol=1e-4 --set solver.residual_tol=3e-3 --set solver.max_iter=5000
+a3_set_policy :=
+a3_set_mid    := --set solver.tol=2e-3 --set solver.anderson=5 --set contact.overlap_projection=0.5
+a3_set_fast   := --set solver.tol=3e-3 --set solver.anderson=5 --set contact.overlap_projection=0.5
+a3_set_anderson1e-3 := --set solver.tol=1e-3 --set solver.anderson=5 --set contact.overlap_projection=0.5 --set solver.max_iter=600
+# 1000 spheres, 3 seeds, I = 0.01, the four settings: ~2 CPU hours, most of
+# it the reference's (docs/accuracy.md, "Three samples").
+A3_N ?= 1000
+A3_SEEDS ?= 11 12 13
+A3_I ?= 0.01
+A3_SETTINGS ?= ref policy mid fast
+A3_START ?= 0.5
+A3_STRAIN ?= 1
+A3_W0 ?= 0.1
+A3_DIR ?= outputs/accuracy-shear3/N_$(A3_N)
+a3_tp := $(shell awk 'BEGIN { printf "%.6g", 1e-3 * sqrt(2600 / 1e5) }')
+a3_cmd = OMP_NUM_THREADS=1 $(BUILD)/cd/cdsim $(1) --out $(@D) --fresh --set output.quiet=true --set output.snapshot_interval=0
+a3_shear = $(call a3_cmd,configs/shear3-inertial.toml) --set shear.start='"$(1)/checkpoint.bin"' --set shear.pressure=1e5 \
+  --set output.series_interval=$(a3_tp)
+.PHONY: accuracy-shear3 accuracy-shear3-runs
+accuracy-shear3: programs
+	$(MAKE) --no-print-directory accuracy-shear3-runs
+	/usr/bin/python3 cd/bench/accuracy_shear3.py $(A3_DIR)/I_$(A3_I) $(A3_W0) $(A3_SETTINGS)
+accuracy-shear3-runs: $(foreach s,$(A3_SEEDS),$(foreach k,$(A3_SETTINGS),$(A3_DIR)/I_$(A3_I)/s$(s)/$(k)/.done))
+.PRECIOUS: $(A3_DIR)/prep/s%/.done $(A3_DIR)/start/s%/.done
+$(A3_DIR)/prep/s%/.done:
+	rm -rf $(@D)
+	$(call a3_cmd,configs/shear3-prep.toml) --set particles.n=$(A3_N) --set particles.seed=$*
+	touch $@
+$(A3_DIR)/start/s%/.done: $(A3_DIR)/prep/s%/.done
+	rm -rf $(@D)
+	$(call a3_shear,$(A3_DIR)/prep/s$*) --set shear.inertial_number=0.01 --set shear.strain=$(A3_START)
+	touch $@
+define a3_rule
+$(A3_DIR)/I_$(A3_I)/s$(1)/$(2)/.done: $(A3_DIR)/start/s$(1)/.done
+	rm -rf $$(@D)
+	$$(call a3_shear,$(A3_DIR)/start/s$(1)) --set shear.inertial_number=$(A3_I) --set shear.strain=$(A3_STRAIN) $$(a3_set_$(2))
+	touch $$@
+endef
+$(foreach s,$(A3_SEEDS),$(foreach k,$(A3_SETTINGS),$(eval $(call a3_rule,$(s),$(k)))))
 
 # Campaign analyses: the report of outputs/campaigns/<name> (made by the
 # campaign-* targets) into outputs/analysis/<name>/, plus the campaign's fits.
