@@ -58,6 +58,7 @@ help:
 	@echo "                       unit strain, sweeps, mu, phi, z, the ratio (CMP_DIR; QUICK=1: strain 0.3)"
 	@echo "  make prep-overlap    ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N: fails if an overlap reaches 0.01 d_small"
 	@echo "  make frozen-shear    steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into FROZEN/N_<FS_N>/"
+	@echo "  make frozen-shear3   a 3D shear step at I = 1e-2 (tests/data/frozen-shear3) into FROZEN/3d/N_<FS3_N>/"
 	@echo "  make regress         re-run the 2D and 3D reference campaigns, refit mu(I), compare with tests/data/regress*/"
 	@echo "  make mutants         apply each deliberate physics bug of tests/mutants/ to a scratch copy, run the tests it names,"
 	@echo "                       print the survivors and the score (BUILD/mutants/)"
@@ -81,6 +82,7 @@ help:
 	@echo "  make campaign-prep-of RUN=<run folder>    the sample that run starts from"
 	@echo "  make regress-campaign, regress3-campaign  the reference campaigns of make regress"
 	@echo "  make frozen-shear-runs, accuracy-shear-runs  the runs of make frozen-shear, make accuracy-shear"
+	@echo "  make frozen-shear3-run  the run of make frozen-shear3 (its sample, then the shear)"
 	@echo "Variables (make TARGET VAR=value ...), with their values now"
 	$(call help_var,SCENE,the scene of make run)
 	$(call help_var,OUT,its output folder)
@@ -127,6 +129,8 @@ help:
 	$(call help_var,FS_QS_STRAIN,strain of its I = 1e-3 runs)
 	$(call help_var,FS_GAP,steps between its two dumped problems)
 	$(call help_var,FS_PREP_SET,--set options of its preparations)
+	$(call help_var,FS3_N,spheres of make frozen-shear3)
+	$(call help_var,FS3_STRAIN,its strain at I = 1e-2 (the step dumped: the last))
 	$(call help_var,ACC,make accuracy-shear's folder)
 	$(call help_var,A3_DIR,make accuracy-shear3's folder (A3_SEEDS, A3_I, A3_SETTINGS, A3_STRAIN: the Makefile))
 	$(call help_var,ACC_N,its grains)
@@ -546,6 +550,25 @@ $(CAMPAIGNS)/frozen/ns_%/I_0.01/.done: $(CAMPAIGNS)/prep/ns_%/.done
 	touch $@
 $(CAMPAIGNS)/frozen/ns_%/I_0.001/.done: $(CAMPAIGNS)/prep/ns_%/.done
 	$(call frozen_run,0.001,$(FS_QS_STRAIN),$(CAMPAIGNS)/prep/ns_$*/checkpoint.bin)
+	touch $@
+
+# ---- A frozen 3D dense-shear step (issue 30; tests/data/frozen-shear3) ------
+# FS3_N spheres compacted by the 3D campaign's preparation (configs/
+# shear3-prep.toml at p = 1e5 N/m^2, until jammed), then sheared at I = 1e-2
+# under cdsim's own policy for that I (solver.tol 1e-3, dt 0.05 t_p: the
+# steps a 3D campaign run at I = 1e-2 solves) for FS3_STRAIN, and the last
+# step's contact problem dumped (.cdp3, exact replay). tests/test_frozen_shear3
+# solves the committed one (gzipped; how it was made: the README there).
+FS3_N ?= 500
+FS3_STRAIN ?= 0.5
+.PHONY: frozen-shear3 frozen-shear3-run
+frozen-shear3:
+	$(MAKE) --no-print-directory DIM=3 CAMPAIGNS=$(FROZEN)/3d/N_$(FS3_N) N=$(FS3_N) frozen-shear3-run
+	@ls -l $(FROZEN)/3d/N_$(FS3_N)/frozen3/I_0.01/problem_*.cdp3
+frozen-shear3-run: $(CAMPAIGNS)/frozen3/I_0.01/.done
+$(CAMPAIGNS)/frozen3/I_0.01/.done: $(CAMPAIGNS)/prep/ns_0/.done
+	$(call shear_cmd,0.01,$(CAMPAIGNS)/prep/ns_0,$(P),$(FS3_STRAIN)) --fresh --set output.snapshot_interval=0 \
+	  --dump-problem $(call fs_steps,0.01,$(FS3_STRAIN))
 	touch $@
 
 # ---- Accuracy against cost in steady shear (issue 14, item 1) ----------------
