@@ -535,7 +535,7 @@ frozen-shear: build
 	$(MAKE) --no-print-directory -j $(JOBS) CAMPAIGNS=$(FROZEN)/N_$(FS_N) N=$(FS_N) \
 	  PREP_SET="$(FS_PREP_SET)" frozen-shear-runs
 	@ls -l $(FROZEN)/N_$(FS_N)/frozen/*/*/problem_*.cdp
-frozen-shear-runs: $(foreach s,$(FS_SHAPES),$(CAMPAIGNS)/frozen/ns_$(s)/I_0.001/.done)
+frozen-shear-runs: $(foreach s,$(FS_SHAPES),$(foreach i,0.01 0.001,$(CAMPAIGNS)/frozen/ns_$(s)/I_$(i)/.done))
 # steps of a strain at I with the campaign's dt: strain / (I dt_tp)
 fs_steps = $(shell awk 'BEGIN { printf "%d", $(2) / ($(1) * $(call resolved,$(1),dt_tp)) + 0.5 }')
 frozen_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --fresh \
