@@ -23,12 +23,9 @@ const std::string kCdsim = CDLAB_BINARY_DIR "/cd/cdsim";
 using Result = cdtest::CmdResult;
 Result run(const std::string& args) { return cdtest::run_command(kCdsim + " " + args); }
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("cdsim_cli_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+// In the build folder (cdtest::scratch_dir), not /tmp, where each run of the
+// suite left seven cdsim_cli_* folders behind.
+fs::path temp_dir(const std::string& name) { return cdtest::scratch_dir("test_cdsim_cli", name); }
 
 fs::path write(const fs::path& dir, const std::string& name, const std::string& text) {
   const fs::path p = dir / name;

@@ -12,6 +12,7 @@
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataReader.h>
 
+#include "cli_util.hpp"
 #include "output3.hpp"
 #include "pile3d.hpp"
 
@@ -23,8 +24,9 @@ TEST(Output3, SpheresRoundTripThroughVtk) {
   w.bodies.add_sphere(Vec3(1, 2, 3), 0.5, 1000, Vec3(0.1, 0.2, 0.3), Vec3(-1, 0, 2));
   w.bodies.add_sphere(Vec3(-1, 0.5, 2), 0.25, 1000);
   w.bodies.orient[2] = Quat(Eigen::AngleAxisd(0.3, Vec3(0, 1, 0)));
-  const auto dir = std::filesystem::temp_directory_path() / "cdlab_output3";
-  std::filesystem::create_directories(dir);
+  // In the build folder, not a fixed name in /tmp that the suites of other
+  // checkouts running at the same time would share.
+  const auto dir = cdtest::scratch_dir("test_output3", "vtp");
   const std::string path = (dir / "s.vtp").string();
   write_spheres_vtp(w, path);
   vtkNew<vtkXMLPolyDataReader> r;
@@ -68,12 +70,11 @@ TEST(Output3, Pile3dLayout) {
 // cdsim runs a small pile3d scene (configs/pile3d.toml, dimension = 3) and
 // writes its series and snapshots (spheres and contacts, with .pvd).
 TEST(Output3, CdsimSmallPileWritesSeriesAndSnapshots) {
-  const auto dir = std::filesystem::temp_directory_path() / "cdlab_cdsim_3d";
-  std::filesystem::remove_all(dir);
+  const auto scratch = cdtest::scratch_dir("test_output3", "cdsim"), dir = scratch / "out";
   const std::string cmd = std::string(CDLAB_BINARY_DIR "/cd/cdsim ") + CDLAB_SOURCE_DIR +
                           "/configs/pile3d.toml --set particles.n=27 --set time.duration=0.05 "
                           "--set output.snapshot_interval=0.025 --threads 1 --quiet --out " +
-                          dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
+                          dir.string() + " > " + (scratch / "log").string() + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   EXPECT_TRUE(std::filesystem::exists(dir / "series.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir / "spheres_00000.vtp"));
@@ -82,6 +83,5 @@ TEST(Output3, CdsimSmallPileWritesSeriesAndSnapshots) {
   EXPECT_FALSE(std::filesystem::exists(dir / "spheres_00003.vtp"));
   EXPECT_TRUE(std::filesystem::exists(dir / "spheres.pvd"));
   EXPECT_TRUE(std::filesystem::exists(dir / "contacts.pvd"));
-  std::filesystem::remove_all(dir);
-  std::filesystem::remove(dir.string() + ".log");
+  std::filesystem::remove_all(scratch);
 }

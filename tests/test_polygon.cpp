@@ -263,15 +263,14 @@ TEST(PolygonHardCases, SquaresWithDisksTenTimesSmaller) {
 
 #include <filesystem>
 
+#include "cli_util.hpp"
 #include "output.hpp"
 
 TEST(PolygonOutput, ShapesCarryTrueOutlines) {
   // A hexagon and a disk: the shapes file has one cell each, the hexagon's
   // six points at its vertices (read back through VTK's XML reader).
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("cd_shapes_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = cdtest::scratch_dir("test_polygon", "shapes");  // not /tmp: kept by a failure
   cd::World w(params(1e-3, 9.81, 0.4));
   const int h = w.bodies.add_polygon({0.0, 2.0}, 0.5, 6, 0.3, 1.0);
   w.bodies.add_disk({3.0, 2.0}, 0.5, 1.0);

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
 
 #include "checkpoint.hpp"
+#include "cli_util.hpp"
 #include "config.hpp"
 #include "run_plan.hpp"
 #include "setup.hpp"
@@ -149,8 +149,7 @@ TEST(PrepHardCases, Ratio4HexagonsCompactWithoutOverlap) {
 // the overlaps stay below 1 % of the smaller grain at every step.
 TEST(PrepHardCases, Ratio4ShearFromTheSampleKeepsOverlapsBounded) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("cd_prep4_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = cdtest::scratch_dir("test_prep_overlap", "ratio4");  // not /tmp: kept by a failure
   const std::string ckpt = (dir / "checkpoint.bin").string();
   {
     const cd::Scene s = ratio4_prep(200, "[0]");

@@ -4,7 +4,6 @@
 // sample, determinism (threads, checkpoint), wall-driven shear, bad scenes.
 #include <gtest/gtest.h>
 #include <omp.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,6 +16,7 @@
 #include <vector>
 
 #include "checkpoint.hpp"
+#include "cli_util.hpp"
 #include "config.hpp"
 #include "detect.hpp"
 #include "regress_ref.hpp"
@@ -28,13 +28,9 @@ using cd::Vec2;
 
 namespace {
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("cdlab_shear_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+// In the build folder (cdtest::scratch_dir), not /tmp, where each run of the
+// suite left a cdlab_shear_pressure_* folder behind.
+fs::path temp_dir(const std::string& name) { return cdtest::scratch_dir("test_shear", name); }
 
 Vec2 momentum(const cd::World& w) {
   Vec2 p = Vec2::Zero();
