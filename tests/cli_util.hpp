@@ -1,7 +1,10 @@
 // Runs a command line and collects its exit code and output (stdout and
 // stderr), for the tests that drive the executables as a user would.
 #pragma once
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -10,6 +13,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace cdtest {
 
@@ -41,6 +45,32 @@ inline std::filesystem::path scratch_dir(const std::string& test, const std::str
   std::filesystem::remove_all(p);
   std::filesystem::create_directories(p);
   return p;
+}
+
+// Starts args[0] with the arguments args, without waiting, its stdout and
+// stderr to the file `out` (/dev/null if empty); own_group: in a process
+// group of its own (its pid), as a command run under GNU timeout, so that a
+// signal can be sent as timeout sends it. Returns its pid, or -1.
+inline pid_t spawn(std::vector<std::string> args, const std::string& out = "", bool own_group = false) {
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, out.empty() ? "/dev/null" : out.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  posix_spawnattr_t at;
+  posix_spawnattr_init(&at);
+  if (own_group) {
+    posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&at, 0);
+  }
+  pid_t pid;
+  const int rc = posix_spawn(&pid, argv[0], &fa, &at, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  posix_spawnattr_destroy(&at);
+  return rc == 0 ? pid : -1;
 }
 
 }  // namespace cdtest

@@ -2,10 +2,8 @@
 // bit-identical to one never stopped, in the library (state hash) and through
 // cdsim killed with SIGKILL mid-run and run again (every output compared);
 // damaged checkpoints and checkpoints of another scene are refused clearly.
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -284,17 +282,8 @@ TEST(CdsimRestart, KilledRunResumesBitIdentical) {
   // past it, so that the restart must also drop rows written after it.
   const fs::path B = d / "B";
   const std::string out_b = B.string();
-  std::vector<std::string> args = {kCdsim, scene.string(), "--quiet", "--out", out_b};
-  std::vector<char*> argv;
-  for (auto& s : args) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
-  pid_t pid;
-  ASSERT_EQ(posix_spawn(&pid, kCdsim.c_str(), &fa, nullptr, argv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&fa);
+  const pid_t pid = cdtest::spawn({kCdsim, scene.string(), "--quiet", "--out", out_b});
+  ASSERT_GT(pid, 0);
   const long first_ckpt = 250;  // checkpoint_interval / dt
   const auto t0 = std::chrono::steady_clock::now();
   int status = 0;
@@ -349,25 +338,10 @@ TEST(CdsimRestart, KilledRunResumesBitIdentical) {
 
 // ---- a campaign run killed at half its length ---------------------------------
 
-// Spawns `args` (output to /dev/null); returns its pid, or -1.
-pid_t spawn(std::vector<std::string> args) {
-  std::vector<char*> argv;
-  for (auto& s : args) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
-  pid_t pid;
-  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  return rc == 0 ? pid : -1;
-}
-
 // Spawns `args` and sends it `sig` as soon as `ready()` holds; returns its
 // wait status, or -1 if it ended first.
 int run_and_signal_when(std::vector<std::string> args, const std::function<bool()>& ready, int sig) {
-  const pid_t pid = spawn(std::move(args));
+  const pid_t pid = cdtest::spawn(std::move(args));
   if (pid < 0) return -1;
   const auto t0 = std::chrono::steady_clock::now();
   int status = 0;
@@ -728,7 +702,7 @@ TEST(CdsimRestart, ASecondCdsimOnAHeldFolderIsRefused) {
   const fs::path d = temp_dir("lock");
   const fs::path scene = d / "s.toml", B = d / "B";
   spit(scene, kPile);
-  const pid_t pid = spawn({kCdsim, scene.string(), "--quiet", "--threads", "1", "--out", B.string()});
+  const pid_t pid = cdtest::spawn({kCdsim, scene.string(), "--quiet", "--threads", "1", "--out", B.string()});
   ASSERT_GT(pid, 0);
   const auto t0 = std::chrono::steady_clock::now();
   while (row_steps(B / "series.csv").size() < 2 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
@@ -761,7 +735,7 @@ TEST(CdsimRestart, TwoCdsimStartedTogetherOneRuns) {
   spit(scene, kPile);
   const std::vector<std::string> args = {kCdsim, scene.string(), "--quiet", "--threads", "1", "--set",
                                          "time.duration=0.05", "--out", B.string()};
-  const pid_t p1 = spawn(args), p2 = spawn(args);
+  const pid_t p1 = cdtest::spawn(args), p2 = cdtest::spawn(args);
   ASSERT_GT(p1, 0);
   ASSERT_GT(p2, 0);
   int s1 = 0, s2 = 0;
