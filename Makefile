@@ -52,7 +52,7 @@ help:
 	@echo "  make accuracy-cost   eps_f, dt and N against cost and error (outputs/accuracy-cost/; QUICK=1: ~30 s);"
 	@echo "                       3D: polyhedral-cone Lemke against e and the exact NLGS (outputs/accuracy-cost/3d/)"
 	@echo "  make accuracy-shear  solver settings against steady mu*, phi, z and cost in shear (ACC/; hours)"
-	@echo "  make accuracy-shear3 3D shear settings against a tight reference over 3 samples (A3_DIR; ~2 CPU hours)"
+	@echo "  make accuracy-shear3  3D shear settings against a tight reference over 3 samples (A3_DIR; ~2 CPU hours)"
 	@echo "  make tensile         tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
 	@echo "  make compare-liggghts-shear  a 1000-sphere mu(I) point by LIGGGHTS and cdsim, one thread each: CPU per"
 	@echo "                       unit strain, sweeps, mu, phi, z, the ratio (CMP_DIR; QUICK=1: strain 0.3)"
@@ -81,7 +81,7 @@ help:
 	@echo "  make campaign-list CAMPAIGN=inertial      the run folders of a campaign (configs/cluster/job-array.sh)"
 	@echo "  make campaign-prep-of RUN=<run folder>    the sample that run starts from"
 	@echo "  make regress-campaign, regress3-campaign  the reference campaigns of make regress"
-	@echo "  make frozen-shear-runs, accuracy-shear-runs  the runs of make frozen-shear, make accuracy-shear"
+	@echo "  make frozen-shear-runs, accuracy-shear-runs, accuracy-shear3-runs  the runs of make frozen-shear, make accuracy-shear, make accuracy-shear3"
 	@echo "  make frozen-shear3-run  the run of make frozen-shear3 (its sample, then the shear)"
 	@echo "Variables (make TARGET VAR=value ...), with their values now"
 	$(call help_var,SCENE,the scene of make run)
@@ -132,7 +132,14 @@ help:
 	$(call help_var,FS3_N,spheres of make frozen-shear3)
 	$(call help_var,FS3_STRAIN,its strain at I = 1e-2 (the step dumped: the last))
 	$(call help_var,ACC,make accuracy-shear's folder)
-	$(call help_var,A3_DIR,make accuracy-shear3's folder (A3_SEEDS, A3_I, A3_SETTINGS, A3_STRAIN: the Makefile))
+	$(call help_var,A3_DIR,make accuracy-shear3's folder)
+	$(call help_var,A3_N,its spheres)
+	$(call help_var,A3_SEEDS,its samples' particles.seed)
+	$(call help_var,A3_I,the inertial number its settings continue at)
+	$(call help_var,A3_SETTINGS,its settings (a3_set_<name> in the Makefile; the first is the reference))
+	$(call help_var,A3_START,the strain at I = 0.01 of the common start)
+	$(call help_var,A3_STRAIN,each setting's strain from there)
+	$(call help_var,A3_W0,its window: continuation strain from)
 	$(call help_var,ACC_N,its grains)
 	$(call help_var,ACC_SHAPES,its shapes)
 	$(call help_var,ACC_I,its inertial numbers)
