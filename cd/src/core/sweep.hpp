@@ -14,6 +14,10 @@
 //   void update(Row& r, double& dp2, double& pabs)
 //       one local solve of row r with law L; dp2 = |dp|^2, pabs = |p|.
 //       Write1 = false when body 1 is driven (read, never written).
+//       A coupling with `static constexpr bool kNormBound = true` gives in
+//       pabs a cheap upper bound of |p| instead (3D: |p_n| + |p_t1| +
+//       |p_t2|, no square root); the sweep then sums the exact |p| only on
+//       the sweeps where the bound cannot rule the stop out (LazyNorm).
 // and the row type provides, found by argument-dependent lookup,
 //   double row_residual(const C& c, const Row& r)   the law residual of r
 //   double impulse_norm(const Row& r)               |p| of r
@@ -263,6 +267,40 @@ bool end_sweep(int it, double dsum, double psum, int n, Row* R, std::vector<Dof>
   return it >= prm.max_iter || (st.dp_rel < prm.tol && st.dof_rel < prm.tol);
 }
 
+// The scale of the convergence test, mean |p|, for couplings whose row
+// update returns a bound of |p| (kNormBound): a sweep's bound sum B >= the
+// exact sum P, so when rms |dp| >= tol B / n the test fails at P as well and
+// P is not needed. Otherwise (and on every sweep an observer watches, and
+// after the last) P is summed by impulse_norm in the sweep's own blocks and
+// order, so it is the sum the update's |p| would have given, bit for bit:
+// the stop, dp_rel and p_mean are exactly those of the plain sum.
+template <class C>
+constexpr bool norm_bound() {
+  if constexpr (requires { C::kNormBound; })
+    return C::kNormBound;
+  else
+    return false;
+}
+
+template <class Row>
+double exact_psum(const std::vector<RowBlock>& blocks, const Row* R) {
+  double psum = 0;
+  for (const RowBlock& k : blocks) {
+    double s = 0;
+    for (int i = k.begin; i < k.end; ++i) s += impulse_norm(R[i]);
+    psum += s;
+  }
+  return psum;
+}
+
+// True when the bound sums (dsum, bsum over n rows) leave the stop open.
+inline bool bound_leaves_stop_open(double dsum, double bsum, int n, double tol) {
+  const double scale = bsum > 0 ? bsum / n : 1.0;
+  // 1e-9: the bound's own round-off (each row's |p_n| + |p_t1| + |p_t2| >=
+  // its computed norm to a few ulps), kept far on the safe side.
+  return std::sqrt(dsum / n) / scale < tol * (1.0 + 1e-9);
+}
+
 template <class L, class Row, class C, class Dof>
 SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const SolverParams& prm,
                  std::vector<Dof>* dofs, const SweepObserver& observer) {
@@ -285,6 +323,8 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
   const bool parallel = n >= prm.min_parallel;
   bool done = false;
   int it = 0;
+  bool psum_exact = true;  // kNormBound: was the last sweep's |p| sum exact
+  double last_dsum = 0;
   // Anderson acceleration (off unless asked and the coupling can take it).
   std::optional<Anderson<impulse_dim<C>()>> acc;
   if constexpr (AddsImpulse<C, Row>) {
@@ -320,6 +360,11 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
           dsum += bs[b].dp2sum;
           psum += bs[b].psum;
         }
+        if constexpr (norm_bound<C>()) {
+          psum_exact = observer || it + 1 >= prm.max_iter || bound_leaves_stop_open(dsum, psum, n, prm.tol);
+          if (psum_exact) psum = exact_psum(blocks, R);
+          last_dsum = dsum;
+        }
         done = end_sweep(++it, dsum, psum, n, R, dofs, prm, observer, st);
         // The optional second criterion: the law residual itself, checked
         // every kResidualEvery sweeps (a read-only pass over the rows, on
@@ -340,6 +385,13 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
     }
   }
 
+  if constexpr (norm_bound<C>()) {
+    if (!psum_exact) {  // stopped by the law residual on a sweep the bound ruled out: the exact figures
+      const double p_mean = exact_psum(blocks, R) / n;
+      st.p_mean = p_mean;
+      st.dp_rel = std::sqrt(last_dsum / n) / (p_mean > 0 ? p_mean : 1.0);
+    }
+  }
   residuals(rows, c, prm.min_parallel, st);
   st.cap_hit = not_converged(st, prm);
   return st;
@@ -355,6 +407,7 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
 template <class Row, class C, class Dof, class Update>
 SolveStats solve_units(std::vector<Row>& rows, int units, const C& c, const SolverParams& prm,
                        std::vector<Dof>* dofs, const SweepObserver& observer, Update&& update) {
+  static_assert(!norm_bound<C>(), "solve_units sums the update's pabs as |p|: not for kNormBound couplings");
   if (rows.empty()) return no_rows(dofs);
   SolveStats st;
   const int n = static_cast<int>(rows.size());
