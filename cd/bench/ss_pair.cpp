@@ -344,6 +344,7 @@ SweepStats sweep_solve(std::vector<cd::ContactRow>& rows, std::vector<cd::BodyVe
   const cd::sweep::BodyCoupling<true> c{vel.data()};
   const auto row = [&](cd::ContactRow& r, double& dp2, double& pabs) {
     c.update<cd::Coulomb, true>(r, dp2, pabs);
+    pabs = cd::impulse_norm(r);  // the update gives a bound (kNormBound); solve_units sums |p|
   };
   out.st = cd::sweep::solve_units(
       rows, static_cast<int>(U.u.size()), c, prm, static_cast<std::vector<cd::BoundaryDof>*>(nullptr), {},

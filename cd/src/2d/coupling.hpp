@@ -33,6 +33,9 @@ struct BodyCoupling {
   // thread; a driven body has zero inverse mass and inertia, so it is not
   // moved).
   static constexpr int kImpulseDim = 2;
+  // update's pabs is |p_n| + |p_t|, a bound of |p| without the square root:
+  // the sweep sums the exact |p| only when the stop may come (core/sweep.hpp).
+  static constexpr bool kNormBound = true;
   void read_impulse(const ContactRow& r, double* x) const {
     x[0] = r.pn;
     x[1] = r.pt;
@@ -76,7 +79,7 @@ struct BodyCoupling {
     r.pn = pn;
     if constexpr (L::tangential) {
       r.pt = pt;
-      pabs = std::sqrt(pn * pn + pt * pt);
+      pabs = std::abs(pn) + std::abs(pt);  // >= |p|: kNormBound
     } else {
       pabs = std::abs(pn);
     }

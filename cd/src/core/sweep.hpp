@@ -400,14 +400,13 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
 // Sequential symmetric Gauss-Seidel over `units` groups of rows in the
 // caller's order, for studies that visit rows in their own order
 // (cd/bench/ss_pair: a side-side pair as one block): update(k, backward,
-// dp2, pabs) updates unit k (dp2 and pabs summed over its rows, as a row
-// update gives them); units go forward on odd sweeps, backward on even ones,
-// and dp2, pabs are summed in visiting order. The convergence test, the
+// dp2, pabs) updates unit k (dp2 and pabs summed over its rows, pabs the
+// exact |p| also for a kNormBound coupling's rows); units go forward on odd
+// sweeps, backward on even ones, and dp2, pabs are summed in visiting order. The convergence test, the
 // dofs, the observer and the residuals are solve's. One thread.
 template <class Row, class C, class Dof, class Update>
 SolveStats solve_units(std::vector<Row>& rows, int units, const C& c, const SolverParams& prm,
                        std::vector<Dof>* dofs, const SweepObserver& observer, Update&& update) {
-  static_assert(!norm_bound<C>(), "solve_units sums the update's pabs as |p|: not for kNormBound couplings");
   if (rows.empty()) return no_rows(dofs);
   SolveStats st;
   const int n = static_cast<int>(rows.size());
