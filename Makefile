@@ -267,8 +267,8 @@ tensile: build
 # preparations (configs/shear-prep.toml, cell sized for the grains) at N =
 # PO_N, one thread each, run by cdsim into outputs/prep-overlap/<i>/. Each
 # series row's max_overlap_small is the largest over the row's steps, so the
-# check against 0.01 covers every step. About 1 (disks) to 4 (hexagons)
-# minutes each at 1000.
+# check against 0.01 covers every step. About 10 (disks) to 25 (hexagons)
+# CPU seconds each at 1000 (each stops when jammed: shear.settle_*).
 PO_N ?= 1000
 PO_DIR ?= outputs/prep-overlap
 prep-overlap: build
@@ -422,9 +422,9 @@ $(manifest_checks): $(CAMPAIGNS)/%/.manifest-check:
 # The campaigns asked on the command line: checked before a sample is made.
 goal_manifests = $(foreach c,$(filter-out list prep-of status,$(patsubst campaign-%,%,$(filter campaign-%,$(MAKECMDGOALS)))),$(CAMPAIGNS)/$(c)/.manifest-check)
 
-# Compacted samples: disks (ns_0) or n-gons, N grains, isotropic at P
-# (3D: spheres, compacted at 0.05 / t_p until jammed at p, the scene's stop
-# rule shear.settle_*; PREP_SET adds settings).
+# Compacted samples: disks (ns_0) or n-gons, N grains, isotropic at P,
+# compacted at 0.01 / t_p (3D: spheres, at 0.05 / t_p) until jammed at p,
+# the scenes' stop rule shear.settle_*; PREP_SET adds settings.
 PREP_SET ?=
 $(CAMPAIGNS)/prep/ns_%/.done: | programs $(CAMPAIGNS)/prep/.manifest-check $(goal_manifests)
 	$(CDSIM) $(PREP_SCENE) --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_strain=0 \
@@ -534,8 +534,9 @@ FS_SHAPES ?= 0 6
 FS_STRAIN ?= 0.5
 FS_QS_STRAIN ?= 0.02
 FS_GAP ?= 50
-# The compaction only has to give a jammed sample to shear: at the campaign's
-# 1e-4 the hexagons' prep sits at the 2000-sweep cap on most steps.
+# The compaction only has to give a jammed sample to shear: at 1e-4 the
+# hexagons' prep sat at the 2000-sweep cap on most steps (1e-3 is now
+# configs/shear-prep.toml's own; kept explicit, as the problems were made).
 FS_PREP_SET ?= --set solver.tol=1e-3
 .PHONY: frozen-shear frozen-shear-runs
 frozen-shear: build

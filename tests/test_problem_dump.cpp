@@ -113,8 +113,10 @@ TEST(ProblemDump, ShearStepWithBoundaryDofReplaysBitForBitAndAsAMatrix) {
                              {"particles.n=120", "shear.width=0.0165", "shear.height=0.0185",
                               "shear.isotropic=false", "shear.inertial_number=0.1",
                               "solver.tol=1e-3",
-                              // a shear step: without the preparation's compaction bound
-                              "shear.compaction_rate=0", "contact.overlap_projection=0"},
+                              // a shear step: without the preparation's compaction bound,
+                              // projection and stop rule
+                              "shear.compaction_rate=0", "contact.overlap_projection=0",
+                              "shear.settle_stress=0", "shear.settle_phi=0", "shear.settle_time=0"},
                              150);
   ASSERT_EQ(c.problem.dofs.size(), 1u);
   EXPECT_GT(c.problem.dofs[0].rows.size(), 3u);

@@ -99,8 +99,10 @@ const std::vector<Case>& cases() {
       {"lees_edwards", "shear-prep.toml",
        {"particles.n=120", "shear.width=0.0165", "shear.height=0.0185", "shear.isotropic=false",
         "shear.inertial_number=0.1", "solver.tol=1e-3",
-        // a shear run: without the preparation's compaction bound and projection
-        "shear.compaction_rate=0", "contact.overlap_projection=0"},
+        // a shear run: without the preparation's compaction bound, projection
+        // and stop rule
+        "shear.compaction_rate=0", "contact.overlap_projection=0", "shear.settle_stress=0",
+        "shear.settle_phi=0", "shear.settle_time=0"},
        // changed with the kinetic stress about the grains' own profile (as above)
        120, 0x5f18b3d49377be18ull},
       // The walls scenes changed with the mu_wall fix (a driven body is now
