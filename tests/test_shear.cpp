@@ -573,9 +573,9 @@ TEST(Determinism, PeriodicShearIsThreadCountAndRestartIndependent) {
 
 TEST(Walls, TopWallSettlesAtThePressureAndMovesAtTheImposedVelocity) {
   // 100 disks between rough walls (rows of 16 glued grains, 16 d long),
-  // loose at first (gap 17 d): the top wall falls under p to ~7.4 d within
-  // ~250 steps, then shears the layer at gamma-dot: the top wall's speed is
-  // gamma-dot times the current gap.
+  // loose at first (gap 17 d): the top wall falls under p to ~7.4 d, by at
+  // most 0.025 d a step (landing near step 400), then shears the layer at
+  // gamma-dot: the top wall's speed is gamma-dot times the current gap.
   const double W = 0.016, H0 = 0.017, I = 0.05;
   const std::string text = "name = \"walls\"\n[time]\nduration = 1.0\n" + common_keys() +
       "[particles]\nn = 100\nd_mean = 1e-3\nsize_ratio = 2.0\ndensity = 2.6\n"
@@ -596,7 +596,7 @@ TEST(Walls, TopWallSettlesAtThePressureAndMovesAtTheImposedVelocity) {
       bottom0.push_back(w.bodies.pos[i]);
     }
   ASSERT_EQ(bottom.size(), 16u);
-  const int n = 1500, settle = 400;
+  const int n = 1700, settle = 600;
   std::vector<double> syy, hs, hd;
   double travel = 0;  // the top wall's imposed x travel: sum of gamma-dot H dt
   Effort e;
@@ -625,10 +625,10 @@ TEST(Walls, TopWallSettlesAtThePressureAndMovesAtTheImposedVelocity) {
               I, n, settle, w.cell.strain - T * gd, w.cell.strain, my, ey, mh / kD, eh / kD, H0 / kD,
               md, ed, md / (gd * mh), md * T / kD, double(e.iterations) / e.steps, e.cap_hits,
               e.max_overlap);
-  // sigma_yy: measured -0.1 % (block error 0.5 %); the acceptance is 5 %.
+  // sigma_yy: measured +0.4 % (block error 0.9 %); the acceptance is 5 %.
   EXPECT_NEAR(my, kP, 0.05 * kP);
   // Settled: over the steady part the gap moves by less than 0.5 d (it fell
-  // by ~10 d before; measured 0.02 d, with fluctuations of ~0.2 d), i.e.
+  // by ~10 d before; measured 0.075 d, with fluctuations of ~0.2 d), i.e.
   // |mean dH/dt| < 0.5 d / T.
   EXPECT_LT(std::abs(md) * T, 0.5 * kD);
   // The top wall's grains move together, at the imposed x velocity and the
@@ -640,6 +640,52 @@ TEST(Walls, TopWallSettlesAtThePressureAndMovesAtTheImposedVelocity) {
     EXPECT_NEAR(w.bodies.pos[t].y(), w.cell.height, 1e-12);
   }
   for (std::size_t k = 0; k < bottom.size(); ++k) EXPECT_EQ(w.bodies.pos[bottom[k]], bottom0[k]);
+  EXPECT_LT(e.max_overlap, 0.01);
+  EXPECT_EQ(e.cap_hits, 0);
+}
+
+// A loose sample far below the top wall (40 disks on a lattice 11 d tall
+// in a 30 d gap, jammed at 5.3 d): under p alone the wall would fall at
+// p W / M the whole way (unbounded, measured on this scene before the
+// bound: it landed at 0.50 d a step, five times the alert distance, with an
+// overlap of 0.096 d). It falls by at most a quarter of the alert distance
+// a step (WallShear::set_dofs), reaches that bound, and lands without that
+// overlap, holding p.
+TEST(Walls, TopWallFallsAtMostAQuarterOfTheAlertDistanceAStep) {
+  const double W = 0.008, H0 = 0.03;
+  const std::string text = "name = \"fall\"\n[time]\nduration = 1.0\n" + common_keys() +
+      "[particles]\nn = 40\nd_mean = 1e-3\nsize_ratio = 2.0\ndensity = 2.6\n"
+      "[shear]\nmode = \"walls\"\nwidth = " + std::to_string(W) + "\nheight = " + std::to_string(H0) +
+      "\npressure = 100.0\ndt_tp = 0.05\n";
+  cd::World w = cd::build_world(cd::parse_scene(text, "fall.toml"));
+  const double bound = 0.25 * 0.1 * kD;  // a quarter of the alert distance (0.1 d)
+  const int n = 1600, tail = 200;
+  double fall_max = 0;
+  int first_at_bound = -1;
+  std::vector<double> syy;
+  Effort e;
+  for (int k = 0; k < n; ++k) {
+    const double h = w.cell.height;
+    w.step();
+    e.add(w);
+    const double fall = h - w.cell.height;
+    ASSERT_LE(fall, bound * (1 + 1e-9)) << "step " << k;
+    if (fall >= bound * (1 - 1e-9) && first_at_bound < 0) first_at_bound = k;
+    fall_max = std::max(fall_max, fall);
+    if (k >= n - tail) syy.push_back(w.contact_stress(W * w.cell.height)(1, 1));
+  }
+  const auto [my, ey] = block_mean(syy, 5);
+  std::printf("[ walls ] fall onto a loose sample: at most %.4f d a step (bound %.4f d, reached at step "
+              "%d), gap %.1f -> %.2f d; sigma_yy %.2f +- %.2f over the last %d steps; max overlap "
+              "%.1e d\n",
+              fall_max / kD, bound / kD, first_at_bound, H0 / kD, w.cell.height / kD, my, ey, tail,
+              e.max_overlap);
+  // The bound was what held the wall (it would have gone faster).
+  EXPECT_GE(first_at_bound, 0);
+  // Landed: at rest on the sample, holding p (the acceptance of the walls
+  // test above), without the overlap of the unbounded landing.
+  EXPECT_LT(w.cell.height, 0.5 * H0);
+  EXPECT_NEAR(my, kP, 0.05 * kP);
   EXPECT_LT(e.max_overlap, 0.01);
   EXPECT_EQ(e.cap_hits, 0);
 }
@@ -678,6 +724,10 @@ TEST(BadInput, ShearScenesNameTheKeyAtFault) {
       {"isotropic with shear",
        no_g + disks + ok_shear + "pressure = 100.0\ninertial_number = 0.01\nisotropic = true\n",
        {"shear.isotropic"}},
+      {"walls without an alert distance",
+       no_g + disks + "[contact]\nalert = 0.0\n[shear]\nmode = \"walls\"\nwidth = 0.02\nheight = 0.02\n"
+       "pressure = 100.0\n",
+       {"contact.alert", "shear.mode = \"walls\"", "quarter of the alert distance"}},
       {"isotropic walls",
        no_g + disks + "[shear]\nmode = \"walls\"\nwidth = 0.02\nheight = 0.02\nisotropic = true\n",
        {"shear.isotropic"}},

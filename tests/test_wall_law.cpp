@@ -63,14 +63,16 @@ TEST(WallLaw, MuWallActsOnContactsWithADrivenBodyWhicheverComesFirst) {
 // Wall-driven shear of hexagons between rough walls (configs/shear-walls.toml,
 // smaller) with mu_wall = 0.1 < mu = 0.4: every contact with a glued grain
 // obeys |p_t| <= mu_wall p_n, some slide at that bound (the walls drag the
-// sample), and grain-grain contacts use mu (some exceed mu_wall).
+// sample), and grain-grain contacts use mu (some exceed mu_wall). The top
+// wall starts just above the grains (height 0.0135): it falls by at most a
+// quarter of the alert distance a step, and loads the sample in 300 steps.
 TEST(WallLaw, RoughWallShearUsesTheScenesWallFriction) {
   const cd::Scene s =
       cd::load_scene(std::string(CDLAB_SOURCE_DIR) + "/configs/shear-walls.toml",
-                     {"particles.n=80", "shear.width=0.012", "contact.mu_wall=0.1",
+                     {"particles.n=80", "shear.width=0.012", "shear.height=0.0135", "contact.mu_wall=0.1",
                       "solver.tol=1e-6", "solver.max_iter=20000"});
   cd::World w = cd::build_world(s);
-  for (int k = 0; k < 150; ++k) w.step();
+  for (int k = 0; k < 300; ++k) w.step();
   int wall_rows = 0, wall_sliding = 0, grain_above = 0;
   double wall_ratio_max = 0, grain_ratio_max = 0;
   for (const cd::ContactRow& r : w.rows()) {

@@ -13,14 +13,20 @@
 
 namespace cd::cell_dof {
 
+// The fastest approach a pressure-driven boundary may make: a quarter of
+// the alert distance a step, so that what it closes on comes within the
+// alert distance a step or more before they touch and those contacts are
+// detected before they close. (The 2D top wall always, the periodic cells'
+// lengths with the compaction brake.)
+inline double approach_floor(double alert, double dt) { return -0.25 * alert / dt; }
+
 // Lower bound of the free velocity of a length L with the compaction brake
 // (shear.compaction_rate): -min(rate L, alert / (4 dt)): the cell shrinks at
 // most at the strain rate `rate`, and by a quarter of the alert distance a
-// step, so that the images approach the grains across the boundary by well
-// under the alert distance in a step and those contacts are detected before
-// they close. rate = 0: no bound (-inf).
+// step (approach_floor: the images approach the grains across the boundary
+// by well under the alert distance in a step). rate = 0: no bound (-inf).
 inline double floor(double rate, double L, double alert, double dt) {
-  return rate > 0.0 ? -std::min(rate * L, 0.25 * alert / dt) : -std::numeric_limits<double>::infinity();
+  return rate > 0.0 ? std::max(-rate * L, approach_floor(alert, dt)) : -std::numeric_limits<double>::infinity();
 }
 
 // Free velocity of a length of mass M whose velocity at the start of the
