@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "cell_dof.hpp"
+#include "projection_trigger.hpp"
 
 namespace cd {
 
@@ -225,30 +226,24 @@ void World::integrate() {
 // smallest mass-weighted displacement that removes the fraction beta_p of
 // every overlap; dt times it goes into the midpoint positions (and the
 // cell), never into the velocities: no kinetic energy is put in. Run only
-// on steps where some overlap reaches kProjectionTrigger of its pair's
+// on steps where some overlap reaches projection::kTrigger of its pair's
 // smaller diameter (the solve costs sweeps, and on every step it would keep
 // a jammed sample's main solve from settling: measured, 313 instead of 210
 // main-solve sweeps a step at ratio 4, N = 300, beta_p = 0.2); at most
-// kProjectionSweeps sweeps, which are not in StepStats (their time is in
+// projection::kSweeps sweeps, which are not in StepStats (their time is in
 // the integrate stage's).
 void World::project_overlaps() {
-  constexpr int kProjectionSweeps = 100;
   last_.projection_work = 0.0;
   const std::size_t nr = prob_.rows.size();
-  // Only when some overlap reaches kProjectionTrigger of the smaller grain's
-  // diameter of its pair (a wall's grain's): below it, overlaps are left.
-  constexpr double kProjectionTrigger = 1e-3;
-  bool due = false;
-  for (std::size_t k = 0; k < nr && !due; ++k) {
-    if (info_[k].gap >= 0.0) continue;
+  // The pair's smaller grain's diameter (a wall's grain's).
+  const auto smaller = [&](std::size_t k) {
     const ContactRow& r = prob_.rows[k];
     const bool s1 = bodies.shape[r.b1] == Shape::Segment, s2 = bodies.shape[r.b2] == Shape::Segment;
-    const double d = 2.0 * (s1 ? bodies.radius[r.b2]
-                               : s2 ? bodies.radius[r.b1]
-                                    : std::min(bodies.radius[r.b1], bodies.radius[r.b2]));
-    due = -info_[k].gap >= kProjectionTrigger * d;
-  }
-  if (!due) return;
+    return 2.0 * (s1 ? bodies.radius[r.b2]
+                     : s2 ? bodies.radius[r.b1]
+                          : std::min(bodies.radius[r.b1], bodies.radius[r.b2]));
+  };
+  if (!projection::due(nr, [&](std::size_t k) { return info_[k].gap; }, smaller)) return;
   const double beta = prm_.overlap_projection, dt = prm_.dt;
   ContactProblem& q = proj_;
   q.rows = prob_.rows;
@@ -260,13 +255,13 @@ void World::project_overlaps() {
   for (std::size_t k = 0; k < nr; ++k) {
     ContactRow& r = q.rows[k];
     const double g = info_[k].gap;
-    r.bn = g < 0.0 ? beta * g / dt : g / dt;
+    r.bn = projection::offset(g, beta, dt);
     r.bt = r.pn = r.pt = r.mu = r.adh = 0.0;
   }
   q.dofs = prob_.dofs;
   std::visit([&](const auto& b) { b.pseudo_dofs(q.dofs); }, boundary_);
   SolverParams sp = prm_.solver;
-  sp.max_iter = std::min(sp.max_iter, kProjectionSweeps);
+  sp.max_iter = std::min(sp.max_iter, projection::kSweeps);
   sp.residual_tol = 0.0;
   nlgs_solve(q, sp);
   // The contact forces' work on the displacements: sum f_n (dt u_n).

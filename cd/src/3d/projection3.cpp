@@ -9,26 +9,21 @@
 // (StepStats::projection_work). Rotations: a sphere's gap does not depend on
 // its orientation and frictionless rows carry no tangential impulse, so the
 // pseudo-problem never turns a sphere.
+#include "projection_trigger.hpp"
 #include "world3.hpp"
 
 namespace cd {
 
 void World3::project_overlaps() {
-  constexpr int kProjectionSweeps = 100;
-  // Only when some overlap reaches kProjectionTrigger of its pair's smaller
-  // diameter (a plane's sphere's): below it, overlaps are left as they are.
-  constexpr double kProjectionTrigger = 1e-3;
   last_.projection_work = 0.0;
   const std::size_t nr = prob_.rows.size();
-  bool due = false;
-  for (std::size_t k = 0; k < nr && !due; ++k) {
-    if (info_[k].gap >= 0.0) continue;
+  // The pair's smaller diameter (a plane's sphere's).
+  const auto smaller = [&](std::size_t k) {
     const SphereRow& r = prob_.rows[k];
     const double r1 = bodies.radius[r.b1], r2 = bodies.radius[r.b2];
-    const double d = 2.0 * (r1 <= 0.0 ? r2 : r2 <= 0.0 ? r1 : std::min(r1, r2));
-    due = -info_[k].gap >= kProjectionTrigger * d;
-  }
-  if (!due) return;
+    return 2.0 * (r1 <= 0.0 ? r2 : r2 <= 0.0 ? r1 : std::min(r1, r2));
+  };
+  if (!projection::due(nr, [&](std::size_t k) { return info_[k].gap; }, smaller)) return;
   const double beta = prm_.overlap_projection, dt = prm_.dt;
   ContactProblem3& q = proj_;
   q.rows = prob_.rows;
@@ -40,14 +35,14 @@ void World3::project_overlaps() {
   for (std::size_t k = 0; k < nr; ++k) {
     SphereRow& r = q.rows[k];
     const double g = info_[k].gap;
-    r.bn = g < 0.0 ? beta * g / dt : g / dt;
+    r.bn = projection::offset(g, beta, dt);
     r.r = Vec3::Zero();
     r.mu = r.adh = 0.0;
   }
   q.dofs = prob_.dofs;
   for (CellDof3& d : q.dofs) d.v0 = d.v = 0.0;
   SolverParams sp = prm_.solver;
-  sp.max_iter = std::min(sp.max_iter, kProjectionSweeps);
+  sp.max_iter = std::min(sp.max_iter, projection::kSweeps);
   sp.residual_tol = 0.0;
   sp.anderson = 0;
   nlgs_solve3(q, sp);

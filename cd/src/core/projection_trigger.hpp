@@ -1,0 +1,37 @@
+// When the overlap projection runs, and for how long: the rule 2D's
+// World::project_overlaps (2d/world.cpp) and 3D's World3::project_overlaps
+// (3d/projection3.cpp) share. Each dimension keeps its own rows and its own
+// notion of a pair's smaller diameter (a wall's or plane's grain's); the
+// numbers go through here, so that the two project on the same steps.
+#pragma once
+#include <cstddef>
+
+namespace cd::projection {
+
+// At most this many sweeps of the projection's solve (they are not in
+// StepStats; their time is in the integrate stage's).
+constexpr int kSweeps = 100;
+
+// The projection runs only on a step where some overlap reaches kTrigger
+// of its pair's smaller diameter: below it, overlaps are left as they are
+// (the solve costs sweeps, and on every step it would keep a jammed
+// sample's main solve from settling).
+constexpr double kTrigger = 1e-3;
+
+// Whether the step is due: some row k < n whose midpoint gap(k) < 0 is an
+// overlap of at least kTrigger times diameter(k), its pair's smaller
+// diameter (asked only of overlapping rows).
+template <class Gap, class Diameter>
+bool due(std::size_t n, Gap&& gap, Diameter&& diameter) {
+  for (std::size_t k = 0; k < n; ++k) {
+    const double g = gap(k);
+    if (g < 0.0 && -g >= kTrigger * diameter(k)) return true;
+  }
+  return false;
+}
+
+// The pseudo-velocity a row's gap g asks for: open an overlap by beta of
+// it in the step (u_n >= beta |g| / dt), and close no open gap (u_n >= -g / dt).
+inline double offset(double g, double beta, double dt) { return g < 0.0 ? beta * g / dt : g / dt; }
+
+}  // namespace cd::projection
