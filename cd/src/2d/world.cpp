@@ -263,6 +263,7 @@ void World::project_overlaps() {
   SolverParams sp = prm_.solver;
   sp.max_iter = std::min(sp.max_iter, projection::kSweeps);
   sp.residual_tol = 0.0;
+  sp.anderson = 0;  // plain NLGS for the pseudo-velocities, as in 3D (projection3.cpp)
   nlgs_solve(q, sp);
   // The contact forces' work on the displacements: sum f_n (dt u_n).
   double work = 0.0;
