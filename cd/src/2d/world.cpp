@@ -260,11 +260,7 @@ void World::project_overlaps() {
   }
   q.dofs = prob_.dofs;
   std::visit([&](const auto& b) { b.pseudo_dofs(q.dofs); }, boundary_);
-  SolverParams sp = prm_.solver;
-  sp.max_iter = std::min(sp.max_iter, projection::kSweeps);
-  sp.residual_tol = 0.0;
-  sp.anderson = 0;  // plain NLGS for the pseudo-velocities, as in 3D (projection3.cpp)
-  nlgs_solve(q, sp);
+  nlgs_solve(q, projection::solver_params(prm_.solver));
   // The contact forces' work on the displacements: sum f_n (dt u_n).
   double work = 0.0;
   for (std::size_t k = 0; k < nr; ++k) {

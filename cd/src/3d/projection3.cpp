@@ -41,11 +41,7 @@ void World3::project_overlaps() {
   }
   q.dofs = prob_.dofs;
   for (CellDof3& d : q.dofs) d.v0 = d.v = 0.0;
-  SolverParams sp = prm_.solver;
-  sp.max_iter = std::min(sp.max_iter, projection::kSweeps);
-  sp.residual_tol = 0.0;
-  sp.anderson = 0;
-  nlgs_solve3(q, sp);
+  nlgs_solve3(q, projection::solver_params(prm_.solver));
   // The contact forces' work on the displacements: sum f_n (dt u_n), u_n
   // the pseudo-velocity across the contact (bodies and cell lengths).
   double work = 0.0;

@@ -4,7 +4,10 @@
 // notion of a pair's smaller diameter (a wall's or plane's grain's); the
 // numbers go through here, so that the two project on the same steps.
 #pragma once
+#include <algorithm>
 #include <cstddef>
+
+#include "solver.hpp"
 
 namespace cd::projection {
 
@@ -33,5 +36,15 @@ bool due(std::size_t n, Gap&& gap, Diameter&& diameter) {
 // The pseudo-velocity a row's gap g asks for: open an overlap by beta of
 // it in the step (u_n >= beta |g| / dt), and close no open gap (u_n >= -g / dt).
 inline double offset(double g, double beta, double dt) { return g < 0.0 ? beta * g / dt : g / dt; }
+
+// The projection's solver settings from the scene's: at most kSweeps
+// sweeps, no law-residual stop, plain NLGS (no Anderson mixing) for the
+// frictionless pseudo-velocity problem; the tolerance is the scene's.
+inline SolverParams solver_params(SolverParams sp) {
+  sp.max_iter = std::min(sp.max_iter, kSweeps);
+  sp.residual_tol = 0.0;
+  sp.anderson = 0;
+  return sp;
+}
 
 }  // namespace cd::projection
