@@ -203,8 +203,11 @@ TEST(Signals, TermStopsAtAStepBoundaryWithACheckpointTheRunResumesFrom) {
 TEST(BadInput, StartSamplesAreCheckedAgainstTheScene) {
   const fs::path dir = cdtest::scratch_dir("bad_input", "start");
   const std::string prep =
-      "name = \"prep\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 30\nd_mean = 1e-3\ndensity = 2.6\n"
-      "[shear]\nmode = \"periodic\"\nwidth = 0.01\nheight = 0.01\npressure = 100.0\nisotropic = true\n"
+      // 60 grains: the cell shrinks at most 0.025 d a step, and 30 (as
+      // before that bound held here) reached the grid's smallest cell before
+      // they jammed
+      "name = \"prep\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 60\nd_mean = 1e-3\ndensity = 2.6\n"
+      "[shear]\nmode = \"periodic\"\nwidth = 0.012\nheight = 0.012\npressure = 100.0\nisotropic = true\n"
       "dt_tp = 0.05\n[time]\nduration = 2e-3\n[output]\nseries_interval = 1e-3\ncheckpoint_interval = 1e-3\n";
   const fs::path sc = write(dir, "prep.toml", prep);
   const cdtest::CmdResult r = cdsim(sc.string() + " -q --out " + (dir / "prep").string());

@@ -52,10 +52,12 @@ double phi(const World3& w) {
 // trapezoidal rule, exact for a constant acceleration: after n steps v =
 // -n dt p A/M and L = L0 - p A (n dt)^2 / (2 M), to round-off. L_x, L_z
 // stay. With the brake (compaction_rate c / t_p) the rate stops at the
-// floor -c L_m / t_p instead.
+// floor -c L_m / t_p instead; with or without it, at the approach floor
+// -alert / (4 dt) (here 25 m/s, not reached, until the last part).
 TEST(Shear3Cell, HeightUnderPressureWithoutContactsIsAMassUnderAConstantForce) {
   WorldParams3 p;
   p.dt = 1e-5;
+  p.alert = 1e-3;
   p.cell = Vec3(0.02, 0.05, 0.03);
   p.periodic = {true, true, true};
   p.pressure = 2e3;
@@ -78,7 +80,6 @@ TEST(Shear3Cell, HeightUnderPressureWithoutContactsIsAMassUnderAConstantForce) {
 
   // The brake: -dL/dt <= min(rate L_m, alert / (4 dt)).
   WorldParams3 q = p;
-  q.alert = 1e-3;
   q.max_strain_rate = 0.02;  // 1/s: reached after ~40 steps
   World3 b(q);
   b.bodies.add_sphere(Vec3(0.005, 0.004, 0.01), 0.002, 1000);
@@ -92,6 +93,22 @@ TEST(Shear3Cell, HeightUnderPressureWithoutContactsIsAMassUnderAConstantForce) {
     floored = floored || free < floor;
   }
   EXPECT_TRUE(floored);  // the test reaches the brake
+
+  // No brake (compaction_rate = 0: no bound on the rate) still keeps the
+  // approach floor: -dL/dt <= alert / (4 dt) = 2.5e-3 m/s, reached after
+  // ~100 steps, after which the rate stays exactly at it.
+  WorldParams3 r = p;
+  r.alert = 1e-7;
+  World3 c(r);
+  c.bodies.add_sphere(Vec3(0.005, 0.004, 0.01), 0.002, 1000);
+  int at_floor = 0;
+  for (int k = 0; k < n; ++k) {
+    const double free = c.cell().rate.y() - r.dt * a, floor = -0.25 * r.alert / r.dt;
+    c.step();
+    EXPECT_DOUBLE_EQ(c.cell().rate.y(), std::max(free, floor)) << k;
+    at_floor += free < floor;
+  }
+  EXPECT_GT(at_floor, 50);  // the test reaches the floor
 }
 
 // ---------------------------------------------------------------- compaction
@@ -383,6 +400,10 @@ TEST(Shear3Cell, KeysWithoutWhatTheyNeedAreRefusedByName) {
   { Scene t = s; t.pressure = 0; t.dt_tp = 0; t.dt = 1e-5; refused(t, "shear.isotropic needs shear.pressure"); }
   { Scene t = s; t.pressure = 0; t.isotropic = false; t.dt_tp = 0; t.dt = 1e-5; refused(t, "shear.compaction_rate needs shear.pressure"); }
   { Scene t = s; t.pressure = std::nan(""); refused(t, "t_p"); }
+  // The lengths shrink by at most a quarter of the alert distance a step:
+  // with none they could not shrink.
+  { Scene t = s; t.alert = 0; refused(t, "shear.pressure > 0 needs contact.alert > 0"); }
+  { Scene t = s; t.alert = 0; t.compaction_rate = 0; refused(t, "shear.pressure > 0 needs contact.alert > 0"); }
   // The overlap projection serves 3D too (tests/test_projection3.cpp).
   { Scene t = s; t.overlap_projection = 0.5; EXPECT_NO_THROW(check_scene3(t)); }
 }

@@ -73,14 +73,15 @@ void LeesEdwardsCell::set_dofs(World& w) const {
   const Eigen::Matrix2d K = w.kinetic_stress();
   const CellState& cm = w.cm_;
   const CellState& cell = w.cell;
-  // With max_strain_rate, the free velocity of a length L is bounded below
-  // by -max_strain_rate L (a controlled compaction rate), and by a quarter
-  // of the alert distance a step: the images then approach the grains
-  // across the boundary by well under the alert distance in a step, so those
-  // contacts are detected before they close, and the grains they hit move
-  // (and spin) no faster, whatever the cell's size.
+  // The free velocity of a length L is bounded below by a quarter of the
+  // (scene's) alert distance a step, always: the images then approach the
+  // grains across the boundary by well under the alert distance in a step,
+  // so those contacts are detected before they close, and the grains they
+  // hit move (and spin) no faster, whatever the cell's size. With
+  // max_strain_rate, also by -max_strain_rate L (a controlled compaction
+  // rate).
   const double rate = c.max_strain_rate;
-  const auto floor = [&](double L) { return cell_dof::floor(rate, L, w.alert_, w.prm_.dt); };
+  const auto floor = [&](double L) { return cell_dof::floor(rate, L, w.prm_.alert, w.prm_.dt); };
   dofs.push_back(w.make_dof(cell.hdot, (c.pressure - K(1, 1)) * cm.width, cm.width, floor(cm.height)));
   if (c.isotropic)
     dofs.push_back(w.make_dof(cell.wdot, (c.pressure - K(0, 0)) * cm.height, cm.height, floor(cm.width)));

@@ -59,10 +59,12 @@ void check_shear(const Scene& s) {
   if (s.compaction_rate > 0 && (s.shear_mode != ShearMode::Periodic || s.pressure <= 0))
     fail("shear.compaction_rate > 0 needs shear.mode = \"periodic\" and shear.pressure > 0 (it "
          "bounds the rate of the cell's pressure-controlled lengths)");
-  if (s.shear_mode == ShearMode::Walls && s.pressure > 0 && !(s.alert > 0))
-    fail("shear.mode = \"walls\" with shear.pressure > 0 needs contact.alert > 0: the top wall falls by "
-         "at most a quarter of the alert distance a step (so that its contacts are detected before "
-         "they close), and would not move");
+  if (s.pressure > 0 && !(s.alert > 0))
+    fail(fmt::format("shear.mode = \"{}\" with shear.pressure > 0 needs contact.alert > 0: {} by at most a "
+                     "quarter of the alert distance a step (so that {} contacts are detected before they "
+                     "close), and would not move", name_of(s.shear_mode),
+                     s.shear_mode == ShearMode::Walls ? "the top wall falls" : "the cell's lengths shrink",
+                     s.shear_mode == ShearMode::Walls ? "its" : "their"));
   if (!s.start.empty() && s.shear_mode != ShearMode::Periodic)
     fail("shear.start needs shear.mode = \"periodic\" (a walls run places its own grains "
          "between its walls)");

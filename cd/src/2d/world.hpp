@@ -53,11 +53,12 @@ struct CellParams {
   double mass = 0.0;           // mass of the height (and width) dof (kg)
   bool isotropic = false;
   // > 0 (LeesEdwards with a pressure): a length dof L (height, width) may
-  // shrink at most at this strain rate, -dL/dt <= max_strain_rate L (1/s),
-  // and by at most a quarter of the alert distance a step. The bound acts on the
-  // dof's free velocity v0 (the imposed stress's impulse): a brake on the
-  // pressure-driven collapse, which the contacts, pushing the cell apart,
-  // never undo. 0: no bound.
+  // shrink at most at this strain rate, -dL/dt <= max_strain_rate L (1/s).
+  // The bound acts on the dof's free velocity v0 (the imposed stress's
+  // impulse): a brake on the pressure-driven collapse, which the contacts,
+  // pushing the cell apart, never undo. 0: no bound on the rate. Either
+  // way a length shrinks by at most a quarter of the alert distance a step
+  // (core/cell_dof.hpp, approach_floor).
   double max_strain_rate = 0.0;
 };
 

@@ -44,6 +44,9 @@ void check_cell3(const Scene& s) {
         fail3(fmt::format("{} needs shear.pressure > 0 (the cell's lengths at imposed stress; t_p = d "
                           "sqrt(rho/p), shear rate I sqrt(p/rho)/d)", key));
   }
+  if (s.pressure > 0 && !(s.alert > 0))
+    fail3("shear.pressure > 0 needs contact.alert > 0: the cell's lengths shrink by at most a quarter of the "
+          "alert distance a step (so that their contacts are detected before they close), and would not move");
   if (s.isotropic && s.inertial_number > 0)
     fail3("shear.isotropic (compaction: all three lengths at sigma = p) needs shear.inertial_number = 0");
   if (s.strain > 0 && s.inertial_number <= 0) fail3("shear.strain > 0 needs shear.inertial_number > 0");

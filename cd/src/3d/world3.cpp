@@ -231,7 +231,7 @@ void World3::set_dofs(const Eigen::Matrix3d& K) {
     d.inv_mass = 1.0 / M;
     const double area = V / cm_[a], v_start = cell_.rate[a];
     d.v0 = cell_dof::free_velocity(v_start, (prm_.pressure - K(a, a)) * area, M, dt,
-                                   cell_dof::floor(prm_.max_strain_rate, cm_[a], alert_, dt));
+                                   cell_dof::floor(prm_.max_strain_rate, cm_[a], prm_.alert, dt));
     d.v = d.v0;
     d.scale = dt * prm_.pressure * area;
     d.extra = extras_on_ ? prob_.extra.data() : nullptr;

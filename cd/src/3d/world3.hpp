@@ -104,7 +104,8 @@ struct WorldParams3 {
   // face normal to a) - dt (pressure - K_aa) A_a, A_a = V / L_a the face,
   // K the kinetic stress (pressure: force per area, N/m^2). Isotropic
   // compaction: all three; shear: L_y. max_strain_rate > 0: the lengths
-  // shrink at most at that strain rate (the brake, core/cell_dof.hpp).
+  // shrink at most at that strain rate (the brake); whatever it is, by at
+  // most a quarter of the alert distance a step (core/cell_dof.hpp).
   double pressure = 0.0, cell_mass = 0.0, max_strain_rate = 0.0;
   std::array<bool, 3> cell_dof{false, false, false};
 };
