@@ -396,7 +396,7 @@ TEST(BadInput, NanAndOutOfRangeOptionsAreRefusedByName) {
   const std::string ok = "2\n1\n0\n2 2\n2 2\n1 0\n0 1\n-1 0\n0.5\n";
   const fs::path good = write(dir, "ok.dat", ok);
   for (const std::string opt : {"--residual-tol nan", "--residual-tol -1", "--residual-tol inf", "--tol inf",
-                                "--tol nan"}) {
+                                "--tol nan", "--anderson -1", "--anderson 51", "--anderson nan"}) {
     const cdtest::CmdResult r = cdtest::run_command(kCdproblem + " solve " + good.string() + " " + opt);
     EXPECT_EQ(r.code, 2) << opt << "\n" << r.out;
     EXPECT_NE(r.out.find(opt.substr(0, opt.find(' '))), std::string::npos) << opt << "\n" << r.out;

@@ -114,7 +114,8 @@ Eigen::VectorXd free_q(const cd::ContactProblem3& p) {
 // 100 spheres compacted, then sheared at I = 0.1 with the height at imposed
 // stress (Lees-Edwards images and a cell dof coupled to the crossing rows),
 // step 20 dumped; solver.tol 1e-4 given (the bounds below are for it, not
-// for whatever the scene's policy picks).
+// for whatever the scene's policy picks), with Anderson's mixing (memory 5),
+// which the file records, so that the replay is the step's own solve.
 TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
   const fs::path dir = cdtest::scratch_dir("problem_dump3", "shear");
   const std::string prep = (dir / "prep").string(), shear = (dir / "shear").string();
@@ -124,7 +125,7 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
   ASSERT_EQ(r.code, 0) << r.out;
   r = cdtest::run_command(kCdsim + " " + kConfigs + "shear3-inertial.toml --set shear.start=" + prep +
                           "/checkpoint.bin --set shear.strain=0.3 --set shear.inertial_number=0.1 --set solver.tol=1e-4 "
-                          "--quiet "
+                          "--set solver.anderson=5 --quiet "
                           "--dump-problem 20 --out " + shear);
   ASSERT_EQ(r.code, 0) << r.out;
   const fs::path cdp = fs::path(shear) / "problem_20.cdp3", h5 = fs::path(shear) / "problem_20.hdf5",
@@ -142,6 +143,7 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
 
   cd::SolverParams prm;
   const cd::ContactProblem3 p = cd::read_contact_problem3(cdp.string(), prm);
+  EXPECT_EQ(prm.anderson, 5);
   const int nc = static_cast<int>(p.rows.size());
   ASSERT_GT(nc, 100);
   ASSERT_EQ(p.dofs.size(), 1u);

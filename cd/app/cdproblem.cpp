@@ -175,12 +175,14 @@ struct Step3 {
 // tolerance and cap unless given. Writes the impulses (row order, hex
 // floats: exact) to `out` if given.
 template <class Step>
-int solve_step(const std::string& path, double tol, int max_sweeps, double residual_tol, const std::string& out) {
+int solve_step(const std::string& path, double tol, int max_sweeps, double residual_tol, int anderson,
+               const std::string& out) {
   cd::SolverParams prm;
   typename Step::Problem p = Step::read(path, prm);
   if (tol > 0) prm.tol = tol;
   if (max_sweeps > 0) prm.max_iter = max_sweeps;
   if (residual_tol >= 0) prm.residual_tol = residual_tol;
+  if (anderson >= 0) prm.anderson = anderson;
   fmt::print("{}: {}\n", path, Step::describe(p));
   const auto t0 = std::chrono::steady_clock::now();
   const cd::SolveStats st = Step::solve(p, prm);
@@ -227,6 +229,11 @@ int main(int argc, char** argv) {
                   "(.cdp, .cdp3) also stop when the largest law residual is below this (checked every 10 "
                   "sweeps; solver.residual_tol); 0: off; default: the step's own")
       ->check(cd::finite_range(0.0, 1.0));
+  int anderson = -1;
+  cmd->add_option("--anderson", anderson,
+                  "(.cdp, .cdp3) Anderson acceleration over this many symmetric pairs (solver.anderson); 0: off; "
+                  "default: the step's own")
+      ->check(CLI::Range(0, cd::kAndersonMaxMemory));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -238,7 +245,7 @@ int main(int argc, char** argv) {
       if (lemke) throw std::runtime_error("--lemke takes a .dat or .hdf5 problem (matrix form)");
       const bool tol_given = cmd->count("--tol") > 0, cap_given = cmd->count("--max-sweeps") > 0;
       return (ends(".cdp") ? solve_step<Step2> : solve_step<Step3>)(path, tol_given ? opt.tol : 0.0,
-                                                       cap_given ? opt.max_sweeps : 0, residual_tol, out);
+                                                       cap_given ? opt.max_sweeps : 0, residual_tol, anderson, out);
     }
     if (ends(".hdf5")) return solve_fclib(path, opt, lemke, facets);
     return solve_dat(path, opt, lemke, facets);

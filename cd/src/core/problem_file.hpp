@@ -26,10 +26,12 @@ namespace cd::problem_file {
 // %a: hexadecimal floats, read back to the same bits by strtod.
 inline std::string hex(double v) { return fmt::format("{:a}", v); }
 
-// "tol T", "max_iter N", "min_parallel N" and, when > 0, "residual_tol R".
+// "tol T", "max_iter N", "min_parallel N" and, when > 0, "residual_tol R"
+// and "anderson M" (so that a replay takes the step's own solve).
 inline void write_solver(std::ostream& out, const SolverParams& prm) {
   out << "tol " << hex(prm.tol) << "\nmax_iter " << prm.max_iter << "\nmin_parallel " << prm.min_parallel << "\n";
   if (prm.residual_tol > 0) out << "residual_tol " << hex(prm.residual_tol) << "\n";
+  if (prm.anderson > 0) out << "anderson " << prm.anderson << "\n";
 }
 
 inline void read_solver(TextReader& rd, SolverParams& prm, const std::string& after) {
@@ -43,6 +45,10 @@ inline void read_solver(TextReader& rd, SolverParams& prm, const std::string& af
   if (rd.peek() == "residual_tol") {  // optional: written when > 0
     rd.token();
     prm.residual_tol = rd.non_negative("the residual tolerance", true);
+  }
+  if (rd.peek() == "anderson") {  // optional: written when > 0
+    rd.token();
+    prm.anderson = static_cast<int>(rd.integer("the Anderson memory", 1, kAndersonMaxMemory));
   }
 }
 

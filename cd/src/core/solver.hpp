@@ -11,6 +11,10 @@
 
 namespace cd {
 
+// The largest Anderson memory (SolverParams::anderson): scene/config.cpp's
+// range of solver.anderson, [0, 50].
+inline constexpr int kAndersonMaxMemory = 50;
+
 struct SolverParams {
   double tol = defaults::tol;  // eps_f on rms |dp| / mean |p| over a sweep (LMGC90's "Quad" norm)
   int max_iter = defaults::max_iter;  // iteration cap

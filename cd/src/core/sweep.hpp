@@ -109,7 +109,7 @@ constexpr int impulse_dim() {
 template <int D>
 class Anderson {
  public:
-  static constexpr int kMaxMemory = 50;  // the scene's bound on solver.anderson
+  static constexpr int kMaxMemory = kAndersonMaxMemory;
 
   Anderson(int memory, int rows)
       : m_(std::min(memory, kMaxMemory)), n_(rows * D), x_(n_), g_(n_), gp_(n_), fp_(n_), dF_(n_, m_), dG_(n_, m_), gram_(m_, m_) {}
