@@ -192,6 +192,7 @@ int solve_step(const std::string& path, double tol, int max_sweeps, double resid
       "{:.3e} (mean |p| {:.3e}), time {:.3g} s\n",
       st.cap_hit ? "NOT converged (sweep cap)" : st.residual_met ? "converged (law residual)" : "converged",
       st.iterations, st.dp_rel, prm.tol, st.residual_max, st.residual_mean, st.p_mean, t);
+  if (st.anderson_off > 0) fmt::print("anderson: stalled, off after {} sweeps (plain NLGS from there)\n", st.anderson_off);
   if (!out.empty()) {
     cd::write_file_atomic(out, Step::impulses(p));  // WriteError (exit 4) if it cannot be written
   }

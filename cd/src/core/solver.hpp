@@ -45,6 +45,7 @@ struct SolveStats {
   double p_mean = 0;         // mean |p| (impulse scale)
   double dof_rel = 0;        // last sweep's largest dof residual / (inv_mass scale) (update_dof)
   bool residual_met = false; // stopped by SolverParams::residual_tol
+  int anderson_off = 0;      // > 0: Anderson stalled and was turned off after this many sweeps
 };
 
 // Called after every sweep with the sweep count and its dp_rel, on one

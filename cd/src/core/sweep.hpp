@@ -29,6 +29,7 @@
 #include <climits>
 #include <cmath>
 #include <concepts>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -85,9 +86,18 @@ void run_block(const RowBlock& k, Row* rows, C& c, BlockStats& s) {
 // velocities together), so the next sweep sees a consistent state. Its
 // local solves do not read the row's old impulse beyond q = u - W r, so a
 // mixed impulse outside the cone is harmless: the sweep projects it. The
-// boundary dofs keep their own update (not mixed). Safeguard: when |f|
+// boundary dofs keep their own update (not mixed). Safeguards: when |f|
 // grows tenfold over a pair, the memory is cleared and the plain G(x) is
-// kept (kRestartGrowth).
+// kept (kRestartGrowth); and when the solve stalls (Stall: kStallPairs
+// pairs in a row without the pair's rms |dp| falling 10 % below its best),
+// Anderson is off for the rest of the solve and plain NLGS goes on from
+// where it is. On frictional dense-shear steps the mixing can settle on a
+// plateau that NLGS alone leaves (docs/accuracy.md: a 1000-sphere step held
+// at rms |dp| 4e-4 for 5000 sweeps, where plain NLGS reached 1e-4 in 2050;
+// tests/test_sweep_accel.cpp a 150-sphere one at tol 3e-6). The rule bounds
+// what a stall costs at 2 kStallPairs sweeps. 40 pairs: 25 turned Anderson
+// off on a plateau it would have left (436 sweeps to tol 1e-4 became 848);
+// 40 keeps that, and costs 0-5 % more than 25 on the stalling steps.
 // All of it on one thread, in row order: results do not depend on threads.
 template <class C, class Row>
 concept AddsImpulse = requires(const C& c, const Row& cr, Row& r, const double* dx, double* x) {
@@ -112,7 +122,8 @@ class Anderson {
   static constexpr int kMaxMemory = kAndersonMaxMemory;
 
   Anderson(int memory, int rows)
-      : m_(std::min(memory, kMaxMemory)), n_(rows * D), x_(n_), g_(n_), gp_(n_), fp_(n_), dF_(n_, m_), dG_(n_, m_), gram_(m_, m_) {}
+      : m_(std::min(memory, kMaxMemory)), n_(rows * D), x_(n_), g_(n_), gp_(n_), fp_(n_), gcol_(m_), b_(m_),
+        dF_(n_, m_), dG_(n_, m_), gram_(m_, m_) {}
 
   // The start of a pair: x = the rows' impulses.
   template <class Row, class C>
@@ -124,11 +135,7 @@ class Anderson {
   template <class Row, class C>
   void mix(Row* R, const C& c) {
     for (int i = 0, k = 0; k < n_; ++i, k += D) c.read_impulse(R[i], g_.data() + k);
-    double fn = 0;
-    for (int k = 0; k < n_; ++k) {
-      const double f = g_[k] - x_[k];
-      fn += f * f;
-    }
+    const double fn = (g_ - x_).squaredNorm();
     if (have_prev_ && !(fn <= kRestartGrowth * kRestartGrowth * fn_prev_)) {
       cols_ = next_ = 0;  // the pair made things worse: restart from the plain iterate
       have_prev_ = false;
@@ -136,18 +143,13 @@ class Anderson {
     // The new column (f - f_prev, g - g_prev) in place of the oldest, and
     // f, g kept as the next previous ones; x = g from here on.
     const int j = next_;
-    double* df = dF_.col(j).data();
-    double* dg = dG_.col(j).data();
-    for (int k = 0; k < n_; ++k) {
-      const double f = g_[k] - x_[k];
-      if (have_prev_) {
-        df[k] = f - fp_[k];
-        dg[k] = g_[k] - gp_[k];
-      }
-      fp_[k] = f;
-      gp_[k] = g_[k];
-      x_[k] = g_[k];  // the next pair starts at G(x), or at the mix below
+    if (have_prev_) {  // Eigen expressions, one pass each: vectorised (a fused plain loop over six arrays is not)
+      dF_.col(j) = (g_ - x_) - fp_;
+      dG_.col(j) = g_ - gp_;
     }
+    fp_ = g_ - x_;
+    gp_ = g_;
+    x_ = g_;  // the next pair starts at G(x), or at the mix below
     const bool added = have_prev_;
     fn_prev_ = fn;
     have_prev_ = true;
@@ -155,42 +157,29 @@ class Anderson {
     next_ = (next_ + 1) % m_;
     cols_ = std::min(cols_ + 1, m_);
     // The Gram matrix dF^T dF, updated in the new column's row and column
-    // only; b = dF^T f. Plain loops over contiguous columns: Eigen's
-    // expression objects, built once per row, cost 2x the sweeps they
-    // accelerate (perf, 1000-sphere shear step).
-    double b[kMaxMemory];
-    const double* fj = dF_.col(j).data();
-    for (int i = 0; i < cols_; ++i) {
-      const double* fi = dF_.col(i).data();
-      double g = 0, bi = 0;
-      for (int k = 0; k < n_; ++k) {
-        g += fi[k] * fj[k];
-        bi += fi[k] * fp_[k];
-      }
-      gram_(i, j) = gram_(j, i) = g;
-      b[i] = bi;
-    }
+    // only; b = dF^T f. Whole-matrix products over the stored columns (two
+    // matrix-vector products and one below: Eigen vectorises them, where
+    // plain reduction loops stay scalar without -ffast-math; perf on a
+    // 1000-sphere shear step: the mix cost 0.75 of the sweeps it
+    // accelerates with plain loops). Their sums' order is fixed by the
+    // build, not by the threads: the mix runs on one thread.
+    const auto F = dF_.leftCols(cols_);
+    gcol_.head(cols_).noalias() = F.transpose() * dF_.col(j);
+    b_.head(cols_).noalias() = F.transpose() * fp_;
+    for (int i = 0; i < cols_; ++i) gram_(i, j) = gram_(j, i) = gcol_[i];
     Eigen::MatrixXd A = gram_.topLeftCorner(cols_, cols_);
     // A small Tikhonov term keeps nearly dependent columns harmless.
     A.diagonal().array() += 1e-12 * A.diagonal().maxCoeff() + 1e-300;
-    const Eigen::VectorXd gamma = A.ldlt().solve(Eigen::Map<const Eigen::VectorXd>(b, cols_));
+    const Eigen::VectorXd gamma = A.ldlt().solve(b_.head(cols_));
     if (!gamma.allFinite()) {
       cols_ = next_ = 0;
       return;
     }
-    // x+ = G(x) - dG gamma: dx = -dG gamma column by column, then into the
-    // rows and their bodies.
-    double* dx = g_.data();  // g is spent: reused for dx
-    for (int k = 0; k < n_; ++k) dx[k] = 0;
-    for (int i = 0; i < cols_; ++i) {
-      const double* gi = dG_.col(i).data();
-      const double w = gamma[i];
-      for (int k = 0; k < n_; ++k) dx[k] -= gi[k] * w;
-    }
-    for (int i = 0, k = 0; k < n_; ++i, k += D) {
-      for (int a = 0; a < D; ++a) x_[k + a] += dx[k + a];
-      c.add_impulse(R[i], dx + k);
-    }
+    // x+ = G(x) - dG gamma, then into the rows and their bodies.
+    Eigen::VectorXd& dx = g_;  // g is spent: reused for dx
+    dx.noalias() = -(dG_.leftCols(cols_) * gamma);
+    x_ += dx;
+    for (int i = 0, k = 0; k < n_; ++i, k += D) c.add_impulse(R[i], dx.data() + k);
   }
 
  private:
@@ -202,8 +191,29 @@ class Anderson {
   int m_, n_, cols_ = 0, next_ = 0;
   bool have_prev_ = false;
   double fn_prev_ = 0;
-  Eigen::VectorXd x_, g_, gp_, fp_;
+  Eigen::VectorXd x_, g_, gp_, fp_, gcol_, b_;
   Eigen::MatrixXd dF_, dG_, gram_;
+};
+
+// The stall rule of Anderson's mixing (above): fed the rms |dp|^2 sum of
+// the sweep that ends each pair, it says when to give up mixing.
+class Stall {
+ public:
+  static constexpr int kStallPairs = 40;
+  // True when this pair makes kStallPairs in a row without a 10 % better
+  // rms |dp| than the best so far (0.81 on the squares).
+  bool stalled(double dsum) {
+    if (dsum < 0.81 * best_) {
+      best_ = dsum;
+      since_ = 0;
+      return false;
+    }
+    return ++since_ >= kStallPairs;
+  }
+
+ private:
+  double best_ = std::numeric_limits<double>::infinity();
+  int since_ = 0;
 };
 
 // Law residual of every row (normalised by mean |p|), read-only.
@@ -327,6 +337,7 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
   double last_dsum = 0;
   // Anderson acceleration (off unless asked and the coupling can take it).
   std::optional<Anderson<impulse_dim<C>()>> acc;
+  Stall stall;
   if constexpr (AddsImpulse<C, Row>) {
     if (prm.anderson > 0) {
       acc.emplace(prm.anderson, n);
@@ -365,6 +376,7 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
           if (psum_exact) psum = exact_psum(blocks, R);
           last_dsum = dsum;
         }
+        const double pair_dsum = dsum;
         done = end_sweep(++it, dsum, psum, n, R, dofs, prm, observer, st);
         // The optional second criterion: the law residual itself, checked
         // every kResidualEvery sweeps (a read-only pass over the rows, on
@@ -377,7 +389,12 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
         }
         if constexpr (AddsImpulse<C, Row>) {
           if (acc && !done && it % 2 == 0) {  // after the backward sweep: a pair done
-            acc->mix(R, c);
+            if (stall.stalled(pair_dsum)) {
+              acc.reset();  // plain NLGS from here
+              st.anderson_off = it;
+            } else {
+              acc->mix(R, c);
+            }
           }
         }
       }
