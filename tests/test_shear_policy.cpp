@@ -17,21 +17,27 @@
 namespace {
 
 struct Expected {
-  double I, tol, residual_tol, dt_tp, cell_mass;
+  double I, tol, tol_anderson, residual_tol, dt_tp, cell_mass;
 };
 
 // docs/shear.md's table, read at and around each breakpoint (I = 0.01 for
 // the tolerance, 0.1 for the time step's cap, 0.5 for the cell mass).
 const Expected kTable[] = {
-    {0.001, 1e-4, 3e-3, 0.05, 0.1},   {0.00999, 1e-4, 3e-3, 0.05, 0.1}, {0.01, 1e-3, 0.0, 0.05, 0.1},
-    {0.05, 1e-3, 0.0, 0.05, 0.1},     {0.1, 1e-3, 0.0, 0.05, 0.1},      {0.2, 1e-3, 0.0, 0.025, 0.1},
-    {0.3, 1e-3, 0.0, 0.01667, 0.1},   {0.49, 1e-3, 0.0, 0.0102, 0.1},   {0.5, 1e-3, 0.0, 0.01, 0.01},
-    {1.0, 1e-3, 0.0, 0.005, 0.01},
+    {0.001, 1e-4, 1e-4, 3e-3, 0.05, 0.1},   {0.00999, 1e-4, 1e-4, 3e-3, 0.05, 0.1},
+    {0.01, 1e-3, 5e-4, 0.0, 0.05, 0.1},     {0.05, 1e-3, 5e-4, 0.0, 0.05, 0.1},
+    {0.1, 1e-3, 5e-4, 0.0, 0.05, 0.1},      {0.2, 1e-3, 5e-4, 0.0, 0.025, 0.1},
+    {0.3, 1e-3, 5e-4, 0.0, 0.01667, 0.1},   {0.49, 1e-3, 5e-4, 0.0, 0.0102, 0.1},
+    {0.5, 1e-3, 5e-4, 0.0, 0.01, 0.01},     {1.0, 1e-3, 5e-4, 0.0, 0.005, 0.01},
 };
 
 TEST(ShearPolicy, TheTableAtItsBreakpoints) {
   for (const Expected& e : kTable) {
     const cd::ShearSettings s = cd::shear_settings(e.I);
+    const cd::ShearSettings a = cd::shear_settings(e.I, true);
+    EXPECT_EQ(a.tol, e.tol_anderson) << "I = " << e.I;
+    EXPECT_EQ(a.residual_tol, s.residual_tol) << "I = " << e.I;
+    EXPECT_EQ(a.dt_tp, s.dt_tp) << "I = " << e.I;
+    EXPECT_EQ(a.cell_mass, s.cell_mass) << "I = " << e.I;
     EXPECT_EQ(s.tol, e.tol) << "I = " << e.I;
     EXPECT_EQ(s.residual_tol, e.residual_tol) << "I = " << e.I;
     EXPECT_EQ(s.dt_tp, e.dt_tp) << "I = " << e.I;
@@ -70,6 +76,16 @@ TEST(ShearPolicy, AutoKeysTakeThePolicysValueForTheScenesI) {
   EXPECT_EQ(o.residual_tol, 3e-3);
   const cd::Scene w = cd::parse_scene("[shear]\ninertial_number = 0.6\n", "a.toml", {"shear.cell_mass=auto"});
   EXPECT_EQ(w.cell_mass, 0.01);
+  // With Anderson's mixing on, "auto" takes the band's tol_anderson, wherever
+  // solver.anderson is given (the scene or an override after the key).
+  for (const Expected& e : kTable) {
+    std::ostringstream I;
+    I << e.I;
+    const cd::Scene a =
+        cd::parse_scene(kAutoScene, "a.toml", {"shear.inertial_number=" + I.str(), "solver.anderson=5"});
+    EXPECT_EQ(a.tol, e.tol_anderson) << "I = " << e.I;
+    EXPECT_EQ(a.residual_tol, e.residual_tol) << "I = " << e.I;
+  }
 }
 
 TEST(ShearPolicy, AutoWithoutAnInertialNumberOrOnAnotherKeyIsRefused) {
@@ -157,6 +173,12 @@ TEST(ShearPolicy, ACampaignPointAndASingleRunAtTheSameIRunTheSameSettings) {
   EXPECT_EQ(c3.size(), 5u);
   EXPECT_EQ(c3, s3);
   EXPECT_EQ(std::stod(s3.at("solver.residual_tol")), 3e-3);
+  // The 3D scene mixes (solver.anderson = 5): its tolerance is the band's
+  // tol_anderson, the same for a campaign point.
+  const auto c3b = campaign_settings("0.01", "3"), s3b = single_run_settings("shear3-inertial.toml", "0.01");
+  EXPECT_EQ(c3b, s3b);
+  EXPECT_EQ(std::stod(s3b.at("solver.tol")), cd::shear_settings(0.01, true).tol);
+  EXPECT_EQ(std::stod(s3.at("solver.tol")), cd::shear_settings(0.001, true).tol);
 }
 
 }  // namespace

@@ -514,7 +514,7 @@ Scene read_scene(const toml::value& root, const std::string& path) {
                           a->key, text(s.inertial_number, false)));
       continue;
     }
-    s.*(a->member) = shear_settings(s.inertial_number).*(a->value);
+    s.*(a->member) = shear_settings(s.inertial_number, s.anderson > 0).*(a->value);
   }
   out.throw_if_any();
 

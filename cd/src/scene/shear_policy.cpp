@@ -8,13 +8,13 @@
 
 namespace cd {
 
-ShearSettings shear_settings(double I) {
+ShearSettings shear_settings(double I, bool anderson) {
   const ShearBand* b = &kShearBands.front();
   for (const ShearBand& x : kShearBands)
     if (I >= x.i_min) b = &x;
   // %.4g, then read back: the Makefile's awk printed dt_tp so.
   const double dt_tp = std::stod(fmt::format("{:.4g}", std::min(kSlidePerStep / I, kDtMaxTp)));
-  return {b->tol, b->residual_tol, dt_tp, b->cell_mass};
+  return {anderson ? b->tol_anderson : b->tol, b->residual_tol, dt_tp, b->cell_mass};
 }
 
 }  // namespace cd
