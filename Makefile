@@ -549,7 +549,7 @@ fs_steps = $(shell awk 'BEGIN { printf "%d", $(2) / ($(1) * $(call resolved,$(1)
 frozen_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --fresh \
 	  --set shear.start='"$(3)"' --set shear.pressure=$(P) \
 	  --set shear.inertial_number=$(1) --set shear.strain=$(2) --set solver.tol=1e-4 --set solver.residual_tol=0 \
-	  --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=0 \
+	  --set solver.anderson=0 --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=0 \
 	  --dump-problem $(shell echo $$(( $(call fs_steps,$(1),$(2)) - $(FS_GAP) ))) \
 	  --dump-problem $(call fs_steps,$(1),$(2))
 .PRECIOUS: $(CAMPAIGNS)/frozen/ns_%/I_0.01/.done

@@ -163,7 +163,7 @@ TEST(ShearPolicy, ACampaignPointAndASingleRunAtTheSameIRunTheSameSettings) {
     const auto c = campaign_settings(I, "2"), s = single_run_settings("shear-inertial.toml", I);
     EXPECT_EQ(c.size(), 5u) << I;
     EXPECT_EQ(c, s) << "I = " << I;
-    const cd::ShearSettings p = cd::shear_settings(std::stod(I));
+    const cd::ShearSettings p = cd::shear_settings(std::stod(I), true);  // the scene mixes (anderson = 5)
     EXPECT_EQ(std::stod(s.at("solver.tol")), p.tol) << I;
     EXPECT_EQ(std::stod(s.at("solver.residual_tol")), p.residual_tol) << I;
     EXPECT_EQ(std::stod(s.at("shear.dt_tp")), p.dt_tp) << I;
@@ -173,8 +173,8 @@ TEST(ShearPolicy, ACampaignPointAndASingleRunAtTheSameIRunTheSameSettings) {
   EXPECT_EQ(c3.size(), 5u);
   EXPECT_EQ(c3, s3);
   EXPECT_EQ(std::stod(s3.at("solver.residual_tol")), 3e-3);
-  // The 3D scene mixes (solver.anderson = 5): its tolerance is the band's
-  // tol_anderson, the same for a campaign point.
+  // The 3D scene mixes too (solver.anderson = 5): its tolerance is the
+  // band's tol_anderson, the same for a campaign point.
   const auto c3b = campaign_settings("0.01", "3"), s3b = single_run_settings("shear3-inertial.toml", "0.01");
   EXPECT_EQ(c3b, s3b);
   EXPECT_EQ(std::stod(s3b.at("solver.tol")), cd::shear_settings(0.01, true).tol);
