@@ -13,7 +13,8 @@ namespace cd {
 
 // The policy, all its numbers in this table: a band applies from its I_min
 // up to the next band's. A scene with Anderson's mixing on (solver.anderson
-// > 0: configs/shear3-inertial.toml) gets tol_anderson instead of tol.
+// > 0: configs/shear-inertial.toml and shear3-inertial.toml) gets
+// tol_anderson instead of tol.
 struct ShearBand {
   double i_min;         // the band starts at this I
   double tol;           // solver.tol (plain NLGS)
@@ -26,15 +27,17 @@ inline constexpr std::array<ShearBand, 3> kShearBands = {{
     // 0.012 d at I = 1e-3) and tol 1e-4 alone hits the sweep cap on 43 % of
     // the steps; 1e-4 with the law-residual stop 3e-3 agrees with it within
     // 0.7 sigma at a third of its cost. With Anderson (and its stall rule)
-    // the same stop keeps mu, phi and z within 1 sigma of plain NLGS's over
-    // three 1000-sphere samples at I = 1e-3, at 0.6-0.7x the CPU.
+    // the same stop keeps mu, phi and z within 0.5 sigma of plain NLGS's
+    // over three samples at I = 1e-3, at 0.68x (1000 spheres) and 0.60x
+    // (1000 disks) the CPU.
     {0.0, 1e-4, 1e-4, 3e-3, 0.1},
     // From I = 0.01, tol 1e-3 keeps mu*, phi and z within ~2 sigma of tol
     // 1e-5 at 11-35 % of its cost; 1e-4 costs 2-4x more, not measurably
     // closer (disks). On 1000 spheres at I = 0.01 (three samples against tol
     // 1e-4 + residual_tol 3e-3), plain tol 1e-3 leaves z 0.016 high (3.7
     // sigma); Anderson at tol 5e-4 holds mu, phi and z within 1 sigma at
-    // 1.4x plain tol 1e-3's CPU (7e-4: the same CPU, z 0.008 high).
+    // 1.4x plain tol 1e-3's CPU (7e-4: the same CPU, z 0.008 high). 1000
+    // disks: within 1.2 sigma at 0.93x plain tol 1e-3's CPU.
     {0.01, 1e-3, 5e-4, 0.0, 0.1},
     // From I = 0.5 the cell height of mass 0.1 oscillates for several units
     // of strain; a light cell (0.01) holds sigma_yy + K_yy = p.
