@@ -251,6 +251,26 @@ void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, Solve
   st.residual_mean = rsum / n / scale;
 }
 
+// The law-residual stop's test, residuals(...).residual_max < tol, with
+// the same figures and decision but leaving at the first row that fails
+// it: the test fails on all but the last of a solve's checks, and a full
+// pass (a velocity and a natural-map residual with two hypot calls a row)
+// cost a quarter of a 3D run at I = 1e-3 (perf). The scale is the same sum
+// of |p| in row order; e / scale >= tol for some row exactly when max e /
+// scale >= tol (rounded division is monotone), and a NaN residual is
+// skipped as std::max skips it there. Read-only, one thread.
+template <class Row, class C>
+bool residual_below(const std::vector<Row>& rows, const C& c, double tol) {
+  if (rows.empty()) return true;
+  double psum = 0;
+  for (const Row& r : rows) psum += impulse_norm(r);
+  const double p_mean = psum / static_cast<double>(rows.size());
+  const double scale = p_mean > 0 ? p_mean : 1.0;
+  for (const Row& r : rows)
+    if (row_residual(c, r) / scale >= tol) return false;
+  return true;
+}
+
 // A problem without rows: the dofs keep their free velocity, nothing to solve.
 template <class Dof>
 SolveStats no_rows(std::vector<Dof>* dofs) {
@@ -382,9 +402,7 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
         // every kResidualEvery sweeps (a read-only pass over the rows, on
         // this thread). Off (residual_tol = 0) it costs nothing.
         if (!done && prm.residual_tol > 0 && it % kResidualEvery == 0) {
-          SolveStats r;
-          residuals(rows, c, INT_MAX, r);
-          st.residual_met = r.residual_max < prm.residual_tol && st.dof_rel < prm.tol;
+          st.residual_met = residual_below(rows, c, prm.residual_tol) && st.dof_rel < prm.tol;
           done = st.residual_met;
         }
         if constexpr (AddsImpulse<C, Row>) {
