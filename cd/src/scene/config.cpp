@@ -145,7 +145,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"solver", "tol", &Scene::tol, "", in_open_closed(0, 1), "NLGS convergence tolerance (relative); \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "max_iter", &Scene::max_iter, "", in(1, 1e8), "NLGS iteration cap per time step"},
       {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
-      {"solver", "anderson", &Scene::anderson, "", in(0, 50), "> 0: Anderson acceleration of the sweep with this memory (5 is the measured choice): after each forward-backward pair of sweeps the impulses are mixed over the last pairs (docs/accuracy.md); 0: plain NLGS"},
+      {"solver", "anderson", &Scene::anderson, "", in(0, 50), "> 0: Anderson acceleration of the sweep with this memory (5 is the measured choice): after each forward-backward pair of sweeps the impulses are mixed over the last pairs, and the mixing is off for the rest of a step's solve once it stalls (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it (docs/shear.md, Settings by I); 0: plain NLGS"},
       {"solver", "threads", &Scene::threads, "", in(0, 1024), "OpenMP threads; 0: OpenMP default"},
       {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
