@@ -131,6 +131,8 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
   const fs::path cdp = fs::path(shear) / "problem_20.cdp3", h5 = fs::path(shear) / "problem_20.hdf5",
                  imp = fs::path(shear) / "problem_20.impulses";
   ASSERT_TRUE(fs::exists(cdp) && fs::exists(h5) && fs::exists(imp)) << r.out;
+  // A run that mixes says how often the mixing stalled (cdsim's summary).
+  EXPECT_NE(r.out.find("cdsim: Anderson's mixing stalled and went off on "), std::string::npos) << r.out;
 
   // The replay, on one and two threads: the same bytes.
   for (int t : {1, 2}) {

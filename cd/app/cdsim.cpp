@@ -131,6 +131,9 @@ int main(int argc, char** argv) {
         s.steps, s.wall_time, 1e3 * per_step, omp_get_max_threads(), s.mean_iterations,
         s.max_iterations, s.cap_hits, s.steps ? 100.0 * double(s.cap_hits) / double(s.steps) : 0.0,
         s.max_residual, s.max_overlap, s.max_overlap_small);
+    if (scene.anderson > 0)  // how often the mixing stalled and the solve went on as plain NLGS
+      fmt::print("cdsim: Anderson's mixing stalled and went off on {} steps ({:.1f} % of steps)\n", s.anderson_off,
+                 s.steps ? 100.0 * double(s.anderson_off) / double(s.steps) : 0.0);
     fmt::print("cdsim: outputs in {}/ (the run's cost: summary.toml)\n", out);
     // Over the whole run (every session), as summary.toml says.
     if (s.cap_share() > 0.01)

@@ -63,6 +63,7 @@ struct RunSummary {
   double mean_iterations = 0;
   int max_iterations = 0;
   std::int64_t cap_hits = 0;
+  std::int64_t anderson_off = 0;  // steps whose Anderson mixing stalled and went off (SolveStats::anderson_off)
   double max_residual = 0;
   double max_overlap = 0;        // largest overlap / mean diameter
   double max_overlap_small = 0;  // largest overlap / the smaller grain's diameter
