@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 #include <set>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "run_plan.hpp"
 #include "setup.hpp"
 #include "world.hpp"
+#include "world_util.hpp"
 
 namespace {
 
@@ -169,6 +171,85 @@ TEST(PrepHardCases, Ratio4ShearFromTheSampleKeepsOverlapsBounded) {
   EXPECT_LE(r.ov_max, 0.01) << "step " << r.worst_step;
   EXPECT_NEAR(w.cell.strain, 0.3, 1e-6);
   fs::remove_all(dir);
+}
+
+// Small polygons next to large disks (d_max/d_min = 5, triangles and disks):
+// the loose phase of make prep-overlap's mixture, in a cell large enough
+// (60 d, packing 0.07) that the approach floor, not the rate, sets how fast
+// its lengths shrink, as at N = 1000. Before the approach distance heeded
+// the polygons (boundary_approach) the cell approached at a quarter of the
+// alert distance a step, small triangles hit by it spun at 0.1 rad a step,
+// and the disks on their sides went into them unseen: 0.0247 of the
+// smaller grain within these 1200 steps (0.010, 0.003 and 0.010 for seeds
+// 2-4). Now the closure a step is at most 2.5e-3 and the projection keeps
+// the overlaps below twice that (measured 2.3e-3; seeds 2-4: 1.6e-3,
+// 1.3e-3, 4.0e-3).
+TEST(PrepHardCases, SmallTrianglesAmongLargeDisksCompactWithoutOverlap) {
+  const cd::Scene s = cd::load_scene(kSrc + "/configs/shear-prep.toml",
+                                     {"particles.n=300", "particles.size_ratio=5", "particles.nsides=[3,0]",
+                                      "shear.width=0.06", "shear.height=0.06", "output.quiet=true"});
+  cd::World w = cd::build_world(s);
+  const double approach = cd::boundary_approach(w.bodies, w.params().alert);
+  const auto t0 = std::chrono::steady_clock::now();
+  const PrepRecord r = run_prep(w, s, 1200);
+  print("triangles and disks, ratio 5, loose", r, seconds_since(t0));
+  std::printf("approach distance %.3g of the alert distance\n", approach / w.params().alert);
+  // The polygons bind: about half of the alert distance here.
+  EXPECT_LT(approach, 0.6 * w.params().alert);
+  // The cell approached by at most a quarter of it a step, and reached that.
+  EXPECT_LT(r.approach_max, 0.25 * 1.01 * approach / w.params().alert);
+  EXPECT_GT(r.approach_max, 0.25 * 0.99 * approach / w.params().alert);
+  EXPECT_LE(r.ov_max, 5e-3) << "step " << r.worst_step;
+}
+
+// Why the approach distance heeds small polygons (boundary_approach): a
+// polygon's side turning by theta in a step carries a disk resting on it
+// into the side by l (1 - cos theta), l the distance from the polygon's
+// centre to the disk's along the side's normal (apothem a + the disk's
+// radius), and the midpoint's linearised gap does not see it. A triangle
+// (R = 0.25, a = R/2) spinning at omega, frictionless, a disk of radius
+// 0.875 (l = 1) at rest touching its top side at the first step's midpoint:
+// there the disk needs no force (the side point's normal velocity is 0), and
+// at the next midpoint the overlap is l (1 - cos(omega dt)) exactly. At
+// 0.1 rad a step (the triangles' spin in make prep-overlap's mixture), 1 %
+// of the triangle's size 2R in one step; at the spin a step the approach
+// distance allows the smallest polygon (s / R), 2.5e-3.
+TEST(PrepHardCases, ASpinningSideCarriesADiskIntoItUnseenByTheGap) {
+  const double R = 0.25, a = 0.5 * R, rd = 0.875, l = a + rd, dt = 1e-3;
+  const auto overlap_after_a_step = [&](double theta) {
+    cd::WorldParams p = cdtest::params(dt, 0.0, 0.0);
+    p.alert = 0.1;
+    cd::World w(p);
+    const double omega = theta / dt;
+    // vertex 0 pointing down, the top side level, at the first midpoint
+    w.bodies.add_polygon({0.0, 0.0}, R, 3, -0.5 * std::numbers::pi - 0.5 * theta, 1.0, {0.0, 0.0}, omega);
+    w.bodies.add_disk({0.0, l}, rd, 1.0);
+    w.step();
+    EXPECT_EQ(w.infos().size(), 1u);
+    EXPECT_NEAR(w.infos()[0].gap, 0.0, 1e-15);
+    EXPECT_EQ(w.rows()[0].pn, 0.0);
+    w.step();
+    EXPECT_EQ(w.infos().size(), 1u);
+    EXPECT_EQ(w.infos()[0].type, cd::ContactType::SideVertex);
+    return -w.infos()[0].gap;
+  };
+  EXPECT_NEAR(overlap_after_a_step(0.1), l * (1.0 - std::cos(0.1)), 1e-12);
+  EXPECT_NEAR(overlap_after_a_step(0.1) / (2 * R), 0.01, 1e-4);
+  // The approach distance for these two grains, a quarter of it a step:
+  // s = R sqrt(4 eps R / l), eps = 2.5e-3, below the alert's quarter.
+  cd::Bodies b;
+  b.add_polygon({0.0, 0.0}, R, 3, 0.0, 1.0);
+  b.add_disk({0.0, l}, rd, 1.0);
+  const double s = 0.25 * cd::boundary_approach(b, 0.1);
+  EXPECT_NEAR(s, R * std::sqrt(4 * 2.5e-3 * R / l), 1e-15);
+  const double closure = overlap_after_a_step(s / R) / (2 * R);
+  EXPECT_LE(closure, 2.5e-3);
+  EXPECT_GT(closure, 0.999 * 2.5e-3);
+  // Without polygons the approach distance is the alert distance, bit for bit.
+  cd::Bodies disks;
+  disks.add_disk({0.0, 0.0}, 0.1, 1.0);
+  disks.add_disk({1.0, 0.0}, 0.5, 1.0);
+  EXPECT_EQ(cd::boundary_approach(disks, 0.1), 0.1);
 }
 
 // The projection alone, on two disks at rest overlapping by 0.05 d: each

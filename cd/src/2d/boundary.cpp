@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "cell_dof.hpp"
 #include "world.hpp"
@@ -22,6 +23,41 @@ void midpoint_cell(CellState& cm, PeriodicCell& pc, const CellState& cell, doubl
 }
 
 }  // namespace
+
+// A grain the boundary pushes moves at up to about its speed, s a step (a
+// quarter of the approach distance), and a polygon of circumradius R hit
+// near a corner spins by up to about s / R a step (measured: 0.10 rad at s
+// / R = 0.096, a triangle of the ratio-5 mixture of make prep-overlap,
+// N = 1000). A side turning by theta a step carries what rests on it into
+// the side by l theta^2 / 2, l the distance from the polygon's centre to
+// the contact along the side's normal: its apothem a, plus the radius of a
+// disk lying on it. The gap the solve sees, linearised at the midpoint, does
+// not: that triangle, at 2 / t_p, with a disk 3.6 times its size on a side
+// (l = 1.07 mm), overlapped by 0.0103 of its size 2R a step (l theta^2 /
+// 2 = 0.0054 mm), 0.0134 at most with the projection opening half of it a
+// step. So s <= R sqrt(4 eps R / (a + r_disk)) keeps that closure below eps
+// = 2.5e-3 of 2R a step, for the smallest polygon against the largest
+// disk; the projection then holds the overlap below 2 eps, half of the 1 %
+// of the smaller grain cdsim warns at. Disks do not need it (a turning
+// disk presents the same surface): without polygons the approach distance
+// is the alert distance. Polygons among themselves (l = a) need s <= 0.10
+// to 0.14 R, a quarter of an alert distance of 0.1 d_mean once R >= 0.18 to
+// 0.25 d_mean. Halving dt would not do: the approach floor is per step, so
+// s / R, the spin a step, stays (measured: the N = 1000 mixture at dt / 2
+// still reached 0.0095).
+double boundary_approach(const Bodies& b, double alert) {
+  constexpr double kEps = 2.5e-3;
+  double r_disk = 0.0;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    if (b.shape[i] == Shape::Disk) r_disk = std::max(r_disk, b.radius[i]);
+  double s = 0.25 * alert;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.shape[i] != Shape::Polygon) continue;
+    const double R = b.radius[i], a = R * std::cos(std::numbers::pi / b.nsides[i]);
+    s = std::min(s, R * std::sqrt(4.0 * kEps * R / (a + r_disk)));
+  }
+  return 4.0 * s;
+}
 
 // ---- Lees-Edwards cell --------------------------------------------------
 
@@ -74,14 +110,15 @@ void LeesEdwardsCell::set_dofs(World& w) const {
   const CellState& cm = w.cm_;
   const CellState& cell = w.cell;
   // The free velocity of a length L is bounded below by a quarter of the
-  // (scene's) alert distance a step, always: the images then approach the
+  // approach distance a step (the scene's alert distance, or less with
+  // small polygons: boundary_approach), always: the images then approach the
   // grains across the boundary by well under the alert distance in a step,
   // so those contacts are detected before they close, and the grains they
   // hit move (and spin) no faster, whatever the cell's size. With
   // max_strain_rate, also by -max_strain_rate L (a controlled compaction
   // rate).
   const double rate = c.max_strain_rate;
-  const auto floor = [&](double L) { return cell_dof::floor(rate, L, w.prm_.alert, w.prm_.dt); };
+  const auto floor = [&](double L) { return cell_dof::floor(rate, L, w.approach_, w.prm_.dt); };
   dofs.push_back(w.make_dof(cell.hdot, (c.pressure - K(1, 1)) * cm.width, cm.width, floor(cm.height)));
   if (c.isotropic)
     dofs.push_back(w.make_dof(cell.wdot, (c.pressure - K(0, 0)) * cm.height, cm.height, floor(cm.width)));
@@ -212,9 +249,9 @@ void WallShear::set_dofs(World& w) const {
   // Dense shear moves the wall far slower; only the fall onto a loose
   // sample meets the bound. (The scene's alert distance: with restitution,
   // whose contacts are detected at touch, it bounds the overlap a landing
-  // makes in a step.)
+  // makes in a step; less with small polygons, boundary_approach.)
   dofs.push_back(w.make_dof(w.cell.hdot, c.pressure * w.cm_.width, w.cm_.width,
-                            cell_dof::approach_floor(w.prm_.alert, w.prm_.dt)));
+                            cell_dof::approach_floor(w.approach_, w.prm_.dt)));
   for (std::size_t k = 0; k < w.prob_.rows.size(); ++k) {
     const ContactRow& r = w.prob_.rows[k];
     const double s = w.on_top_[r.b2] ? 1.0 : w.on_top_[r.b1] ? -1.0 : 0.0;

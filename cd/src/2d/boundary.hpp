@@ -23,6 +23,14 @@ namespace cd {
 
 class World;
 
+// The distance a pressure-driven boundary (the periodic cell's lengths, the
+// top wall) may approach the grains by in four steps (cell_dof's
+// approach_floor: a quarter of it a step): the alert distance `alert`, or
+// less where the sample's smallest polygons would spin too fast for the
+// midpoint's linearised gaps (boundary.cpp). Equal to `alert`, bit for bit,
+// without polygons.
+double boundary_approach(const Bodies& b, double alert);
+
 // `cell`: the protocol has a cell (a shear rate, a volume, a kinetic stress).
 // `moving_images`: periodic images move relative to the bodies (their
 // velocity enters the rows that touch them).

@@ -54,6 +54,7 @@ void World::step() {
                              [](const Vec2& f) { return f.squaredNorm() > 0.0; });
     on_top_.assign(std::holds_alternative<WallShear>(boundary_) ? bodies.size() : 0, 0);
     for (const std::int32_t i : top_wall) on_top_[i] = 1;
+    approach_ = boundary_approach(bodies, prm_.alert);
     prepared_ = true;
   }
   std::visit([&](const auto& b) { b.begin_step(*this); }, boundary_);

@@ -176,6 +176,9 @@ class World : public WorldShell<Bodies, ContactProblem, ContactInfo, std::pair<d
   std::vector<std::uint8_t> on_top_;  // WallShear: body is glued to the top wall
   bool forces_on_ = false, prepared_ = false;  // forces_on_: some body has an applied force
   double alert_ = 0.0;
+  // The boundaries' approach distance (boundary_approach, from the bodies at
+  // the first step): a quarter of it a step at most.
+  double approach_ = 0.0;
   std::vector<Vec2> xm_;
   std::vector<double> thm_;
   ContactProblem proj_;    // project_overlaps' pseudo-velocity problem
