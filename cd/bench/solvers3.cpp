@@ -12,11 +12,9 @@
 //             x+ = G(x) + beta p, p+ = beta p + (G(x) - x),
 //             beta = |G(x) - x|^2 / |previous|^2 (Fletcher-Reeves), p
 //             cleared when beta > 1;
-//   anderson:M[:K]  type-II Anderson mixing of the pair map over M pairs
-//             (the production option's algorithm, core/sweep.hpp, with its
-//             tenfold-growth restart), plain gs for good after K pairs without
-//             a 10 % better criterion when K is given (the production stall
-//             rule's shape);
+//   anderson:M  core/sweep.hpp's Anderson mixing of the pair map over M
+//             pairs with its stall rule (Stall), the production code itself
+//             on these rows; anderson:M:raw without the stall rule;
 //   METHOD+scale  the method, with every pair's iterate rescaled along
 //             itself, r <- s r, s the zero of the De Saxce-modified power
 //             sum_k r_k.(s W r + q + mu |u_t| e_n)_k (a one-dimensional
@@ -37,6 +35,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -46,6 +45,7 @@
 #include "contact_problem3.hpp"
 #include "law3.hpp"
 #include "problem3.hpp"
+#include "sweep.hpp"
 
 using namespace cd;
 
@@ -102,11 +102,13 @@ struct Blocks {
     r[i] = out;
   }
   // One symmetric pair: forward, then backward. Returns the smaller of the
-  // two sweeps' production criteria, rms |dr| / mean |r|.
-  double pair(std::vector<Vec3>& r) const {
+  // two sweeps' production criteria, rms |dr| / mean |r|, and in d2back the
+  // backward sweep's sum of |dr|^2 (what the production stall rule reads).
+  double pair(std::vector<Vec3>& r, double& d2back) const {
     double d1 = 0, p1 = 0, d2 = 0, p2 = 0;
     for (int i = 0; i < nc; ++i) update(i, r, d1, p1);
     for (int i = nc - 1; i >= 0; --i) update(i, r, d2, p2);
+    d2back = d2;
     return std::min(std::sqrt(d1 / nc) / (p1 / nc), std::sqrt(d2 / nc) / (p2 / nc));
   }
   Eigen::VectorXd flat(const std::vector<Vec3>& r) const {
@@ -139,47 +141,16 @@ Figures figures(const Problem3& P, const Blocks& B, const std::vector<Vec3>& r, 
   return f;
 }
 
-// Anderson type II over the pair map (core/sweep.hpp's algorithm, dense here).
-struct Anderson {
-  int m;
-  std::vector<Eigen::VectorXd> dF, dG;
-  Eigen::VectorXd fp, gp;
-  bool have = false;
-  double fn_prev = 0;
-  Eigen::VectorXd mix(const Eigen::VectorXd& x, const Eigen::VectorXd& g) {
-    const Eigen::VectorXd f = g - x;
-    const double fn = f.squaredNorm();
-    if (have && !(fn <= 100.0 * fn_prev)) {
-      dF.clear();
-      dG.clear();
-      have = false;
-    }
-    if (have) {
-      dF.push_back(f - fp);
-      dG.push_back(g - gp);
-      if (static_cast<int>(dF.size()) > m) {
-        dF.erase(dF.begin());
-        dG.erase(dG.begin());
-      }
-    }
-    fp = f;
-    gp = g;
-    fn_prev = fn;
-    have = true;
-    if (dF.empty()) return g;
-    const int k = static_cast<int>(dF.size());
-    Eigen::MatrixXd A(k, k);
-    Eigen::VectorXd b(k);
-    for (int i = 0; i < k; ++i) {
-      b[i] = dF[i].dot(f);
-      for (int j = 0; j <= i; ++j) A(i, j) = A(j, i) = dF[i].dot(dF[j]);
-    }
-    A.diagonal().array() += 1e-12 * A.diagonal().maxCoeff() + 1e-300;
-    const Eigen::VectorXd gam = A.ldlt().solve(b);
-    Eigen::VectorXd out = g;
-    for (int i = 0; i < k; ++i) out -= gam[i] * dG[i];
-    return out;
+// The rows as core/sweep.hpp's Anderson sees them (its AddsImpulse
+// interface): the production mixing and stall rule run here unchanged.
+struct VecRows {
+  static constexpr int kImpulseDim = 3;
+  void read_impulse(const Vec3& r, double* x) const {
+    x[0] = r[0];
+    x[1] = r[1];
+    x[2] = r[2];
   }
+  void add_impulse(Vec3& r, const double* dx) const { r += Vec3(dx[0], dx[1], dx[2]); }
 };
 
 // The scale s that the De Saxce-modified energy prefers along r itself:
@@ -233,7 +204,8 @@ int main(int argc, char** argv) {
     std::vector<Vec3> ref = r0;
     int ref_pairs = 0;
     for (; 2 * ref_pairs < ref_sweeps; ++ref_pairs) {
-      (void)B.pair(ref);
+      double unused;
+      (void)B.pair(ref, unused);
       if ((ref_pairs + 1) % 100 == 0 && problem_residual(P, B.flat(ref)).max < ref_residual) break;
     }
     const Figures fr = figures(P, B, ref, nullptr);
@@ -256,18 +228,23 @@ int main(int argc, char** argv) {
       const bool scale = base.size() > 6 && base.substr(base.size() - 6) == "+scale";
       if (scale) base.resize(base.size() - 6);
       const bool nncg = base == "nncg";
-      int mem = 0, stall = 0;  // anderson:M[:K]: plain gs for good after K pairs without a 10 % better criterion
+      int mem = 0;  // anderson:M (the production mixing and stall rule) or anderson:M:raw (no stall rule)
+      bool raw = false;
       if (base.rfind("anderson:", 0) == 0) {
         const std::string a = base.substr(9);
         const auto c = a.find(':');
         mem = std::stoi(a.substr(0, c));
-        if (c != std::string::npos) stall = std::stoi(a.substr(c + 1));
+        raw = c != std::string::npos && a.substr(c + 1) == "raw";
+        if (c != std::string::npos && !raw) throw std::invalid_argument("unknown method " + m);
       }
-      double best = 1e300;
-      int since = 0, off_at = 0;
       if (!nncg && mem == 0 && base != "gs") throw std::invalid_argument("unknown method " + m);
-      Anderson acc;
-      acc.m = mem;
+      std::optional<sweep::Anderson<3>> acc;
+      if (mem > 0) {
+        acc.emplace(mem, B.nc);
+        acc->start(r.data(), VecRows{});
+      }
+      sweep::Stall stall;
+      int off_at = 0;
       Eigen::VectorXd x = B.flat(r), p = Eigen::VectorXd::Zero(3 * B.nc);
       double fprev = 0;
       int restarts = 0;
@@ -275,7 +252,8 @@ int main(int argc, char** argv) {
       fmt::print("{}\n  {:>6} {:>9} {:>9} {:>7} {:>6} {:>9} {:>9}\n", m, "sweeps", "res max", "res mean", "loaded",
                  "excess", "sum r_n", "dist");
       for (int k = 1; k <= pairs; ++k) {
-        const double crit = B.pair(r);
+        double d2back = 0;
+        const double crit = B.pair(r, d2back);
         if (scale) rescale(B, r);
         const Eigen::VectorXd g = B.flat(r);
         for (double& t : stops)
@@ -307,20 +285,13 @@ int main(int argc, char** argv) {
             set(r, x);
           }
           fprev = fn;
-        } else if (mem > 0 && stall > 0 && crit >= 0.9 * best && ++since >= stall) {
-          mem = 0;  // stalled: plain gs from here
+        } else if (acc && !raw && stall.stalled(d2back)) {
+          acc.reset();  // stalled: plain gs from here
           off_at = 2 * k;
-          x = g;
-        } else if (mem > 0) {
-          if (crit < 0.9 * best) {
-            best = crit;
-            since = 0;
-          }
-          x = acc.mix(x, g);
-          set(r, x);
-        } else {
-          x = g;
+        } else if (acc) {
+          acc->mix(r.data(), VecRows{});
         }
+        if (!nncg) x = B.flat(r);
       }
       if (nncg) fmt::print("  restarts {}\n", restarts);
       if (off_at) fmt::print("  anderson off after {} sweeps\n", off_at);
