@@ -31,6 +31,7 @@
 #include <concepts>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "solver.hpp"
@@ -216,6 +217,17 @@ class Stall {
   int since_ = 0;
 };
 
+// Mean |p| over the rows (summed in row order) and the residuals' scale
+// (mean |p|, or 1 when it is 0): one definition for residuals() and for
+// residual_below(), whose stop decision must be residuals()'s exactly.
+template <class Row>
+std::pair<double, double> p_mean_and_scale(const std::vector<Row>& rows) {
+  double psum = 0;
+  for (const Row& r : rows) psum += impulse_norm(r);
+  const double p_mean = psum / static_cast<double>(rows.size());
+  return {p_mean, p_mean > 0 ? p_mean : 1.0};
+}
+
 // Law residual of every row (normalised by mean |p|), read-only.
 template <class Row, class C>
 void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, SolveStats& st) {
@@ -239,14 +251,13 @@ void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, Solve
     bs[b].rmax = rmax;
     bs[b].rsum = rsum;
   }
-  double rmax = 0, rsum = 0, psum = 0;
+  double rmax = 0, rsum = 0;
   for (const BlockStats& s : bs) {
     rmax = std::max(rmax, s.rmax);
     rsum += s.rsum;
   }
-  for (const Row& r : rows) psum += impulse_norm(r);
-  st.p_mean = psum / n;
-  const double scale = st.p_mean > 0 ? st.p_mean : 1.0;
+  const auto [p_mean, scale] = p_mean_and_scale(rows);
+  st.p_mean = p_mean;
   st.residual_max = rmax / scale;
   st.residual_mean = rsum / n / scale;
 }
@@ -255,17 +266,14 @@ void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, Solve
 // the same figures and decision but leaving at the first row that fails
 // it: the test fails on all but the last of a solve's checks, and a full
 // pass (a velocity and a natural-map residual with two hypot calls a row)
-// cost a quarter of a 3D run at I = 1e-3 (perf). The scale is the same sum
-// of |p| in row order; e / scale >= tol for some row exactly when max e /
+// cost a quarter of a 3D run at I = 1e-3 (perf). The scale is the same
+// (p_mean_and_scale); e / scale >= tol for some row exactly when max e /
 // scale >= tol (rounded division is monotone), and a NaN residual is
 // skipped as std::max skips it there. Read-only, one thread.
 template <class Row, class C>
 bool residual_below(const std::vector<Row>& rows, const C& c, double tol) {
   if (rows.empty()) return true;
-  double psum = 0;
-  for (const Row& r : rows) psum += impulse_norm(r);
-  const double p_mean = psum / static_cast<double>(rows.size());
-  const double scale = p_mean > 0 ? p_mean : 1.0;
+  const double scale = p_mean_and_scale(rows).second;
   for (const Row& r : rows)
     if (row_residual(c, r) / scale >= tol) return false;
   return true;
