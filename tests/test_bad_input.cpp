@@ -97,6 +97,8 @@ TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
   expect_refused("--set contact.mu_wall_b=0.5", {"contact.mu_wall_b", "dimension = 3"});
   expect_refused("--set 'contact.axis_a=[0,1,0]'", {"contact.axis_a", "dimension = 3"});
   expect_refused("--set contact.mu_b=nan", {"contact.mu_b"});
+  // The subspace correction serves the 3D sphere rows only.
+  expect_refused("--set solver.subspace=10", {"solver.subspace", "3D"});
   // t_p = d sqrt(rho/p): a huge dt_tp makes a step longer than the run.
   const std::string shear =
       "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 20\n[time]\nduration = 0.01\n"

@@ -15,6 +15,8 @@
 #include <cmath>
 #include <string>
 
+#include <omp.h>
+
 #include "checkpoint3.hpp"
 #include "cli_util.hpp"
 #include "setup3.hpp"
@@ -28,6 +30,10 @@ namespace {
 // Sweeps the accelerated solve needed to reach tol 1e-3 on this step when
 // measured (2026-11-26; plain NLGS: 393): the guard's bound.
 constexpr int kMeasuredAndersonSweeps = 125;
+// Sweeps and CG iterations of the subspace-corrected solve (10 iterations a
+// correction) to tol 7e-4 on this step when measured (2026-11-26).
+constexpr int kMeasuredSubspaceSweeps = 84;
+constexpr int kMeasuredSubspaceCg = 200;
 
 // The sheared state, once for the whole file.
 const World3& sheared() {
@@ -47,13 +53,15 @@ const World3& sheared() {
 }
 
 // One step of the sheared state with the given solver settings.
-World3 solve_step(double tol, int max_iter, int anderson) {
+World3 solve_step(double tol, int max_iter, int anderson, int subspace = 0, int min_parallel = -1) {
   World3 w = sheared();
   WorldParams3 p = w.params();
   p.solver.tol = tol;
   p.solver.max_iter = max_iter;
   p.solver.residual_tol = 0.0;
   p.solver.anderson = anderson;
+  p.solver.subspace = subspace;
+  if (min_parallel >= 0) p.solver.min_parallel = min_parallel;
   w.set_params(p);
   w.step();
   return w;
@@ -128,4 +136,68 @@ TEST(SweepAnderson, StalledMixingFallsBackToNlgs) {
   EXPECT_GT(a.anderson_off, 0);
   EXPECT_LE(a.iterations, n.iterations);
   EXPECT_LE(a.residual_max, 1.5 * n.residual_max);
+}
+
+// The subspace correction (solver.subspace, core/sweep.hpp's Subspace) on
+// the same step. At the production test it stops on a solution of the step
+// (no cap; law residual, velocities and stress as plain NLGS's at the same
+// tolerance, the factors as above), and it carries the loaded-contact set
+// (r_n > 0), the figure whose slow convergence biases z in dense shear,
+// at least as close to the tight reference's as plain NLGS does.
+TEST(SweepSubspace, SolvesTheSameStepAsPlainNlgs) {
+  const World3 ref = solve_step(1e-14, 10000, 0);
+  const World3 sub = solve_step(7e-4, 20000, 0, 10);
+  const World3 nlgs = solve_step(7e-4, 20000, 0);
+  const SolveStats& a = sub.last().solve;
+  const SolveStats& n = nlgs.last().solve;
+  auto loaded = [](const World3& w) {
+    int k = 0;
+    for (const SphereRow& r : w.rows()) k += r.r[0] > 0;
+    return k;
+  };
+  const Eigen::Matrix3d Sr = ref.contact_stress();
+  const double dva = velocity_distance(sub, ref), dvn = velocity_distance(nlgs, ref);
+  const double dsa = (sub.contact_stress() - Sr).norm() / Sr.norm();
+  const double dsn = (nlgs.contact_stress() - Sr).norm() / Sr.norm();
+  std::printf("tol 7e-4: subspace(10) %d sweeps + %d CG, residual %.3e, |dv| %.3e, |dS| %.3e, loaded %d; NLGS %d, %.3e, "
+              "%.3e, %.3e, loaded %d; reference loaded %d\n",
+              a.iterations, a.subspace_iterations, a.residual_max, dva, dsa, loaded(sub), n.iterations, n.residual_max,
+              dvn, dsn, loaded(nlgs), loaded(ref));
+  EXPECT_FALSE(a.cap_hit);
+  EXPECT_GT(a.subspace_iterations, 0);
+  EXPECT_LE(a.residual_max, 1.5 * n.residual_max);
+  EXPECT_LE(dva, 2.0 * dvn + 1e-12);
+  EXPECT_LE(dsa, 2.0 * dsn + 1e-12);
+  EXPECT_LE(std::abs(loaded(sub) - loaded(ref)), std::abs(loaded(nlgs) - loaded(ref)));
+}
+
+// The regression guard of the subspace correction: sweeps and CG
+// iterations to the production test at tol 7e-4 (the 3D shear policy's
+// setting at I >= 0.01), bounded by what they were when measured (the
+// solve is deterministic), and their sum below plain NLGS's sweeps.
+TEST(SweepSubspace, RegressionGuardWorkToTol7e4) {
+  const World3 sub = solve_step(7e-4, 2000, 0, 10);
+  const World3 nlgs = solve_step(7e-4, 2000, 0);
+  const SolveStats& a = sub.last().solve;
+  std::printf("sweeps to tol 7e-4: subspace(10) %d + %d CG, NLGS %d\n", a.iterations, a.subspace_iterations,
+              nlgs.last().solve.iterations);
+  EXPECT_FALSE(a.cap_hit);
+  EXPECT_LE(a.iterations, kMeasuredSubspaceSweeps);
+  EXPECT_LE(a.subspace_iterations, kMeasuredSubspaceCg);
+  EXPECT_LT(a.iterations + a.subspace_iterations, nlgs.last().solve.iterations);
+}
+
+// The corrections run on one thread between sweeps: the step's impulses are
+// the same, bit for bit, whether the sweeps run on one thread or two (the
+// parallel sweep forced on: min_parallel 64 for ~600 rows).
+TEST(SweepSubspace, ResultsDoNotDependOnThreads) {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const World3 one = solve_step(7e-4, 2000, 0, 10, 64);
+  omp_set_num_threads(2);
+  const World3 two = solve_step(7e-4, 2000, 0, 10, 64);
+  omp_set_num_threads(before);
+  ASSERT_EQ(one.rows().size(), two.rows().size());
+  EXPECT_EQ(one.last().solve.iterations, two.last().solve.iterations);
+  for (std::size_t k = 0; k < one.rows().size(); ++k) ASSERT_EQ(one.rows()[k].r, two.rows()[k].r) << "row " << k;
 }

@@ -176,13 +176,14 @@ struct Step3 {
 // floats: exact) to `out` if given.
 template <class Step>
 int solve_step(const std::string& path, double tol, int max_sweeps, double residual_tol, int anderson,
-               const std::string& out) {
+               int subspace, const std::string& out) {
   cd::SolverParams prm;
   typename Step::Problem p = Step::read(path, prm);
   if (tol > 0) prm.tol = tol;
   if (max_sweeps > 0) prm.max_iter = max_sweeps;
   if (residual_tol >= 0) prm.residual_tol = residual_tol;
   if (anderson >= 0) prm.anderson = anderson;
+  if (subspace >= 0) prm.subspace = subspace;
   fmt::print("{}: {}\n", path, Step::describe(p));
   const auto t0 = std::chrono::steady_clock::now();
   const cd::SolveStats st = Step::solve(p, prm);
@@ -193,6 +194,9 @@ int solve_step(const std::string& path, double tol, int max_sweeps, double resid
       st.cap_hit ? "NOT converged (sweep cap)" : st.residual_met ? "converged (law residual)" : "converged",
       st.iterations, st.dp_rel, prm.tol, st.residual_max, st.residual_mean, st.p_mean, t);
   if (st.anderson_off > 0) fmt::print("anderson: stalled, off after {} sweeps (plain NLGS from there)\n", st.anderson_off);
+  if (prm.subspace > 0)
+    fmt::print("subspace: {} CG iterations{}\n", st.subspace_iterations,
+               st.subspace_off > 0 ? fmt::format(", stalled and stopped after {} sweeps", st.subspace_off) : "");
   if (!out.empty()) {
     cd::write_file_atomic(out, Step::impulses(p));  // WriteError (exit 4) if it cannot be written
   }
@@ -235,6 +239,11 @@ int main(int argc, char** argv) {
                   "(.cdp, .cdp3) Anderson acceleration over this many symmetric pairs (solver.anderson); 0: off; "
                   "default: the step's own")
       ->check(CLI::Range(0, cd::kAndersonMaxMemory));
+  int subspace = -1;
+  cmd->add_option("--subspace", subspace,
+                  "(.cdp3) the subspace correction with at most this many CG iterations (solver.subspace); 0: off; "
+                  "default: the step's own")
+      ->check(CLI::Range(0, 1000));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -246,7 +255,7 @@ int main(int argc, char** argv) {
       if (lemke) throw std::runtime_error("--lemke takes a .dat or .hdf5 problem (matrix form)");
       const bool tol_given = cmd->count("--tol") > 0, cap_given = cmd->count("--max-sweeps") > 0;
       return (ends(".cdp") ? solve_step<Step2> : solve_step<Step3>)(path, tol_given ? opt.tol : 0.0,
-                                                       cap_given ? opt.max_sweeps : 0, residual_tol, anderson, out);
+                                                       cap_given ? opt.max_sweeps : 0, residual_tol, anderson, subspace, out);
     }
     if (ends(".hdf5")) return solve_fclib(path, opt, lemke, facets);
     return solve_dat(path, opt, lemke, facets);

@@ -15,6 +15,12 @@
 //   anderson:M  core/sweep.hpp's Anderson mixing of the pair map over M
 //             pairs with its stall rule (Stall), the production code itself
 //             on these rows; anderson:M:raw without the stall rule;
+//   sm:P:C    core/sweep.hpp's subspace correction (Subspace: the
+//             sticking and sliding rows' linear problem by at most C
+//             Jacobi-preconditioned CG iterations) after every P-th gs
+//             pair; production corrects every Subspace::kSubspaceEvery
+//             pairs and holds the cell dofs, which the matrix form moves;
+//             the CG iterations are reported with the sweeps ("work");
 //   METHOD+scale  the method, with every pair's iterate rescaled along
 //             itself, r <- s r, s the zero of the De Saxce-modified power
 //             sum_k r_k.(s W r + q + mu |u_t| e_n)_k (a one-dimensional
@@ -26,7 +32,7 @@
 // over the reference's, the sum of normal impulses against the reference's,
 // and rms |r - r_ref| / mean |r_ref|; and where the production criterion
 // (rms |dr| / mean |r| of a sweep) first meets each of --tols, the same.
-//   solvers3 FILE.cdp3 [--methods gs,nncg,anderson:5] [--pairs 1000]
+//   solvers3 FILE.cdp3 [--methods gs,nncg,anderson:5,sm:2:10] [--pairs 1000]
 //            [--every 5] [--ref-sweeps 20000] [--tols 1e-3,1e-4] [--csv OUT.csv]
 // One thread.
 #include <CLI/CLI.hpp>
@@ -172,6 +178,57 @@ double rescale(const Blocks& B, std::vector<Vec3>& r) {
   return sc;
 }
 
+// The rows as core/sweep.hpp's Subspace sees them: W's blocks in place of
+// the bodies (the cell dofs condensed in, so the corrections move them too,
+// where production holds them), the sphere's diagonal preconditioner.
+struct BlockRows : VecRows {
+  const Blocks& B;
+  const Vec3* base;
+  template <class L>
+  static constexpr bool kSubspaceLaw = true;
+  using Scratch = int;
+  Scratch subspace_scratch() const { return 0; }
+  int index(const Vec3& r) const { return static_cast<int>(&r - base); }
+  template <class L>
+  void subspace_row(const Vec3& r, double* free, double* diag, double* u) const {
+    const int i = index(r);
+    Vec3 v = B.q[i] + B.diag[i] * r;
+    for (int k = B.start[i]; k < B.start[i + 1]; ++k) v.noalias() += B.off[k] * base[B.col[k]];
+    for (int k = 0; k < 3; ++k) {
+      u[k] = v[k];
+      diag[k] = B.diag[i](k, k);
+    }
+    const bool closed = r[0] > 0, sticks = closed && std::hypot(r[1], r[2]) < (1.0 - 1e-9) * B.cone[i].mu_a * r[0];
+    free[0] = closed ? 1.0 : 0.0;
+    free[1] = free[2] = sticks ? 1.0 : 0.0;
+  }
+  void subspace_apply(const Vec3*, const std::vector<int>& live, const double* p, double* y, Scratch&) const {
+    for (const int i : live) {
+      Vec3 w = B.diag[i] * Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+      for (int k = B.start[i]; k < B.start[i + 1]; ++k) {
+        const int j = B.col[k];
+        w.noalias() += B.off[k] * Vec3(p[3 * j], p[3 * j + 1], p[3 * j + 2]);
+      }
+      y[3 * i] = w[0];
+      y[3 * i + 1] = w[1];
+      y[3 * i + 2] = w[2];
+    }
+  }
+  template <class L>
+  void subspace_put(Vec3& r, const double* d, bool sticking) const {
+    Vec3 y(r[0] + d[0], r[1], r[2]);
+    if (sticking) {
+      y[1] += d[1];
+      y[2] += d[2];
+    } else {
+      y.tail<2>() *= std::max(y[0], 0.0) / r[0];
+    }
+    r = law3_detail::project_cone(y, B.cone[index(r)].mu_a);
+  }
+};
+
+struct RoundCone {};  // the law tag Subspace::correct passes on (BlockRows reads none)
+
 void set(std::vector<Vec3>& r, const Eigen::VectorXd& x) {
   for (std::size_t i = 0; i < r.size(); ++i) r[i] = x.segment<3>(3 * i);
 }
@@ -185,7 +242,7 @@ int main(int argc, char** argv) {
   double ref_residual = 1e-7;
   std::vector<double> tols{3e-3, 2e-3, 1e-3, 3e-4, 1e-4};
   app.add_option("file", file, ".cdp3 problem")->required();
-  app.add_option("--methods", methods_s, "gs, nncg, anderson:M");
+  app.add_option("--methods", methods_s, "gs, nncg, anderson:M[:raw], sm:P:C, each [+scale]");
   app.add_option("--pairs", pairs, "symmetric pairs per method");
   app.add_option("--every", every, "report every K pairs");
   app.add_option("--ref-sweeps", ref_sweeps, "reference: gs sweeps at most");
@@ -237,7 +294,18 @@ int main(int argc, char** argv) {
         raw = c != std::string::npos && a.substr(c + 1) == "raw";
         if (c != std::string::npos && !raw) throw std::invalid_argument("unknown method " + m);
       }
-      if (!nncg && mem == 0 && base != "gs") throw std::invalid_argument("unknown method " + m);
+      // sm:P:C: core/sweep.hpp's subspace correction, C CG iterations at most, every P pairs
+      int sm_every = 0, cg = 0;
+      std::optional<sweep::Subspace<3>> sm;
+      BlockRows::Scratch sm_scratch = 0;
+      if (base.rfind("sm:", 0) == 0) {
+        const std::string a = base.substr(3);
+        const auto c = a.find(':');
+        if (c == std::string::npos) throw std::invalid_argument("sm:P:C expected, got " + m);
+        sm_every = std::stoi(a.substr(0, c));
+        sm.emplace(std::stoi(a.substr(c + 1)), B.nc);
+      }
+      if (!nncg && mem == 0 && !sm && base != "gs") throw std::invalid_argument("unknown method " + m);
       std::optional<sweep::Anderson<3>> acc;
       if (mem > 0) {
         acc.emplace(mem, B.nc);
@@ -259,18 +327,19 @@ int main(int argc, char** argv) {
         for (double& t : stops)
           if (t > 0 && crit < t) {
             const Figures f = figures(P, B, r, &ref);
-            fmt::print("  STOP tol {:.0e} at {} sweeps: residual {:.2e}, loaded excess {:+d}, sum r_n {:+.3f}%, dist {:.2e}\n", t,
-                       2 * k, f.rmax, f.loaded - fr.loaded, 100 * (f.sum_n / fr.sum_n - 1), f.dist);
+            fmt::print("  STOP tol {:.0e} at {} sweeps (+{} cg): residual {:.2e}, loaded excess {:+d}, sum r_n {:+.3f}%, dist {:.2e}\n", t,
+                       2 * k, cg, f.rmax, f.loaded - fr.loaded, 100 * (f.sum_n / fr.sum_n - 1), f.dist);
             t = 0;
           }
         if (k % every == 0 || k == pairs) {
           const Figures f = figures(P, B, r, &ref);
-          fmt::print("  {:6d} {:9.2e} {:9.2e} {:7d} {:+6d} {:+8.3f}% {:9.2e}\n", 2 * k, f.rmax, f.rmean, f.loaded,
-                     f.loaded - fr.loaded, 100 * (f.sum_n / fr.sum_n - 1), f.dist);
+          fmt::print("  {:6d} {:9.2e} {:9.2e} {:7d} {:+6d} {:+8.3f}% {:9.2e} {:6d}\n", 2 * k, f.rmax, f.rmean, f.loaded,
+                     f.loaded - fr.loaded, 100 * (f.sum_n / fr.sum_n - 1), f.dist, 2 * k + cg);
           if (out.is_open())
             out << fmt::format("{},{},{:.6e},{:.6e},{},{},{:.6e},{:.6e}\n", m, 2 * k, f.rmax, f.rmean, f.loaded,
                                f.loaded - fr.loaded, f.sum_n / fr.sum_n - 1, f.dist);
         }
+        if (sm && k % sm_every == 0) cg += sm->correct<RoundCone>(r.data(), BlockRows{{}, B, r.data()}, sm_scratch);
         if (nncg) {
           const Eigen::VectorXd d = g - x;  // -grad
           const double fn = d.squaredNorm();

@@ -55,7 +55,7 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
   const SolveStats st = std::visit(
       [&](auto law) {
         using L = decltype(law);
-        sweep::BodyCoupling3 c{p.vel.data(), extra, rows.data()};
+        sweep::BodyCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size())};
         return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
       },
       p.law);

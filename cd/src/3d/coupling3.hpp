@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 #include <variant>
+#include <vector>
 
 #include "contact3.hpp"
 #include "law3.hpp"
@@ -202,6 +203,72 @@ struct BodyCoupling3 {
     const Vec3 d(dx[0], dx[1], dx[2]);
     r.r += d;
     push_impulse(r, d, vel);
+  }
+
+  // For the sweep's subspace correction (core/sweep.hpp, Subspace): the
+  // laws with the round cone (or none), with or without adhesion. The
+  // products W p go through a copy of the bodies (masses kept, velocities
+  // zeroed each time); nbodies is the size of vel.
+  int nbodies = 0;
+  template <class L>
+  static constexpr bool kSubspaceLaw = !L::orthotropic;
+  using Scratch = std::vector<BodyVel3>;
+  Scratch subspace_scratch() const { return Scratch(vel, vel + nbodies); }
+  // A closed row (shifted normal impulse s_n = r_n + a > 0, a the adhesion)
+  // is free in its normal component, and in its tangential ones too when it
+  // sticks (|r_t| below mu s_n by more than round-off: the local solve puts
+  // a sliding impulse on the cone itself).
+  template <class L>
+  void subspace_row(const SweepRow3& r, double* free, double* diag, double* u) const {
+    const Vec3 v = velocity(r);
+    u[0] = v[0];
+    u[1] = v[1];
+    u[2] = v[2];
+    diag[0] = 1.0 / r.iwnn;
+    diag[1] = diag[2] = 1.0 / r.iwtt;
+    const double sn = r.r[0] + (L::cohesive ? r.adh : 0.0);
+    const bool closed = sn > 0;
+    const bool sticks = L::tangential && closed && std::hypot(r.r[1], r.r[2]) < (1.0 - 1e-9) * r.mu * sn;
+    free[0] = closed ? 1.0 : 0.0;
+    free[1] = free[2] = sticks ? 1.0 : 0.0;
+  }
+  // y = W p on the rows listed in live, through s (offsets and b_n left
+  // out); the other rows' p is zero and their y is not read.
+  void subspace_apply(const SweepRow3* R, const std::vector<int>& live, const double* p, double* y, Scratch& s) const {
+    for (BodyVel3& b : s) {
+      b.v.setZero();
+      b.w.setZero();
+    }
+    for (const int i : live) push_impulse<true>(R[i], Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), s.data());
+    for (const int i : live) {
+      const SweepRow3& r = R[i];
+      const BodyVel3& A = s[r.b1];
+      const BodyVel3& B = s[r.b2];
+      const Vec3 dv = B.v - A.v;
+      const Vec3 om = r.l2 * B.w - r.l1 * A.w;
+      y[3 * i] = r.n.dot(dv);
+      y[3 * i + 1] = r.t1.dot(dv) + r.t2.dot(om);
+      y[3 * i + 2] = r.t2.dot(dv) - r.t1.dot(om);
+    }
+  }
+  // r <- the law's projection of r + d (its local solve's, L::solve): a
+  // sliding row's tangential impulse held in direction and scaled with the
+  // shifted normal one (it stays on the cone's edge).
+  template <class L>
+  void subspace_put(SweepRow3& r, const double* d, bool sticking) const {
+    Vec3 y(r.r[0] + d[0], r.r[1], r.r[2]);
+    if (sticking) {
+      y[1] += d[1];
+      y[2] += d[2];
+    } else if (L::tangential) {
+      const double a = L::cohesive ? r.adh : 0.0;
+      y.tail<2>() *= std::max(y[0] + a, 0.0) / (r.r[0] + a);
+    }
+    Vec3 out;
+    L::solve(r, extra_of(r), y, out);
+    const Vec3 dr = out - r.r;
+    r.r = out;
+    push_impulse<true>(r, dr, vel);
   }
 
   // One row update: the stick trial g = r - W^-1 u from the velocity at

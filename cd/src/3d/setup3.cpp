@@ -192,6 +192,7 @@ WorldParams3 world_params3(const Scene& s0) {
   p.solver.tol = s.tol;
   p.solver.residual_tol = s.residual_tol;
   p.solver.anderson = s.anderson;
+  p.solver.subspace = s.subspace;
   p.solver.max_iter = s.max_iter;
   if (s.shear_mode == ShearMode::Periodic) {
     p.cell = Vec3(s.cell_width, s.cell_height, s.cell_depth);

@@ -332,6 +332,8 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     sum.max_iterations = std::max(sum.max_iterations, st.solve.iterations);
     sum.cap_hits += st.solve.cap_hit;
     sum.anderson_off += st.solve.anderson_off > 0;
+    sum.subspace_off += st.solve.subspace_off > 0;
+    sum.subspace_iterations += st.solve.subspace_iterations;
     sum.max_residual = std::max(sum.max_residual, st.solve.residual_max);
     sum.max_overlap = std::max(sum.max_overlap, st.max_overlap);
     sum.max_overlap_small = std::max(sum.max_overlap_small, st.max_overlap_small);

@@ -64,6 +64,8 @@ struct RunSummary {
   int max_iterations = 0;
   std::int64_t cap_hits = 0;
   std::int64_t anderson_off = 0;  // steps whose Anderson mixing stalled and went off (SolveStats::anderson_off)
+  std::int64_t subspace_off = 0;  // steps whose subspace corrections stalled and stopped (SolveStats::subspace_off)
+  std::int64_t subspace_iterations = 0;  // conjugate-gradient iterations of the subspace corrections, all steps
   double max_residual = 0;
   double max_overlap = 0;        // largest overlap / mean diameter
   double max_overlap_small = 0;  // largest overlap / the smaller grain's diameter

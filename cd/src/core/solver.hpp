@@ -34,6 +34,13 @@ struct SolverParams {
   // last `anderson` pairs, the memory cleared when the pair's change grows.
   // Needs a coupling that can add an impulse to a row (AddsImpulse); 0: off.
   int anderson = defaults::anderson;
+  // > 0: the subspace correction of the sweep (core/sweep.hpp, Subspace):
+  // every two pairs of sweeps, the linear problem of the sticking and
+  // sliding rows is solved by at most this many conjugate-gradient
+  // iterations and put into the rows, until a stall (the Anderson rule)
+  // stops them for the rest of the solve. Needs a coupling and law that
+  // take it (3D spheres with the round cone, adhesion or not); 0: off.
+  int subspace = defaults::subspace;
 };
 
 struct SolveStats {
@@ -46,6 +53,8 @@ struct SolveStats {
   double dof_rel = 0;        // last sweep's largest dof residual / (inv_mass scale) (update_dof)
   bool residual_met = false; // stopped by SolverParams::residual_tol
   int anderson_off = 0;      // > 0: Anderson stalled and was turned off after this many sweeps
+  int subspace_off = 0;      // > 0: the subspace corrections stalled and stopped after this many sweeps
+  int subspace_iterations = 0;  // conjugate-gradient iterations of the subspace corrections (each ~ a sweep)
 };
 
 // Called after every sweep with the sweep count and its dp_rel, on one

@@ -217,6 +217,87 @@ class Stall {
   int since_ = 0;
 };
 
+// Subspace correction of the sweep (SolverParams::subspace; after the
+// "PGS-SM" of Silcowitz, Niebe & Erleben, VRIPHYS 2009, taken from the
+// box-friction LCP to the Coulomb cone). Gauss-Seidel is slow on the
+// long-wavelength modes of the sticking, hyperstatic network
+// (docs/accuracy.md, "Where the sweeps go"), which is linear once the
+// status of each contact is known. Every kSubspaceEvery pairs of sweeps the
+// iterate's status fixes a linear problem: a sticking row (r inside its
+// cone) keeps u = 0 on all its components, a sliding one u_n = 0 with its
+// tangential impulse held, an open one r = 0; W_FF d = -u_F on the free
+// components F is solved by Jacobi-preconditioned conjugate gradients from
+// d = 0 for at most `subspace` iterations (relative residual kSubspaceRel),
+// and r + d (a sliding row's tangential impulse scaled with its normal
+// one, so that it stays on the cone's edge) is projected on the cone and
+// put into the rows and their bodies. W is symmetric positive
+// semidefinite and the system consistent, so CG converges on it and leaves
+// the indeterminate part of the forces where the sweeps put it. The
+// boundary dofs are held (their own update follows in the next sweep). One
+// CG iteration is one product W p through the bodies of the closed rows (a
+// scatter and a gather). When the pairs stall (Stall, the rule of Anderson's
+// mixing, fed apart) the corrections stop for the rest of the solve. One
+// thread, in row order: results do not depend on threads.
+// A coupling C takes it when, for the law L, it provides
+//   C::Scratch c.subspace_scratch()     bodies' storage for the products
+//   c.subspace_row<L>(row, free, diag, u)  per component: 1/0 free, W_kk's
+//       diagonal, the row's velocity; all-zero free when L has no such step
+//   c.subspace_apply(rows, live, p, y, scratch)   y = W p on the rows listed
+//       in live (the others' p is 0 and their y unread; no offsets)
+//   c.subspace_put<L>(row, d, sticking)    r <- proj(r + d), bodies follow
+template <class C, class Row, class L>
+concept Subspaces = AddsImpulse<C, Row> && C::template kSubspaceLaw<L>;
+
+template <int D>
+class Subspace {
+ public:
+  static constexpr int kSubspaceEvery = 2;      // pairs of sweeps between corrections
+  static constexpr double kSubspaceRel = 1e-2;  // CG's relative residual
+
+  Subspace(int iters, int rows)
+      : iters_(iters), n_(rows * D), free_(n_), diag_(n_), d_(n_), res_(n_), z_(n_), p_(n_), wp_(n_) {}
+
+  // One correction of the rows' impulses; returns the CG iterations spent.
+  template <class L, class Row, class C, class Scratch>
+  int correct(Row* R, const C& c, Scratch& s) {
+    const int nr = n_ / D;
+    for (int i = 0, k = 0; i < nr; ++i, k += D)
+      c.template subspace_row<L>(R[i], free_.data() + k, diag_.data() + k, res_.data() + k);
+    live_.clear();  // the rows with a free component: the products skip the open ones
+    for (int i = 0, k = 0; i < nr; ++i, k += D)
+      if (free_[k] != 0) live_.push_back(i);
+    res_ = -(free_.array() * res_.array()).matrix();
+    z_ = (res_.array() / diag_.array()).matrix();
+    p_ = z_;
+    d_.setZero();
+    double rz = res_.dot(z_);
+    const double stop = kSubspaceRel * kSubspaceRel * res_.squaredNorm();
+    int it = 0;
+    for (; it < iters_ && res_.squaredNorm() > stop; ++it) {
+      c.subspace_apply(R, live_, p_.data(), wp_.data(), s);
+      wp_.array() *= free_.array();
+      const double pwp = p_.dot(wp_);
+      if (!(pwp > 0)) break;
+      const double a = rz / pwp;
+      d_ += a * p_;
+      res_ -= a * wp_;
+      z_ = (res_.array() / diag_.array()).matrix();
+      const double rz1 = res_.dot(z_);
+      p_ = z_ + (rz1 / rz) * p_;
+      rz = rz1;
+    }
+    if (!d_.allFinite()) return it;  // nothing put: the sweeps go on from where they are
+    for (int i = 0, k = 0; i < nr; ++i, k += D)
+      if (free_[k] != 0) c.template subspace_put<L>(R[i], d_.data() + k, D > 1 && free_[k + 1] != 0);
+    return it;
+  }
+
+ private:
+  int iters_, n_;
+  Eigen::VectorXd free_, diag_, d_, res_, z_, p_, wp_;
+  std::vector<int> live_;
+};
+
 // Mean |p| over the rows (summed in row order) and the residuals' scale
 // (mean |p|, or 1 when it is 0): one definition for residuals() and for
 // residual_below(), whose stop decision must be residuals()'s exactly.
@@ -372,6 +453,18 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
       acc->start(R, c);
     }
   }
+  // The subspace correction (off unless asked and the coupling takes it for L).
+  std::optional<Subspace<impulse_dim<C>()>> sub;
+  Stall sub_stall;
+  auto scratch = [&] {
+    if constexpr (Subspaces<C, Row, L>)
+      return prm.subspace > 0 ? c.subspace_scratch() : typename C::Scratch{};
+    else
+      return 0;
+  }();
+  if constexpr (Subspaces<C, Row, L>) {
+    if (prm.subspace > 0) sub.emplace(prm.subspace, n);
+  }
 
 #pragma omp parallel if (parallel)
   {
@@ -421,6 +514,16 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
             } else {
               acc->mix(R, c);
             }
+          }
+        }
+        if constexpr (Subspaces<C, Row, L>) {
+          if (sub && !done && it % 2 == 0 && sub_stall.stalled(pair_dsum)) {
+            sub.reset();  // stalled: no more corrections in this solve
+            st.subspace_off = it;
+          }
+          if (sub && !done && it % (2 * Subspace<impulse_dim<C>()>::kSubspaceEvery) == 0) {
+            st.subspace_iterations += sub->template correct<L>(R, c, scratch);
+            if (acc) acc->start(R, c);  // the next pair starts from the corrected impulses
           }
         }
       }

@@ -146,6 +146,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"solver", "max_iter", &Scene::max_iter, "", in(1, 1e8), "NLGS iteration cap per time step"},
       {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "anderson", &Scene::anderson, "", in(0, 50), "> 0: Anderson acceleration of the sweep with this memory (5 is the measured choice): after each forward-backward pair of sweeps the impulses are mixed over the last pairs, and the mixing is off for the rest of a step's solve once it stalls (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it (docs/shear.md, Settings by I); 0: plain NLGS"},
+      {"solver", "subspace", &Scene::subspace, "", in(0, 1000), "> 0: the subspace correction of the sweep (3D only; it acts on the round cone, with adhesion or not, and does nothing under the orthotropic one): every two forward-backward pairs of sweeps, the linear problem of the contacts that stick (u = 0) and slide (u_n = 0) is solved by at most this many conjugate-gradient iterations and put into the impulses (docs/accuracy.md); 0: off"},
       {"solver", "threads", &Scene::threads, "", in(0, 1024), "OpenMP threads; 0: OpenMP default"},
       {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
@@ -568,6 +569,10 @@ Scene read_scene(const toml::value& root, const std::string& path) {
     out.add(child(child(root, "box"), "depth"), "depth",
             fmt::format("box.depth = {}: only a dimension = 3 scene has a depth",
                         text(s.box_depth, false)));
+  if (s.dimension == 2 && s.subspace > 0)
+    out.add(child(child(root, "solver"), "subspace"), "subspace",
+            fmt::format("solver.subspace = {}: the subspace correction serves 3D spheres only (dimension = 3); "
+                        "2D scenes take solver.anderson", s.subspace));
   if (s.dimension == 2 && (s.mu_b >= 0 || s.mu_wall_b >= 0))
     out.add(child(child(root, "contact"), s.mu_b >= 0 ? "mu_b" : "mu_wall_b"), s.mu_b >= 0 ? "mu_b" : "mu_wall_b",
             fmt::format("contact.{} = {}: an orthotropic (elliptic) cone needs a 2D tangent plane, "

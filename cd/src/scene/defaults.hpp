@@ -12,6 +12,7 @@ inline constexpr bool rotation = true;      // bodies rotate
 inline constexpr double tol = 1e-4;         // NLGS eps_f on rms |dp| / mean |p|
 inline constexpr int max_iter = 2000;       // NLGS sweep cap per step
 inline constexpr double residual_tol = 0.0; // law-residual stop; 0: off
+inline constexpr int subspace = 0;          // subspace correction: CG iterations; 0: off
 inline constexpr int anderson = 0;          // Anderson acceleration memory; 0: off
 
 }  // namespace cd::defaults

@@ -84,6 +84,7 @@ struct Scene {
   int max_iter = defaults::max_iter;         // iteration cap per step
   double residual_tol = defaults::residual_tol;  // > 0: also stop on the law residual
   int anderson = defaults::anderson;         // > 0: Anderson acceleration memory
+  int subspace = defaults::subspace;         // > 0: subspace correction's CG iterations
   int threads = 0;           // 0: OpenMP default
 
   // [particles]: random generation (n = 0 for none)
