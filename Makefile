@@ -579,7 +579,7 @@ frozen-shear3:
 frozen-shear3-run: $(CAMPAIGNS)/frozen3/I_0.01/.done
 $(CAMPAIGNS)/frozen3/I_0.01/.done: $(CAMPAIGNS)/prep/ns_0/.done
 	$(call shear_cmd,0.01,$(CAMPAIGNS)/prep/ns_0,$(P),$(FS3_STRAIN)) --fresh --set output.snapshot_interval=0 \
-	  --set solver.anderson=0 --dump-problem $(call fs_steps,0.01,$(FS3_STRAIN))
+	  --set solver.subspace=0 --dump-problem $(call fs_steps,0.01,$(FS3_STRAIN))
 	touch $@
 
 # ---- Accuracy against cost in steady shear (issue 14, item 1) ----------------
@@ -641,22 +641,24 @@ $(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(eva
 # A3_W0, +- the standard error over samples, the difference to the first
 # setting in combined errors, CPU per unit strain, sweeps a step, capped
 # steps, the largest overlap and law residual. Settings (a3_set_<name>):
-a3_set_ref    := --set solver.tol=1e-4 --set solver.residual_tol=3e-3 --set solver.max_iter=5000 --set solver.anderson=0
+a3_set_ref    := --set solver.tol=1e-4 --set solver.residual_tol=3e-3 --set solver.max_iter=5000 --set solver.subspace=0
 a3_set_policy :=
-a3_set_plain  := --set solver.anderson=0
-a3_set_anderson7e-4 := --set solver.tol=7e-4
-a3_set_mid    := --set solver.tol=2e-3 --set solver.anderson=5 --set contact.overlap_projection=0.5
-a3_set_fast   := --set solver.tol=3e-3 --set solver.anderson=5 --set contact.overlap_projection=0.5
-a3_set_anderson1e-3 := --set solver.tol=1e-3 --set solver.anderson=5 --set contact.overlap_projection=0.5 --set solver.max_iter=600
-# ref is plain NLGS; policy is the 3D scene's own (Anderson's mixing at the
-# policy's tol_anderson), plain the same policy without it (the policy
-# before the sixth session). 1000 spheres, 3 seeds, I = 0.01, the five
+a3_set_plain  := --set solver.subspace=0
+a3_set_anderson := --set solver.subspace=0 --set solver.anderson=5
+a3_set_anderson7e-4 := --set solver.subspace=0 --set solver.anderson=5 --set solver.tol=7e-4
+a3_set_mid    := --set solver.tol=2e-3 --set solver.subspace=0 --set solver.anderson=5 --set contact.overlap_projection=0.5
+a3_set_fast   := --set solver.tol=3e-3 --set solver.subspace=0 --set solver.anderson=5 --set contact.overlap_projection=0.5
+a3_set_anderson1e-3 := --set solver.tol=1e-3 --set solver.subspace=0 --set solver.anderson=5 --set contact.overlap_projection=0.5 --set solver.max_iter=600
+# ref is plain NLGS; policy is the 3D scene's own (the subspace correction
+# at the policy's tol_subspace), plain the same policy without it (the
+# policy before the sixth session), anderson the sixth session's (Anderson's
+# mixing at tol_anderson). 1000 spheres, 3 seeds, I = 0.01, the five
 # settings: ~2 CPU hours, most of it the reference's (docs/accuracy.md,
 # "Three samples").
 A3_N ?= 1000
 A3_SEEDS ?= 11 12 13
 A3_I ?= 0.01
-A3_SETTINGS ?= ref policy plain mid fast
+A3_SETTINGS ?= ref policy anderson plain fast
 A3_START ?= 0.5
 A3_STRAIN ?= 1
 A3_W0 ?= 0.1

@@ -2,9 +2,12 @@
 // of 500 spheres in steady tri-periodic shear at I = 1e-2 and p = 1e5 N/m^2
 // (tests/data/frozen-shear3, README there: `make frozen-shear3`), solved
 // by the production solver:
-//   policy  solver.tol 5e-4 with Anderson memory 5 (the 3D campaign's
-//           setting at I = 1e-2 since the sixth session: configs/
-//           shear3-inertial.toml, scene/shear_policy.hpp's tol_anderson);
+//   policy  solver.tol 7e-4 with the subspace correction (10 CG
+//           iterations; the 3D campaign's setting at I = 1e-2 since the
+//           seventh session: configs/shear3-inertial.toml,
+//           scene/shear_policy.hpp's tol_subspace);
+//   anderson  solver.tol 5e-4 with Anderson memory 5 (the policy of the
+//           sixth session, tol_anderson);
 //   plain   solver.tol 1e-3, plain NLGS (the policy before; the run the
 //           step was dumped from);
 //   fast    solver.tol 3e-3 with Anderson memory 5 (issue 30's fast setting).
@@ -47,17 +50,20 @@ const char* const kStep = "spheres500_I1e-2_step1000";
 struct Setting {
   const char* name;
   double tol;
-  int anderson;
+  int anderson, subspace;
   // Sweeps the solve took when measured, 1 and 2 threads: plain and fast
   // 2026-11-26 at main 0e2c4d4 with this test added (fast again, the same
   // count, after the vectorised mix and the stall rule of 7189ba3); policy
-  // the same day at main 7aecd5e and after, when it became the policy.
+  // the same day at main 7aecd5e and after, when it became the policy;
+  // the subspace policy the same day, seventh session.
   int sweeps;
+  int cg;  // and the subspace corrections' CG iterations (each about a sweep's traffic)
 };
 const Setting kSettings[] = {
-    {"policy (tol 5e-4, anderson 5)", 5e-4, 5, 224},
-    {"plain (tol 1e-3)", 1e-3, 0, 390},
-    {"fast (tol 3e-3, anderson 5)", 3e-3, 5, 22},
+    {"policy (tol 7e-4, subspace 10)", 7e-4, 0, 10, 88, 210},
+    {"anderson (tol 5e-4, anderson 5)", 5e-4, 5, 0, 224, 0},
+    {"plain (tol 1e-3)", 1e-3, 0, 0, 390, 0},
+    {"fast (tol 3e-3, anderson 5)", 3e-3, 5, 0, 22, 0},
 };
 
 cd::ContactProblem3 frozen(cd::SolverParams& prm) {
@@ -223,16 +229,18 @@ TEST(FrozenShear3, SolvesWithinTheMeasuredSweepsAndMeetsTheLaws) {
     prm.tol = set.tol;
     prm.residual_tol = 0.0;
     prm.anderson = set.anderson;
+    prm.subspace = set.subspace;
     cd::ContactProblem3 s = p0;
     const cd::SolveStats st = cd::nlgs_solve3(s, prm);
     const LawCheck c = check_laws(p0, s);
     const double bound = lb.bound(set.tol, c.r_mean);
-    std::printf("[ frozen shear3 ] %s: %d sweeps (guard %d), rms |dp|/|p| %.2e; law residual rms %.2e "
+    std::printf("[ frozen shear3 ] %s: %d sweeps (guard %d) + %d CG (guard %d), rms |dp|/|p| %.2e; law residual rms %.2e "
                 "(bound %.2e) max %.2e; cone excess %.1e, cell dof %.1e, velocities %.1e\n",
-                set.name, st.iterations, set.sweeps, st.dp_rel, c.rms, bound, c.max, c.cone_excess, c.dof_res,
+                set.name, st.iterations, set.sweeps, st.subspace_iterations, set.cg, st.dp_rel, c.rms, bound, c.max, c.cone_excess, c.dof_res,
                 c.vel_err);
     EXPECT_FALSE(st.cap_hit) << set.name;
     EXPECT_LE(st.iterations, set.sweeps) << set.name << ": slower than when measured";
+    EXPECT_LE(st.subspace_iterations, set.cg) << set.name << ": slower than when measured";
     // Round-off: the returned velocities are the returned impulses' (a
     // few thousand updates of each body, each exact to ~1e-16 of it), and
     // every impulse left the local solver inside its cone.
@@ -245,11 +253,14 @@ TEST(FrozenShear3, SolvesWithinTheMeasuredSweepsAndMeetsTheLaws) {
     // (deterministic: the same states up to there) gives the impulses
     // before the last sweep, and their change over it must be the solver's
     // rms |dp| / mean |p| (round-off of the sums' order), below tol. With
-    // Anderson a mix follows every even sweep but the last, so the capped
-    // state is the one the last sweep started from only when the count is
-    // even (the recorded counts are); an odd one leaves this to the policy's
-    // solve, which goes through the same stopping test (sweep.hpp's end_sweep).
-    if (set.anderson == 0 || st.iterations % 2 == 0) {
+    // Anderson a mix follows every even sweep but the last (a subspace
+    // correction every fourth), so the capped state is the one the last
+    // sweep started from only when none followed sweep count - 1; otherwise
+    // this is left to the other settings' solves, which go through the same
+    // stopping test (sweep.hpp's end_sweep).
+    const bool moved_before_last = (set.anderson > 0 && (st.iterations - 1) % 2 == 0) ||
+                                   (set.subspace > 0 && (st.iterations - 1) % 4 == 0);
+    if (!moved_before_last) {
       cd::SolverParams cap = prm;
       cap.max_iter = st.iterations - 1;
       cd::ContactProblem3 before = p0;
@@ -260,7 +271,7 @@ TEST(FrozenShear3, SolvesWithinTheMeasuredSweepsAndMeetsTheLaws) {
       EXPECT_NEAR(dp_rel, st.dp_rel, 1e-9 * st.dp_rel) << set.name;
       EXPECT_LT(dp_rel, set.tol) << set.name;
     } else {
-      std::printf("[ frozen shear3 ] %s: an odd count with Anderson, the stop not recomputed\n", set.name);
+      std::printf("[ frozen shear3 ] %s: a mix or correction before the last sweep, the stop not recomputed\n", set.name);
     }
 
     // The same bits on 1 and 2 threads, with the colours swept in parallel

@@ -114,8 +114,9 @@ Eigen::VectorXd free_q(const cd::ContactProblem3& p) {
 // 100 spheres compacted, then sheared at I = 0.1 with the height at imposed
 // stress (Lees-Edwards images and a cell dof coupled to the crossing rows),
 // step 20 dumped; solver.tol 1e-4 given (the bounds below are for it, not
-// for whatever the scene's policy picks), with Anderson's mixing (memory 5),
-// which the file records, so that the replay is the step's own solve.
+// for whatever the scene's policy picks), with the scene's subspace
+// correction (10 CG iterations), which the file records, so that the replay
+// is the step's own solve.
 TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
   const fs::path dir = cdtest::scratch_dir("problem_dump3", "shear");
   const std::string prep = (dir / "prep").string(), shear = (dir / "shear").string();
@@ -125,14 +126,14 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
   ASSERT_EQ(r.code, 0) << r.out;
   r = cdtest::run_command(kCdsim + " " + kConfigs + "shear3-inertial.toml --set shear.start=" + prep +
                           "/checkpoint.bin --set shear.strain=0.3 --set shear.inertial_number=0.1 --set solver.tol=1e-4 "
-                          "--set solver.anderson=5 --quiet "
+                          "--quiet "
                           "--dump-problem 20 --out " + shear);
   ASSERT_EQ(r.code, 0) << r.out;
   const fs::path cdp = fs::path(shear) / "problem_20.cdp3", h5 = fs::path(shear) / "problem_20.hdf5",
                  imp = fs::path(shear) / "problem_20.impulses";
   ASSERT_TRUE(fs::exists(cdp) && fs::exists(h5) && fs::exists(imp)) << r.out;
-  // A run that mixes says how often the mixing stalled (cdsim's summary).
-  EXPECT_NE(r.out.find("cdsim: Anderson's mixing stalled and went off on "), std::string::npos) << r.out;
+  // A run with the correction says what it cost (cdsim's summary).
+  EXPECT_NE(r.out.find("cdsim: subspace corrections: "), std::string::npos) << r.out;
 
   // The replay, on one and two threads: the same bytes.
   for (int t : {1, 2}) {
@@ -145,7 +146,7 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
 
   cd::SolverParams prm;
   const cd::ContactProblem3 p = cd::read_contact_problem3(cdp.string(), prm);
-  EXPECT_EQ(prm.anderson, 5);
+  EXPECT_EQ(prm.subspace, 10);
   const int nc = static_cast<int>(p.rows.size());
   ASSERT_GT(nc, 100);
   ASSERT_EQ(p.dofs.size(), 1u);

@@ -17,24 +17,29 @@
 namespace {
 
 struct Expected {
-  double I, tol, tol_anderson, residual_tol, dt_tp, cell_mass;
+  double I, tol, tol_anderson, tol_subspace, residual_tol, dt_tp, cell_mass;
 };
 
 // docs/shear.md's table, read at and around each breakpoint (I = 0.01 for
 // the tolerance, 0.1 for the time step's cap, 0.5 for the cell mass).
 const Expected kTable[] = {
-    {0.001, 1e-4, 1e-4, 3e-3, 0.05, 0.1},   {0.00999, 1e-4, 1e-4, 3e-3, 0.05, 0.1},
-    {0.01, 1e-3, 5e-4, 0.0, 0.05, 0.1},     {0.05, 1e-3, 5e-4, 0.0, 0.05, 0.1},
-    {0.1, 1e-3, 5e-4, 0.0, 0.05, 0.1},      {0.2, 1e-3, 5e-4, 0.0, 0.025, 0.1},
-    {0.3, 1e-3, 5e-4, 0.0, 0.01667, 0.1},   {0.49, 1e-3, 5e-4, 0.0, 0.0102, 0.1},
-    {0.5, 1e-3, 5e-4, 0.0, 0.01, 0.01},     {1.0, 1e-3, 5e-4, 0.0, 0.005, 0.01},
+    {0.001, 1e-4, 1e-4, 1e-4, 3e-3, 0.05, 0.1},   {0.00999, 1e-4, 1e-4, 1e-4, 3e-3, 0.05, 0.1},
+    {0.01, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1},     {0.05, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1},
+    {0.1, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1},      {0.2, 1e-3, 5e-4, 7e-4, 0.0, 0.025, 0.1},
+    {0.3, 1e-3, 5e-4, 7e-4, 0.0, 0.01667, 0.1},   {0.49, 1e-3, 5e-4, 7e-4, 0.0, 0.0102, 0.1},
+    {0.5, 1e-3, 5e-4, 7e-4, 0.0, 0.01, 0.01},     {1.0, 1e-3, 5e-4, 7e-4, 0.0, 0.005, 0.01},
 };
 
 TEST(ShearPolicy, TheTableAtItsBreakpoints) {
   for (const Expected& e : kTable) {
     const cd::ShearSettings s = cd::shear_settings(e.I);
-    const cd::ShearSettings a = cd::shear_settings(e.I, true);
+    const cd::ShearSettings a = cd::shear_settings(e.I, cd::Acceleration::Anderson);
+    const cd::ShearSettings g = cd::shear_settings(e.I, cd::Acceleration::Subspace);
     EXPECT_EQ(a.tol, e.tol_anderson) << "I = " << e.I;
+    EXPECT_EQ(g.tol, e.tol_subspace) << "I = " << e.I;
+    EXPECT_EQ(g.residual_tol, s.residual_tol) << "I = " << e.I;
+    EXPECT_EQ(g.dt_tp, s.dt_tp) << "I = " << e.I;
+    EXPECT_EQ(g.cell_mass, s.cell_mass) << "I = " << e.I;
     EXPECT_EQ(a.residual_tol, s.residual_tol) << "I = " << e.I;
     EXPECT_EQ(a.dt_tp, s.dt_tp) << "I = " << e.I;
     EXPECT_EQ(a.cell_mass, s.cell_mass) << "I = " << e.I;
@@ -106,6 +111,42 @@ TEST(ShearPolicy, AutoWithoutAnInertialNumberOrOnAnotherKeyIsRefused) {
   }
 }
 
+// "auto" for the acceleration: the band's choice, resolved before the
+// tolerance that depends on it; a number wins; a 2D scene cannot take the
+// subspace correction the band would choose for it.
+TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
+  const std::string scene =
+      "dimension = 3\ngravity.g = [0.0, 0.0, 0.0]\n[solver]\ntol = \"auto\"\nanderson = \"auto\"\nsubspace = \"auto\"\n"
+      "[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.01\n";
+  for (const double I : {0.001, 0.00999, 0.01, 0.3, 0.5}) {
+    std::ostringstream is;
+    is << "shear.inertial_number=" << I;
+    const cd::Scene s = cd::parse_scene(scene, "a.toml", {is.str()});
+    const cd::ShearSettings band = cd::shear_settings(I);
+    EXPECT_EQ(s.anderson, band.anderson) << "I = " << I;
+    EXPECT_EQ(s.subspace, band.subspace) << "I = " << I;
+    EXPECT_EQ(s.anderson, I < 0.01 ? 5 : 0) << "I = " << I;
+    EXPECT_EQ(s.subspace, I < 0.01 ? 0 : 10) << "I = " << I;
+    const auto acc = I < 0.01 ? cd::Acceleration::Anderson : cd::Acceleration::Subspace;
+    EXPECT_EQ(s.tol, cd::shear_settings(I, acc).tol) << "I = " << I;
+  }
+  // A number for one of them: kept, and the tolerance follows what runs.
+  const cd::Scene n = cd::parse_scene(scene, "a.toml", {"solver.subspace=0", "shear.inertial_number=0.01"});
+  EXPECT_EQ(n.subspace, 0);
+  EXPECT_EQ(n.anderson, 0);  // the band's own choice for anderson at 0.01
+  EXPECT_EQ(n.tol, cd::shear_settings(0.01).tol);
+  // 2D: the band's subspace correction is refused, with the key named.
+  try {
+    cd::parse_scene("[solver]\nsubspace = \"auto\"\n[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.01\n",
+                    "b.toml");
+    FAIL() << "a 2D scene took the subspace correction";
+  } catch (const cd::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("solver.subspace = 10: the subspace correction serves 3D spheres only"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // The four keys of a resolved scene printed by cdsim --print-scene.
 std::map<std::string, std::string> settings_of(const std::string& printed) {
   std::map<std::string, std::string> out;
@@ -163,7 +204,7 @@ TEST(ShearPolicy, ACampaignPointAndASingleRunAtTheSameIRunTheSameSettings) {
     const auto c = campaign_settings(I, "2"), s = single_run_settings("shear-inertial.toml", I);
     EXPECT_EQ(c.size(), 5u) << I;
     EXPECT_EQ(c, s) << "I = " << I;
-    const cd::ShearSettings p = cd::shear_settings(std::stod(I), true);  // the scene mixes (anderson = 5)
+    const cd::ShearSettings p = cd::shear_settings(std::stod(I), cd::Acceleration::Anderson);  // the scene mixes (anderson = 5)
     EXPECT_EQ(std::stod(s.at("solver.tol")), p.tol) << I;
     EXPECT_EQ(std::stod(s.at("solver.residual_tol")), p.residual_tol) << I;
     EXPECT_EQ(std::stod(s.at("shear.dt_tp")), p.dt_tp) << I;
@@ -173,12 +214,13 @@ TEST(ShearPolicy, ACampaignPointAndASingleRunAtTheSameIRunTheSameSettings) {
   EXPECT_EQ(c3.size(), 5u);
   EXPECT_EQ(c3, s3);
   EXPECT_EQ(std::stod(s3.at("solver.residual_tol")), 3e-3);
-  // The 3D scene mixes too (solver.anderson = 5): its tolerance is the
-  // band's tol_anderson, the same for a campaign point.
+  // The 3D scene lets the band choose its acceleration: the subspace
+  // correction at I = 0.01 (tolerance tol_subspace), Anderson's mixing at
+  // 1e-3 (tol_anderson), the same for a campaign point.
   const auto c3b = campaign_settings("0.01", "3"), s3b = single_run_settings("shear3-inertial.toml", "0.01");
   EXPECT_EQ(c3b, s3b);
-  EXPECT_EQ(std::stod(s3b.at("solver.tol")), cd::shear_settings(0.01, true).tol);
-  EXPECT_EQ(std::stod(s3.at("solver.tol")), cd::shear_settings(0.001, true).tol);
+  EXPECT_EQ(std::stod(s3b.at("solver.tol")), cd::shear_settings(0.01, cd::Acceleration::Subspace).tol);
+  EXPECT_EQ(std::stod(s3.at("solver.tol")), cd::shear_settings(0.001, cd::Acceleration::Anderson).tol);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string_view>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <variant>
 
@@ -145,8 +146,8 @@ const std::vector<Param<Scene>>& scene_params() {
       {"solver", "tol", &Scene::tol, "", in_open_closed(0, 1), "NLGS convergence tolerance (relative); \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "max_iter", &Scene::max_iter, "", in(1, 1e8), "NLGS iteration cap per time step"},
       {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
-      {"solver", "anderson", &Scene::anderson, "", in(0, 50), "> 0: Anderson acceleration of the sweep with this memory (5 is the measured choice): after each forward-backward pair of sweeps the impulses are mixed over the last pairs, and the mixing is off for the rest of a step's solve once it stalls (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it (docs/shear.md, Settings by I); 0: plain NLGS"},
-      {"solver", "subspace", &Scene::subspace, "", in(0, 1000), "> 0: the subspace correction of the sweep (3D only; it acts on the round cone, with adhesion or not, and does nothing under the orthotropic one): every two forward-backward pairs of sweeps, the linear problem of the contacts that stick (u = 0) and slide (u_n = 0) is solved by at most this many conjugate-gradient iterations and put into the impulses (docs/accuracy.md); 0: off"},
+      {"solver", "anderson", &Scene::anderson, "", in(0, 50), "> 0: Anderson acceleration of the sweep with this memory (5 is the measured choice): after each forward-backward pair of sweeps the impulses are mixed over the last pairs, and the mixing is off for the rest of a step's solve once it stalls (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it (docs/shear.md, Settings by I); 0: plain NLGS; \"auto\": the shear policy's choice by shear.inertial_number (measured on spheres)"},
+      {"solver", "subspace", &Scene::subspace, "", in(0, 1000), "> 0: the subspace correction of the sweep (3D only; it acts on the round cone, with adhesion or not, and does nothing under the orthotropic one): every two forward-backward pairs of sweeps, the linear problem of the contacts that stick (u = 0) and slide (u_n = 0) is solved by at most this many conjugate-gradient iterations and put into the impulses, until a stall stops them for the step (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it; 0: off; \"auto\": the shear policy's choice by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "threads", &Scene::threads, "", in(0, 1024), "OpenMP threads; 0: OpenMP default"},
       {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
@@ -211,16 +212,21 @@ const std::vector<Param<WallSpec>>& wall_params() {
 }
 
 // The keys that may be "auto": their value is the shear policy's for the
-// scene's inertial number (shear_policy.hpp), put in once every key is read.
+// scene's inertial number (shear_policy.hpp), put in once every key is read:
+// the acceleration first (solver.anderson, solver.subspace), since the
+// tolerance depends on it.
 struct AutoKey {
   std::string_view key;
-  double Scene::*member;
-  double ShearSettings::*value;
+  std::variant<double Scene::*, int Scene::*> member;
+  std::variant<double ShearSettings::*, int ShearSettings::*> value;
+  bool acceleration = false;
 };
-constexpr std::array<AutoKey, 4> kAutoKeys = {{{"solver.tol", &Scene::tol, &ShearSettings::tol},
-                                               {"solver.residual_tol", &Scene::residual_tol, &ShearSettings::residual_tol},
-                                               {"shear.dt_tp", &Scene::dt_tp, &ShearSettings::dt_tp},
-                                               {"shear.cell_mass", &Scene::cell_mass, &ShearSettings::cell_mass}}};
+const std::array<AutoKey, 6> kAutoKeys = {{{"solver.tol", &Scene::tol, &ShearSettings::tol},
+                                           {"solver.residual_tol", &Scene::residual_tol, &ShearSettings::residual_tol},
+                                           {"shear.dt_tp", &Scene::dt_tp, &ShearSettings::dt_tp},
+                                           {"shear.cell_mass", &Scene::cell_mass, &ShearSettings::cell_mass},
+                                           {"solver.anderson", &Scene::anderson, &ShearSettings::anderson, true},
+                                           {"solver.subspace", &Scene::subspace, &ShearSettings::subspace, true}}};
 const AutoKey* auto_key(std::string_view name) {
   for (const AutoKey& a : kAutoKeys)
     if (a.key == name) return &a;
@@ -507,16 +513,28 @@ Scene read_scene(const toml::value& root, const std::string& path) {
 
   // "auto": the shear settings at the scene's I (after every key and
   // override is read, so that --set shear.inertial_number counts).
-  for (const auto& [a, at] : out.autos) {
-    if (!(s.inertial_number > 0)) {
-      out.add(at, a->key.substr(a->key.find('.') + 1),
-              fmt::format("{} = \"auto\" is set by shear.inertial_number (docs/shear.md, \"Settings "
-                          "by I\"), which is {}: give shear.inertial_number > 0 or a number",
-                          a->key, text(s.inertial_number, false)));
-      continue;
+  for (const bool acceleration : {true, false})
+    for (const auto& [a, at] : out.autos) {
+      if (a->acceleration != acceleration) continue;
+      if (!(s.inertial_number > 0)) {
+        out.add(at, a->key.substr(a->key.find('.') + 1),
+                fmt::format("{} = \"auto\" is set by shear.inertial_number (docs/shear.md, \"Settings "
+                            "by I\"), which is {}: give shear.inertial_number > 0 or a number",
+                            a->key, text(s.inertial_number, false)));
+        continue;
+      }
+      const Acceleration acc = s.subspace > 0  ? Acceleration::Subspace
+                               : s.anderson > 0 ? Acceleration::Anderson
+                                                : Acceleration::None;
+      const ShearSettings set = shear_settings(s.inertial_number, acc);
+      std::visit(
+          [&](auto member, auto value) {
+            if constexpr (std::is_same_v<std::remove_cvref_t<decltype(s.*member)>,
+                                         std::remove_cvref_t<decltype(set.*value)>>)
+              s.*member = set.*value;
+          },
+          a->member, a->value);
     }
-    s.*(a->member) = shear_settings(s.inertial_number, s.anderson > 0).*(a->value);
-  }
   out.throw_if_any();
 
   // Explicit diameters: from the file (it wins over a list, so that a

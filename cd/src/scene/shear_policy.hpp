@@ -1,6 +1,7 @@
 // The shear settings that depend on the inertial number I, decided in one
 // place for a single run and a campaign alike: a scene gives "auto" for
-// solver.tol, solver.residual_tol, shear.dt_tp or shear.cell_mass, and the
+// solver.tol, solver.residual_tol, shear.dt_tp or shear.cell_mass (and, in
+// 3D, solver.anderson and solver.subspace: the band's acceleration), and the
 // scene reader (config.cpp) puts in the value for its shear.inertial_number,
 // so the run's resolved scene.toml holds the number it ran with. The
 // Makefile's campaigns only name I (configs/shear-inertial.toml and
@@ -13,12 +14,18 @@ namespace cd {
 
 // The policy, all its numbers in this table: a band applies from its I_min
 // up to the next band's. A scene with Anderson's mixing on (solver.anderson
-// > 0: configs/shear-inertial.toml and shear3-inertial.toml) gets
-// tol_anderson instead of tol.
+// > 0: configs/shear-inertial.toml) gets tol_anderson instead of tol, one
+// with the subspace correction on (solver.subspace > 0) tol_subspace. The
+// 3D scene (configs/shear3-inertial.toml) lets the band choose between the
+// two: "auto" for solver.anderson and solver.subspace gives anderson and
+// subspace (measured on spheres; 2D scenes refuse the subspace correction).
 struct ShearBand {
   double i_min;         // the band starts at this I
   double tol;           // solver.tol (plain NLGS)
   double tol_anderson;  // solver.tol with solver.anderson > 0
+  double tol_subspace;  // solver.tol with solver.subspace > 0
+  int anderson;         // solver.anderson = "auto"
+  int subspace;         // solver.subspace = "auto"
   double residual_tol;  // solver.residual_tol (0: the rms |dp| test alone)
   double cell_mass;     // shear.cell_mass, in the particles' total mass
 };
@@ -30,18 +37,23 @@ inline constexpr std::array<ShearBand, 3> kShearBands = {{
     // the same stop keeps mu, phi and z within 0.5 sigma of plain NLGS's
     // over three samples at I = 1e-3, at 0.68x (1000 spheres) and 0.60x
     // (1000 disks) the CPU.
-    {0.0, 1e-4, 1e-4, 3e-3, 0.1},
+    // The subspace correction at the same stop costs what Anderson does
+    // (1000 spheres, I = 1e-3, 1.00x) and leaves z 0.027 low (3 samples):
+    // the band's acceleration is Anderson's.
+    {0.0, 1e-4, 1e-4, 1e-4, 5, 0, 3e-3, 0.1},
     // From I = 0.01, tol 1e-3 keeps mu*, phi and z within ~2 sigma of tol
     // 1e-5 at 11-35 % of its cost; 1e-4 costs 2-4x more, not measurably
     // closer (disks). On 1000 spheres at I = 0.01 (three samples against tol
     // 1e-4 + residual_tol 3e-3), plain tol 1e-3 leaves z 0.016 high (3.7
     // sigma); Anderson at tol 5e-4 holds mu, phi and z within 1 sigma at
     // 1.4x plain tol 1e-3's CPU (7e-4: the same CPU, z 0.008 high). 1000
-    // disks: within 1.2 sigma at 0.93x plain tol 1e-3's CPU.
-    {0.01, 1e-3, 5e-4, 0.0, 0.1},
+    // disks: within 1.2 sigma at 0.93x plain tol 1e-3's CPU. The subspace
+    // correction at tol 7e-4 holds all three within 0.7 sigma at 0.68x
+    // Anderson's CPU at 5e-4 (spheres, three samples, one sitting).
+    {0.01, 1e-3, 5e-4, 7e-4, 0, 10, 0.0, 0.1},
     // From I = 0.5 the cell height of mass 0.1 oscillates for several units
     // of strain; a light cell (0.01) holds sigma_yy + K_yy = p.
-    {0.5, 1e-3, 5e-4, 0.0, 0.01},
+    {0.5, 1e-3, 5e-4, 7e-4, 0, 10, 0.0, 0.01},
 }};
 // The time step, in t_p = d sqrt(rho/p): at most kDtMaxTp, and at most
 // kSlidePerStep d of relative sliding per step, dt <= kSlidePerStep t_p / I;
@@ -49,11 +61,14 @@ inline constexpr std::array<ShearBand, 3> kShearBands = {{
 inline constexpr double kDtMaxTp = 0.05;
 inline constexpr double kSlidePerStep = 0.005;
 
-// The settings at inertial number I > 0, for a solve with Anderson's
-// mixing on or off.
+// The settings at inertial number I > 0, for a plain solve, one with
+// Anderson's mixing, or one with the subspace correction (which decides the
+// tolerance when a scene asks for both).
+enum class Acceleration { None, Anderson, Subspace };
 struct ShearSettings {
   double tol, residual_tol, dt_tp, cell_mass;
+  int anderson, subspace;  // the band's acceleration (the "auto" of those keys)
 };
-ShearSettings shear_settings(double inertial_number, bool anderson = false);
+ShearSettings shear_settings(double inertial_number, Acceleration acc = Acceleration::None);
 
 }  // namespace cd
