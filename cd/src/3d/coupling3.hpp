@@ -234,7 +234,8 @@ struct BodyCoupling3 {
   }
   // y = W p on the rows listed in live, through s (offsets and b_n left
   // out); the other rows' p is zero and their y is not read.
-  void subspace_apply(const SweepRow3* R, const std::vector<int>& live, const double* p, double* y, Scratch& s) const {
+  [[gnu::flatten]] void subspace_apply(const SweepRow3* R, const std::vector<int>& live, const double* p, double* y,
+                                       Scratch& s) const {
     for (BodyVel3& b : s) {
       b.v.setZero();
       b.w.setZero();

@@ -254,48 +254,66 @@ class Subspace {
   static constexpr int kSubspaceEvery = 2;      // pairs of sweeps between corrections
   static constexpr double kSubspaceRel = 1e-2;  // CG's relative residual
 
-  Subspace(int iters, int rows)
-      : iters_(iters), n_(rows * D), free_(n_), diag_(n_), d_(n_), res_(n_), z_(n_), p_(n_), wp_(n_) {}
+  Subspace(int iters, int rows) : iters_(iters), n_(rows * D), free_(n_), diag_(n_), u_(n_), pf_(n_), yf_(n_) {}
 
   // One correction of the rows' impulses; returns the CG iterations spent.
+  // The CG vectors hold the free components only (comp_: their places in
+  // the rows' D-vectors); the products read and write the full ones.
   template <class L, class Row, class C, class Scratch>
   int correct(Row* R, const C& c, Scratch& s) {
     const int nr = n_ / D;
     for (int i = 0, k = 0; i < nr; ++i, k += D)
-      c.template subspace_row<L>(R[i], free_.data() + k, diag_.data() + k, res_.data() + k);
+      c.template subspace_row<L>(R[i], free_.data() + k, diag_.data() + k, u_.data() + k);
     live_.clear();  // the rows with a free component: the products skip the open ones
-    for (int i = 0, k = 0; i < nr; ++i, k += D)
-      if (free_[k] != 0) live_.push_back(i);
-    res_ = -(free_.array() * res_.array()).matrix();
-    z_ = (res_.array() / diag_.array()).matrix();
+    comp_.clear();
+    for (int i = 0, k = 0; i < nr; ++i, k += D) {
+      if (free_[k] == 0) continue;
+      live_.push_back(i);
+      for (int j = 0; j < D; ++j)
+        if (free_[k + j] != 0) comp_.push_back(k + j);
+    }
+    const int m = static_cast<int>(comp_.size());
+    res_.resize(m);
+    idg_.resize(m);
+    for (int j = 0; j < m; ++j) {
+      res_[j] = -u_[comp_[j]];
+      idg_[j] = 1.0 / diag_[comp_[j]];
+    }
+    z_ = res_.cwiseProduct(idg_);
     p_ = z_;
-    d_.setZero();
-    double rz = res_.dot(z_);
-    const double stop = kSubspaceRel * kSubspaceRel * res_.squaredNorm();
+    d_.setZero(m);
+    pf_.setZero();
+    double rz = res_.dot(z_), rr = res_.squaredNorm();
+    const double stop = kSubspaceRel * kSubspaceRel * rr;
     int it = 0;
-    for (; it < iters_ && res_.squaredNorm() > stop; ++it) {
-      c.subspace_apply(R, live_, p_.data(), wp_.data(), s);
-      wp_.array() *= free_.array();
+    for (; it < iters_ && rr > stop; ++it) {
+      for (int j = 0; j < m; ++j) pf_[comp_[j]] = p_[j];
+      c.subspace_apply(R, live_, pf_.data(), yf_.data(), s);
+      wp_.resize(m);
+      for (int j = 0; j < m; ++j) wp_[j] = yf_[comp_[j]];
       const double pwp = p_.dot(wp_);
       if (!(pwp > 0)) break;
       const double a = rz / pwp;
       d_ += a * p_;
       res_ -= a * wp_;
-      z_ = (res_.array() / diag_.array()).matrix();
+      z_ = res_.cwiseProduct(idg_);
       const double rz1 = res_.dot(z_);
+      rr = res_.squaredNorm();
       p_ = z_ + (rz1 / rz) * p_;
       rz = rz1;
     }
     if (!d_.allFinite()) return it;  // nothing put: the sweeps go on from where they are
-    for (int i = 0, k = 0; i < nr; ++i, k += D)
-      if (free_[k] != 0) c.template subspace_put<L>(R[i], d_.data() + k, D > 1 && free_[k + 1] != 0);
+    pf_.setZero();  // d in the rows' places
+    for (int j = 0; j < m; ++j) pf_[comp_[j]] = d_[j];
+    for (const int i : live_) c.template subspace_put<L>(R[i], pf_.data() + D * i, D > 1 && free_[D * i + 1] != 0);
     return it;
   }
 
  private:
   int iters_, n_;
-  Eigen::VectorXd free_, diag_, d_, res_, z_, p_, wp_;
-  std::vector<int> live_;
+  Eigen::VectorXd free_, diag_, u_, pf_, yf_;        // full: D per row
+  Eigen::VectorXd res_, z_, p_, d_, wp_, idg_;       // the free components
+  std::vector<int> live_, comp_;
 };
 
 // Mean |p| over the rows (summed in row order) and the residuals' scale

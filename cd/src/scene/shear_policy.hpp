@@ -38,8 +38,8 @@ inline constexpr std::array<ShearBand, 3> kShearBands = {{
     // over three samples at I = 1e-3, at 0.68x (1000 spheres) and 0.60x
     // (1000 disks) the CPU.
     // The subspace correction at the same stop costs what Anderson does
-    // (1000 spheres, I = 1e-3, 1.00x) and leaves z 0.027 low (3 samples):
-    // the band's acceleration is Anderson's.
+    // (1000 spheres, I = 1e-3, 1.00x) and leaves z 0.017 low (1.5 sigma,
+    // three samples): the band's acceleration is Anderson's.
     {0.0, 1e-4, 1e-4, 1e-4, 5, 0, 3e-3, 0.1},
     // From I = 0.01, tol 1e-3 keeps mu*, phi and z within ~2 sigma of tol
     // 1e-5 at 11-35 % of its cost; 1e-4 costs 2-4x more, not measurably
@@ -48,7 +48,7 @@ inline constexpr std::array<ShearBand, 3> kShearBands = {{
     // sigma); Anderson at tol 5e-4 holds mu, phi and z within 1 sigma at
     // 1.4x plain tol 1e-3's CPU (7e-4: the same CPU, z 0.008 high). 1000
     // disks: within 1.2 sigma at 0.93x plain tol 1e-3's CPU. The subspace
-    // correction at tol 7e-4 holds all three within 0.7 sigma at 0.68x
+    // correction at tol 7e-4 holds all three within 0.5 sigma at 0.57x
     // Anderson's CPU at 5e-4 (spheres, three samples, one sitting).
     {0.01, 1e-3, 5e-4, 7e-4, 0, 10, 0.0, 0.1},
     // From I = 0.5 the cell height of mass 0.1 oscillates for several units
