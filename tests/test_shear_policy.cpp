@@ -130,6 +130,13 @@ TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
     const auto acc = I < 0.01 ? cd::Acceleration::Anderson : cd::Acceleration::Subspace;
     EXPECT_EQ(s.tol, cd::shear_settings(I, acc).tol) << "I = " << I;
   }
+  // A cohesive scene keeps Anderson's mixing in every band.
+  for (const char* coh : {"contact.cohesion_number=10", "contact.adhesion=1e-3"}) {
+    const cd::Scene c = cd::parse_scene(scene, "a.toml", {coh, "shear.inertial_number=0.01"});
+    EXPECT_EQ(c.subspace, 0) << coh;
+    EXPECT_EQ(c.anderson, cd::kCohesiveAnderson) << coh;
+    EXPECT_EQ(c.tol, cd::shear_settings(0.01, cd::Acceleration::Anderson).tol) << coh;
+  }
   // A number for one of them: kept, and the tolerance follows what runs.
   const cd::Scene n = cd::parse_scene(scene, "a.toml", {"solver.subspace=0", "shear.inertial_number=0.01"});
   EXPECT_EQ(n.subspace, 0);

@@ -526,7 +526,7 @@ Scene read_scene(const toml::value& root, const std::string& path) {
       const Acceleration acc = s.subspace > 0  ? Acceleration::Subspace
                                : s.anderson > 0 ? Acceleration::Anderson
                                                 : Acceleration::None;
-      const ShearSettings set = shear_settings(s.inertial_number, acc);
+      const ShearSettings set = shear_settings(s.inertial_number, acc, s.adhesion > 0 || s.cohesion_number > 0);
       std::visit(
           [&](auto member, auto value) {
             if constexpr (std::is_same_v<std::remove_cvref_t<decltype(s.*member)>,

@@ -8,7 +8,7 @@
 
 namespace cd {
 
-ShearSettings shear_settings(double I, Acceleration acc) {
+ShearSettings shear_settings(double I, Acceleration acc, bool cohesive) {
   const ShearBand* b = &kShearBands.front();
   for (const ShearBand& x : kShearBands)
     if (I >= x.i_min) b = &x;
@@ -17,6 +17,7 @@ ShearSettings shear_settings(double I, Acceleration acc) {
   const double tol = acc == Acceleration::Subspace ? b->tol_subspace
                      : acc == Acceleration::Anderson ? b->tol_anderson
                                                      : b->tol;
+  if (cohesive) return {tol, b->residual_tol, dt_tp, b->cell_mass, kCohesiveAnderson, 0};
   return {tol, b->residual_tol, dt_tp, b->cell_mass, b->anderson, b->subspace};
 }
 
