@@ -134,18 +134,36 @@ TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
   for (const char* coh : {"contact.cohesion_number=10", "contact.adhesion=1e-3"}) {
     const cd::Scene c = cd::parse_scene(scene, "a.toml", {coh, "shear.inertial_number=0.01"});
     EXPECT_EQ(c.subspace, 0) << coh;
-    EXPECT_EQ(c.anderson, cd::kCohesiveAnderson) << coh;
+    EXPECT_EQ(c.anderson, cd::kAnderson) << coh;
     EXPECT_EQ(c.tol, cd::shear_settings(0.01, cd::Acceleration::Anderson).tol) << coh;
+  }
+  // 2D: Anderson's mixing with disks, none with polygons, in every band;
+  // the tolerance follows.
+  const std::string scene2 =
+      "[solver]\ntol = \"auto\"\nanderson = \"auto\"\n[shear]\nmode = \"periodic\"\npressure = 100.0\n";
+  for (const double I : {0.001, 0.01, 0.5}) {
+    std::ostringstream is;
+    is << "shear.inertial_number=" << I;
+    const cd::Scene d = cd::parse_scene(scene2, "c.toml", {is.str()});
+    EXPECT_EQ(d.anderson, cd::kAnderson) << "disks, I = " << I;
+    EXPECT_EQ(d.tol, cd::shear_settings(I, cd::Acceleration::Anderson).tol) << "disks, I = " << I;
+    for (const char* ns : {"particles.nsides=[6]", "particles.nsides=[3,6,0]"}) {
+      const cd::Scene g = cd::parse_scene(scene2, "c.toml", {is.str(), ns});
+      EXPECT_EQ(g.anderson, 0) << ns << ", I = " << I;
+      EXPECT_EQ(g.tol, cd::shear_settings(I).tol) << ns << ", I = " << I;
+    }
   }
   // A number for one of them: kept, and the tolerance follows what runs.
   const cd::Scene n = cd::parse_scene(scene, "a.toml", {"solver.subspace=0", "shear.inertial_number=0.01"});
   EXPECT_EQ(n.subspace, 0);
   EXPECT_EQ(n.anderson, 0);  // the band's own choice for anderson at 0.01
   EXPECT_EQ(n.tol, cd::shear_settings(0.01).tol);
-  // 2D: the band's subspace correction is refused, with the key named.
+  // 2D: "auto" never takes the subspace correction; a number is refused,
+  // with the key named.
+  const std::string two = "[solver]\nsubspace = \"auto\"\n[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.01\n";
+  EXPECT_EQ(cd::parse_scene(two, "b.toml").subspace, 0);
   try {
-    cd::parse_scene("[solver]\nsubspace = \"auto\"\n[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.01\n",
-                    "b.toml");
+    cd::parse_scene(two, "b.toml", {"solver.subspace=10"});
     FAIL() << "a 2D scene took the subspace correction";
   } catch (const cd::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("solver.subspace = 10: the subspace correction serves 3D spheres only"),

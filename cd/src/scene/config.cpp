@@ -526,7 +526,9 @@ Scene read_scene(const toml::value& root, const std::string& path) {
       const Acceleration acc = s.subspace > 0  ? Acceleration::Subspace
                                : s.anderson > 0 ? Acceleration::Anderson
                                                 : Acceleration::None;
-      const ShearSettings set = shear_settings(s.inertial_number, acc, s.adhesion > 0 || s.cohesion_number > 0);
+      const SceneKind kind{s.dimension, s.adhesion > 0 || s.cohesion_number > 0,
+                           std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; })};
+      const ShearSettings set = shear_settings(s.inertial_number, acc, kind);
       std::visit(
           [&](auto member, auto value) {
             if constexpr (std::is_same_v<std::remove_cvref_t<decltype(s.*member)>,

@@ -8,7 +8,7 @@
 
 namespace cd {
 
-ShearSettings shear_settings(double I, Acceleration acc, bool cohesive) {
+ShearSettings shear_settings(double I, Acceleration acc, SceneKind kind) {
   const ShearBand* b = &kShearBands.front();
   for (const ShearBand& x : kShearBands)
     if (I >= x.i_min) b = &x;
@@ -17,7 +17,8 @@ ShearSettings shear_settings(double I, Acceleration acc, bool cohesive) {
   const double tol = acc == Acceleration::Subspace ? b->tol_subspace
                      : acc == Acceleration::Anderson ? b->tol_anderson
                                                      : b->tol;
-  if (cohesive) return {tol, b->residual_tol, dt_tp, b->cell_mass, kCohesiveAnderson, 0};
+  if (kind.dimension == 2) return {tol, b->residual_tol, dt_tp, b->cell_mass, kind.polygons ? 0 : kAnderson, 0};
+  if (kind.cohesive) return {tol, b->residual_tol, dt_tp, b->cell_mass, kAnderson, 0};
   return {tol, b->residual_tol, dt_tp, b->cell_mass, b->anderson, b->subspace};
 }
 
