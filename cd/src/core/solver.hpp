@@ -54,7 +54,7 @@ struct SolveStats {
   bool residual_met = false; // stopped by SolverParams::residual_tol
   int anderson_off = 0;      // > 0: Anderson stalled and was turned off after this many sweeps
   int subspace_off = 0;      // > 0: the subspace corrections stalled and stopped after this many sweeps
-  int subspace_iterations = 0;  // conjugate-gradient iterations of the subspace corrections (each ~ a sweep)
+  int subspace_iterations = 0;  // conjugate-gradient iterations of the subspace corrections (each ~ half a sweep)
 };
 
 // Called after every sweep with the sweep count and its dp_rel, on one

@@ -229,8 +229,8 @@ class Stall {
 // components F is solved by Jacobi-preconditioned conjugate gradients from
 // d = 0 for at most `subspace` iterations (relative residual kSubspaceRel),
 // and r + d (a sliding row's tangential impulse scaled with its normal
-// one, so that it stays on the cone's edge) is projected on the cone and
-// put into the rows and their bodies. W is symmetric positive
+// one, so that it stays on the cone's edge) goes through the law's own
+// projection into the rows and their bodies. W is symmetric positive
 // semidefinite and the system consistent, so CG converges on it and leaves
 // the indeterminate part of the forces where the sweeps put it. The
 // boundary dofs are held (their own update follows in the next sweep). One
@@ -282,6 +282,7 @@ class Subspace {
     z_ = res_.cwiseProduct(idg_);
     p_ = z_;
     d_.setZero(m);
+    wp_.resize(m);
     pf_.setZero();
     double rz = res_.dot(z_), rr = res_.squaredNorm();
     const double stop = kSubspaceRel * kSubspaceRel * rr;
@@ -289,7 +290,6 @@ class Subspace {
     for (; it < iters_ && rr > stop; ++it) {
       for (int j = 0; j < m; ++j) pf_[comp_[j]] = p_[j];
       c.subspace_apply(R, live_, pf_.data(), yf_.data(), s);
-      wp_.resize(m);
       for (int j = 0; j < m; ++j) wp_[j] = yf_[comp_[j]];
       const double pwp = p_.dot(wp_);
       if (!(pwp > 0)) break;

@@ -14,7 +14,6 @@
 #include <sstream>
 #include <string_view>
 #include <tuple>
-#include <type_traits>
 #include <utility>
 #include <variant>
 
@@ -213,20 +212,25 @@ const std::vector<Param<WallSpec>>& wall_params() {
 
 // The keys that may be "auto": their value is the shear policy's for the
 // scene's inertial number (shear_policy.hpp), put in once every key is read:
-// the acceleration first (solver.anderson, solver.subspace), since the
-// tolerance depends on it.
+// the acceleration first (the integer keys, solver.anderson and
+// solver.subspace), since the tolerance depends on it.
+template <class T>
+struct AutoField {
+  T Scene::*member;
+  T ShearSettings::*value;
+};
 struct AutoKey {
   std::string_view key;
-  std::variant<double Scene::*, int Scene::*> member;
-  std::variant<double ShearSettings::*, int ShearSettings::*> value;
-  bool acceleration = false;
+  std::variant<AutoField<double>, AutoField<int>> field;
+  bool acceleration() const { return std::holds_alternative<AutoField<int>>(field); }
 };
-const std::array<AutoKey, 6> kAutoKeys = {{{"solver.tol", &Scene::tol, &ShearSettings::tol},
-                                           {"solver.residual_tol", &Scene::residual_tol, &ShearSettings::residual_tol},
-                                           {"shear.dt_tp", &Scene::dt_tp, &ShearSettings::dt_tp},
-                                           {"shear.cell_mass", &Scene::cell_mass, &ShearSettings::cell_mass},
-                                           {"solver.anderson", &Scene::anderson, &ShearSettings::anderson, true},
-                                           {"solver.subspace", &Scene::subspace, &ShearSettings::subspace, true}}};
+const std::array<AutoKey, 6> kAutoKeys = {
+    {{"solver.tol", AutoField<double>{&Scene::tol, &ShearSettings::tol}},
+     {"solver.residual_tol", AutoField<double>{&Scene::residual_tol, &ShearSettings::residual_tol}},
+     {"shear.dt_tp", AutoField<double>{&Scene::dt_tp, &ShearSettings::dt_tp}},
+     {"shear.cell_mass", AutoField<double>{&Scene::cell_mass, &ShearSettings::cell_mass}},
+     {"solver.anderson", AutoField<int>{&Scene::anderson, &ShearSettings::anderson}},
+     {"solver.subspace", AutoField<int>{&Scene::subspace, &ShearSettings::subspace}}}};
 const AutoKey* auto_key(std::string_view name) {
   for (const AutoKey& a : kAutoKeys)
     if (a.key == name) return &a;
@@ -513,9 +517,11 @@ Scene read_scene(const toml::value& root, const std::string& path) {
 
   // "auto": the shear settings at the scene's I (after every key and
   // override is read, so that --set shear.inertial_number counts).
+  const SceneKind kind{s.dimension, s.adhesion > 0 || s.cohesion_number > 0,
+                       std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; })};
   for (const bool acceleration : {true, false})
     for (const auto& [a, at] : out.autos) {
-      if (a->acceleration != acceleration) continue;
+      if (a->acceleration() != acceleration) continue;
       if (!(s.inertial_number > 0)) {
         out.add(at, a->key.substr(a->key.find('.') + 1),
                 fmt::format("{} = \"auto\" is set by shear.inertial_number (docs/shear.md, \"Settings "
@@ -526,16 +532,8 @@ Scene read_scene(const toml::value& root, const std::string& path) {
       const Acceleration acc = s.subspace > 0  ? Acceleration::Subspace
                                : s.anderson > 0 ? Acceleration::Anderson
                                                 : Acceleration::None;
-      const SceneKind kind{s.dimension, s.adhesion > 0 || s.cohesion_number > 0,
-                           std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; })};
       const ShearSettings set = shear_settings(s.inertial_number, acc, kind);
-      std::visit(
-          [&](auto member, auto value) {
-            if constexpr (std::is_same_v<std::remove_cvref_t<decltype(s.*member)>,
-                                         std::remove_cvref_t<decltype(set.*value)>>)
-              s.*member = set.*value;
-          },
-          a->member, a->value);
+      std::visit([&](const auto& f) { s.*f.member = set.*f.value; }, a->field);
     }
   out.throw_if_any();
 
