@@ -36,6 +36,7 @@
 #include "checkpoint.hpp"
 #include "scene.hpp"
 #include "cli_util.hpp"
+#include "totals_util.hpp"
 #include "world_util.hpp"
 
 namespace fs = std::filesystem;
@@ -146,12 +147,75 @@ TEST(Checkpoint, DamagedFilesAreNamedAndLeaveTheWorldUnchanged) {
   EXPECT_EQ(x.steps, 0);
 
   // The totals round-trip.
-  cd::RunTotals in{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2};
+  cd::RunTotals in{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9};
   cd::save_checkpoint(f.string(), w, 1, in);
   cd::RunTotals out;
   cd::load_checkpoint(f.string(), x, &out);
   EXPECT_EQ(std::memcmp(&in, &out, sizeof in), 0);
   EXPECT_THROW(cd::load_checkpoint((d / "missing.bin").string(), x), cd::CheckpointError);
+}
+
+// A checkpoint of the build before the accelerations' counts holds nine
+// totals under their own name (same format version 5). It resumes: the
+// state and the nine as stored, the three counts at 0 (from then on they
+// count the sessions since the resume).
+TEST(Checkpoint, NineTotalsOfTheEarlierBuildResumeWithTheCountsAtZero) {
+  cd::World w = pile();
+  for (int k = 0; k < 5; ++k) w.step();
+  const fs::path f = temp_dir("nine") / "checkpoint.bin";
+  cd::save_checkpoint(f.string(), w, 1, cd::RunTotals{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9});
+  spit(f, cdtest::with_totals(slurp(f), cdtest::kTotals9, {1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2}));
+  cd::World x = pile();
+  cd::RunTotals t{0, 0, 0, 0, 0, 0, 0, 0, 0, 11, 12, 13};
+  EXPECT_EQ(cd::load_checkpoint(f.string(), x, &t), 1u);
+  EXPECT_EQ(x.steps, 5);
+  EXPECT_EQ(cdtest::state_hash(x), cdtest::state_hash(w));
+  const cd::RunTotals want{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 0, 0, 0};
+  EXPECT_EQ(std::memcmp(&t, &want, sizeof t), 0)
+      << t.wall << " " << t.sessions << " " << t.cg_iterations << " " << t.anderson_off_steps << " "
+      << t.subspace_off_steps;
+}
+
+// Totals under any other name (another build's fields, or one more) are
+// refused naming the file, the world and the caller's totals untouched; so
+// are the nine-field name over twelve values, and a totals array missing.
+TEST(Checkpoint, OtherTotalsAreRefusedNamingTheFile) {
+  cd::World w = pile();
+  for (int k = 0; k < 5; ++k) w.step();
+  const fs::path f = temp_dir("other_totals") / "checkpoint.bin";
+  cd::save_checkpoint(f.string(), w, 1);
+  const std::string good = slurp(f);
+  const std::vector<double> nine(9, 1.0), twelve(12, 1.0);
+  std::string renamed = cdtest::kTotals12;
+  renamed.replace(renamed.find("cg_iterations"), 13, "cg_iters");
+  const struct {
+    std::string name;
+    std::vector<double> values;
+    std::string what;
+  } cases[] = {
+      {renamed, twelve, "holds run totals named '" + renamed + "'; this build reads '" + cdtest::kTotals12 + "'"},
+      {cdtest::kTotals12 + ":sweeps_cg", std::vector<double>(13, 1.0), "holds run totals named"},
+      {"totals:wall:cpu", {1.0, 1.0}, "holds run totals named 'totals:wall:cpu'"},
+      {cdtest::kTotals9, twelve, "is corrupt: 'totals' holds 12 run totals where its name lists 9"},
+      {cdtest::kTotals12, nine, "is corrupt: 'totals' holds 9 run totals where its name lists 12"},
+      {"cell", twelve, "where 'totals:wall:cpu:sweeps:sweeps_max"},
+  };
+  cd::World x = pile();
+  const std::uint64_t h = cdtest::state_hash(x);
+  for (const auto& c : cases) {
+    spit(f, cdtest::with_totals(good, c.name, c.values));
+    cd::RunTotals t;
+    t.sessions = 7;
+    try {
+      cd::load_checkpoint(f.string(), x, &t);
+      ADD_FAILURE() << "totals named " << c.name << " were read";
+    } catch (const cd::CheckpointError& e) {
+      EXPECT_NE(std::string(e.what()).find("checkpoint '" + f.string() + "'"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.what), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(t.sessions, 7.0);
+    EXPECT_EQ(cdtest::state_hash(x), h);
+  }
 }
 
 // ---- cdsim --------------------------------------------------------------------

@@ -21,9 +21,10 @@ constexpr std::string_view kMagic = "CDLABCKP";
 
 // RunTotals' fields, in order: the name of its array, so that a build with
 // other totals refuses the file by name.
-constexpr const char* kTotalsNames[] = {"wall",         "cpu",           "sweeps",
-                                        "sweeps_max",   "cap_steps",     "residual_max",
-                                        "residual_last", "overlap_max",  "sessions"};
+constexpr const char* kTotalsNames[] = {"wall",          "cpu",           "sweeps",
+                                        "sweeps_max",    "cap_steps",     "residual_max",
+                                        "residual_last", "overlap_max",   "sessions",
+                                        "cg_iterations", "anderson_off_steps", "subspace_off_steps"};
 static_assert(sizeof(RunTotals) == std::size(kTotalsNames) * sizeof(double),
               "a RunTotals field is missing from kTotalsNames (checkpoint_io.cpp)");
 std::string totals_name() {
@@ -31,6 +32,27 @@ std::string totals_name() {
   for (const char* n : kTotalsNames) s += std::string(":") + n;
   return s;
 }
+
+// The totals of the builds before the accelerations' counts (same version
+// 5): RunTotals' first nine fields, under this name. Such a checkpoint
+// resumes with the later fields at 0. The name is spelled out, as those
+// files hold it; the assertion keeps the nine the first of kTotalsNames,
+// in order, so that the nine values land in the fields they were.
+constexpr std::size_t kTotals9 = 9;
+constexpr std::string_view kTotals9Name =
+    "totals:wall:cpu:sweeps:sweeps_max:cap_steps:residual_max:residual_last:overlap_max:sessions";
+constexpr bool totals_begin_with(std::string_view name, std::size_t n) {
+  if (!name.starts_with("totals")) return false;
+  name.remove_prefix(6);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::string_view field = kTotalsNames[k];
+    if (!name.starts_with(':') || !name.substr(1).starts_with(field)) return false;
+    name.remove_prefix(1 + field.size());
+  }
+  return name.empty();
+}
+static_assert(totals_begin_with(kTotals9Name, kTotals9),
+              "kTotalsNames must begin with the nine totals older checkpoints hold, in their order");
 
 // The name of the timers' array: the stage names, so that a checkpoint
 // from a build with another stage table is refused by name.
@@ -118,12 +140,24 @@ Header open(const std::string& path, std::string& data, Reader& in, int dimensio
 RunTotals close(Reader& in, const Header& h) {
   RunTotals tot;
   if (h.version >= 4) {
+    // This build's totals, or the nine of a checkpoint written before the
+    // accelerations' counts (version 4 files too): the counts then start at
+    // 0 and cover the sessions from this resume on. Any other totals are
+    // another build's: refused, as their sum could not go on.
+    const std::string name = totals_name();
+    const std::string_view stored = in.next_name("the run totals");
+    const bool nine = stored == kTotals9Name;
+    if (!nine && stored != name && stored.starts_with("totals"))
+      in.fail(fmt::format("holds run totals named '{}'; this build reads '{}' (or the first nine of "
+                          "them, as written before the acceleration counts): written by another build?",
+                          stored.substr(0, 300), name));
+    const std::size_t n = nine ? kTotals9 : std::size(kTotalsNames);
     std::vector<double> t;
-    in.array(totals_name(), t);
-    if (t.size() != std::size(kTotalsNames))
-      in.fail(fmt::format("is corrupt: 'totals' holds {} run totals, this build has {}", t.size(), std::size(kTotalsNames)));
+    in.array(nine ? kTotals9Name : std::string_view(name), t);
+    if (t.size() != n)
+      in.fail(fmt::format("is corrupt: 'totals' holds {} run totals where its name lists {}", t.size(), n));
     for (std::size_t k = 0; k < t.size(); ++k) in.non_negative("totals", k, kTotalsNames[k], t[k]);
-    std::memcpy(static_cast<void*>(&tot), t.data(), sizeof tot);
+    std::memcpy(static_cast<void*>(&tot), t.data(), n * sizeof(double));
   }
   if (!in.rest.empty()) in.fail("has unexpected data after the last array");
   return tot;

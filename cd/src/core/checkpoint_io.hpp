@@ -13,7 +13,9 @@
 //     array named "times:" + the stage names joined by ':' (a build with
 //     other stages refuses the file); then the engine's arrays (its bodies,
 //     warm start, ...); then the run's totals (one f64 per RunTotals field,
-//     in an array named "totals:" + the field names joined by ':')
+//     in an array named "totals:" + the field names joined by ':'; a file
+//     whose totals hold the first nine fields only, written before the
+//     accelerations' counts, is read with the others at 0)
 //   u64 FNV-1a of every byte before it
 // A reader checks every size against the file and the checksum, and names the
 // file in any error.
@@ -52,6 +54,13 @@ struct RunTotals {
   double residual_last = 0;  // the last step's law residual
   double overlap_max = 0;    // largest overlap, in mean diameters
   double sessions = 0;       // cdsim calls that took steps of this run
+  // The accelerations' cost and stalls (solver.subspace, solver.anderson;
+  // 0 when off). A checkpoint written before they were counted holds the
+  // nine fields above only: it resumes with these at 0, and they then count
+  // the sessions since (checkpoint_io.cpp, ckpt::close).
+  double cg_iterations = 0;       // conjugate-gradient iterations of the subspace corrections, all steps
+  double anderson_off_steps = 0;  // steps whose Anderson mixing stalled and went off
+  double subspace_off_steps = 0;  // steps whose subspace corrections stalled and stopped
 };
 
 // 64-bit FNV-1a (the checksum; also used for the scene key).
@@ -119,6 +128,14 @@ struct Reader {
     v.resize(n);
     std::memcpy(static_cast<void*>(v.data()), rest.data(), n * sizeof(T));
     rest.remove_prefix(n * sizeof(T));
+  }
+  // The name of the next array, left unread: for an array whose name
+  // differs between builds that both read it (the run totals).
+  std::string_view next_name(std::string_view what) const {
+    Reader r = *this;
+    const auto len = r.get<std::uint32_t>(what);
+    r.need(len, what);
+    return r.rest.substr(0, len);
   }
 
   // A checkpoint is input like a scene: a matching checksum only says the
