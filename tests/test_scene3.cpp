@@ -9,8 +9,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numbers>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <vtkCellData.h>
 #include <vtkDataArray.h>
@@ -24,6 +27,7 @@
 #include "output3.hpp"
 #include "pile3d.hpp"
 #include "setup3.hpp"
+#include "totals_util.hpp"
 
 namespace fs = std::filesystem;
 using namespace cd;
@@ -372,6 +376,88 @@ TEST(Scene3, CdsimMaxStepsThenResumeIsBitIdentical) {
   EXPECT_EQ(series_without_timers(A / "series.csv"), series_without_timers(B / "series.csv"));
   EXPECT_EQ(slurp(A / "spheres.pvd"), slurp(B / "spheres.pvd"));
   EXPECT_EQ(slurp(A / "spheres_00005.vtp"), slurp(B / "spheres_00005.vtp"));
+}
+
+// summary.toml's "key = value" lines, values as written.
+std::map<std::string, std::string> summary_fields(const fs::path& p) {
+  std::istringstream in(slurp(p));
+  std::map<std::string, std::string> f;
+  for (std::string line; std::getline(in, line);) {
+    const auto eq = line.find(" = ");
+    if (line.starts_with("#") || eq == std::string::npos) continue;
+    std::string v = line.substr(eq + 3, line.find(" #") - eq - 3);
+    while (!v.empty() && v.back() == ' ') v.pop_back();
+    f[line.substr(0, eq)] = v;
+  }
+  return f;
+}
+
+// summary.toml counts the accelerations over every session. A pile with the
+// subspace corrections and Anderson's mixing both on (both stall on some of
+// its steps at its tol 1e-4): the CG iterations and the stalled steps that
+// summary.toml reports are those of the same steps taken in the library, and
+// the run split by --max-steps into two sessions reports them as the run in
+// one. A resume from a checkpoint whose totals are the earlier build's nine
+// (rewritten into the first session's checkpoint) counts them from the
+// resume on: the whole run's minus the first session's.
+TEST(Scene3, SummaryCountsTheAccelerationsOverSessions) {
+  const std::vector<std::string> sets = {"particles.n=64", "time.duration=0.1", "solver.subspace=10",
+                                         "solver.anderson=5"};
+  std::string base = kCdsim + " " + kPile3d + " --quiet --threads 1 --set output.series_interval=0.005 "
+                     "--set output.snapshot_interval=0 --set output.checkpoint_interval=0.02";
+  for (const std::string& s : sets) base += " --set " + s;
+  double cg = 0, anderson_off = 0, subspace_off = 0;
+  World3 w = build_world3(load_scene(kPile3d, sets));
+  for (int k = 0; k < 100; ++k) {
+    w.step();
+    cg += w.last().solve.subspace_iterations;
+    anderson_off += w.last().solve.anderson_off > 0;
+    subspace_off += w.last().solve.subspace_off > 0;
+  }
+  ASSERT_GT(cg, 0);
+  ASSERT_GT(anderson_off, 0) << "no stall: the test sees no stall count";
+  ASSERT_GT(subspace_off, 0) << "no stall: the test sees no stall count";
+
+  const fs::path A = cdtest::scratch_dir("test_scene3", "accel_one");
+  const fs::path B = cdtest::scratch_dir("test_scene3", "accel_two");
+  const fs::path C = cdtest::scratch_dir("test_scene3", "accel_nine");
+  auto r = cdtest::run_command(base + " --out " + A.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto a = summary_fields(A / "summary.toml");
+  EXPECT_EQ(std::stod(a.at("cg_iterations")), cg);
+  EXPECT_DOUBLE_EQ(std::stod(a.at("cg_iterations_mean")), cg / 100);
+  EXPECT_EQ(std::stod(a.at("anderson_off_steps")), anderson_off);
+  EXPECT_EQ(std::stod(a.at("subspace_off_steps")), subspace_off);
+
+  for (const fs::path& d : {B, C}) {
+    r = cdtest::run_command(base + " --max-steps 40 --out " + d.string());
+    ASSERT_EQ(r.code, 0) << r.out;
+  }
+  const auto c1 = summary_fields(C / "summary.toml");
+  const std::string ckpt = (C / "checkpoint.bin").string();
+  RunTotals t;
+  World3 x = build_world3(load_scene(kPile3d, sets));
+  load_checkpoint3(ckpt, x, &t);
+  const std::string nine = cdtest::with_totals(slurp(ckpt), cdtest::kTotals9,
+                                               {t.wall, t.cpu, t.sweeps, t.sweeps_max, t.cap_steps,
+                                                t.residual_max, t.residual_last, t.overlap_max, t.sessions});
+  std::ofstream(ckpt, std::ios::binary) << nine;
+  for (const fs::path& d : {B, C}) {
+    r = cdtest::run_command(base + " --out " + d.string());
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("resumed from"), std::string::npos) << r.out;
+  }
+  const auto b = summary_fields(B / "summary.toml"), c = summary_fields(C / "summary.toml");
+  EXPECT_EQ(b.at("sessions"), "2");
+  for (const char* k : {"steps", "sweeps_mean", "sweeps_max", "cg_iterations", "cg_iterations_mean",
+                        "anderson_off_steps", "subspace_off_steps"})
+    EXPECT_EQ(b.at(k), a.at(k)) << k;
+  // The earlier build's totals carried on, the counts from the resume on.
+  EXPECT_EQ(c.at("sessions"), "2");
+  for (const char* k : {"steps", "sweeps_mean", "sweeps_max"}) EXPECT_EQ(c.at(k), a.at(k)) << k;
+  for (const char* k : {"cg_iterations", "anderson_off_steps", "subspace_off_steps"})
+    EXPECT_EQ(std::stod(c.at(k)), std::stod(a.at(k)) - std::stod(c1.at(k))) << k;
+  EXPECT_GT(std::stod(c1.at("cg_iterations")), 0.0);
 }
 
 // A checkpoint of the other dimension is refused, naming both, before

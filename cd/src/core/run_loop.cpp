@@ -144,6 +144,17 @@ std::string summary_toml(const RunSummary& s) {
   o += line("load_end = " + load(s.load_end), "and when it ended");
   o += line("sweeps_mean = " + toml_float(s.last_step ? t.sweeps / double(s.last_step) : 0.0), "NLGS sweeps per step, mean over the steps");
   o += line(fmt::format("sweeps_max = {}", std::llround(t.sweeps_max)), "most sweeps of one step");
+  // The accelerations' cost (0 when off). A CG iteration of the subspace
+  // correction is one product W p through the bodies of the closed rows,
+  // about half a sweep's cost (docs/accuracy.md): sweeps_mean leaves it out.
+  o += line(fmt::format("cg_iterations = {}", std::llround(t.cg_iterations)),
+            "CG iterations of the subspace corrections (solver.subspace), all steps");
+  o += line("cg_iterations_mean = " + toml_float(s.last_step ? t.cg_iterations / double(s.last_step) : 0.0),
+            "per step, mean over the steps; one costs about half a sweep");
+  o += line(fmt::format("anderson_off_steps = {}", std::llround(t.anderson_off_steps)),
+            "steps whose Anderson mixing (solver.anderson) stalled and went off");
+  o += line(fmt::format("subspace_off_steps = {}", std::llround(t.subspace_off_steps)),
+            "steps whose subspace corrections stalled and stopped");
   o += line(fmt::format("cap_steps = {}", std::llround(t.cap_steps)), "steps stopped at solver.max_iter");
   o += line("cap_share = " + toml_float(s.cap_share()), "cap_steps / steps");
   o += line("residual_final = " + toml_float(t.residual_last), "law residual of the last step");
@@ -343,6 +354,9 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     tot.residual_max = std::max(tot.residual_max, st.solve.residual_max);
     tot.residual_last = st.solve.residual_max;
     tot.overlap_max = std::max(tot.overlap_max, st.max_overlap);
+    tot.cg_iterations += st.solve.subspace_iterations;
+    tot.anderson_off_steps += st.solve.anderson_off > 0;
+    tot.subspace_off_steps += st.solve.subspace_off > 0;
 
     if (row_due || stopping) {
       timed_output([&] {
