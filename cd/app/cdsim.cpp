@@ -6,7 +6,8 @@
 // Exit codes: 0 done; 2 bad input (usage, scene, start sample, checkpoint,
 // output folder); 3 the run diverged (non-finite state: the watchdog);
 // 4 could not write (disk full, a file made unwritable: the last checkpoint
-// and the whole rows before it are intact); 6 the output folder is being
+// and the whole rows before it are intact; or the output folder was removed
+// or replaced while the run wrote: nothing more written); 6 the output folder is being
 // written by another cdsim; 128 + signal when stopped by SIGINT, SIGTERM or
 // SIGHUP (at the next series row, with a checkpoint when checkpoints are on).
 #include <omp.h>
@@ -184,6 +185,10 @@ int main(int argc, char** argv) {
   } catch (const cd::RunDiverged& e) {
     std::cerr << "cdsim: run diverged: " << e.what() << "\n";
     return 3;
+  } catch (const cd::FolderGone& e) {
+    // Not a resumable write failure: the folder is another's now.
+    std::cerr << "cdsim: " << e.what() << "\n";
+    return 4;
   } catch (const cd::WriteError& e) {
     std::cerr << "cdsim: " << e.what()
               << "; the run stopped there: series.csv holds whole rows and the last checkpoint (if any) "

@@ -91,10 +91,32 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   rename_into_place(tmp, path);
 }
 
-FolderLock::FolderLock(const std::string& dir) {
+FolderLock::FolderLock(const std::string& dir) : dir_(dir) {
+  // The folder first, then its lock file through it: the identity and the
+  // lock are of one folder even if the name changes between the two. O_PATH
+  // needs no read permission (the folder's checks ask for write and search).
+#ifdef O_PATH
+  constexpr int kDirFlags = O_PATH | O_DIRECTORY | O_CLOEXEC;
+#else
+  constexpr int kDirFlags = O_RDONLY | O_DIRECTORY | O_CLOEXEC;
+#endif
+  dir_fd_ = ::open(dir.c_str(), kDirFlags);
+  if (dir_fd_ < 0) write_failed(dir, errno);
+  struct stat st {};
+  if (::fstat(dir_fd_, &st) != 0) {
+    const int err = errno;
+    ::close(dir_fd_);
+    write_failed(dir, err);
+  }
+  dev_ = st.st_dev;
+  ino_ = st.st_ino;
   const std::string path = (fs::path(dir) / ".cdsim.lock").string();
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0) write_failed(path, errno);
+  fd_ = ::openat(dir_fd_, ".cdsim.lock", O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    const int err = errno;
+    ::close(dir_fd_);
+    write_failed(path, err);
+  }
   struct flock l {};
   l.l_type = F_WRLCK;
   l.l_whence = SEEK_SET;  // the whole file (l_start = l_len = 0)
@@ -108,7 +130,8 @@ FolderLock::FolderLock(const std::string& dir) {
     if (::fcntl(fd_, F_GETLK, &q) == 0 && q.l_type != F_UNLCK && q.l_pid > 0)
       who += fmt::format(" (pid {})", q.l_pid);
     ::close(fd_);
-    fd_ = -1;
+    ::close(dir_fd_);
+    fd_ = dir_fd_ = -1;
     throw FolderBusy(fmt::format("output folder '{}' is being written by {}, which holds its lock '{}'; "
                                  "wait for it to end, or choose another --out", dir, who, path));
   }
@@ -118,6 +141,18 @@ FolderLock::FolderLock(const std::string& dir) {
 
 FolderLock::~FolderLock() {
   if (fd_ >= 0) ::close(fd_);  // releases the lock
+  if (dir_fd_ >= 0) ::close(dir_fd_);
+}
+
+void FolderLock::check_unchanged() const {
+  struct stat st {};
+  if (::stat(dir_.c_str(), &st) != 0) {
+    if (errno != ENOENT && errno != ENOTDIR) write_failed(dir_, errno);
+  } else if (st.st_dev == dev_ && st.st_ino == ino_) {
+    return;
+  }
+  throw FolderGone(fmt::format("output folder '{}' was removed or replaced while the run was writing; "
+                               "nothing written", dir_));
 }
 
 // ---------------------------------------------------------------------------

@@ -28,12 +28,28 @@ struct FolderBusy : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The output folder was removed, or replaced by another of the same name (a
+// new run's), while the run wrote into it (FolderLock::check_unchanged):
+// the run writes nothing more (cdsim exits 4, as for a write that failed).
+struct FolderGone : WriteError {
+  using WriteError::WriteError;
+};
+
 // One writer per output folder: an advisory write lock (fcntl) on
 // DIR/.cdsim.lock, an empty file created once and left in place, held while
 // this object lives. The kernel drops it when the process ends, however it
 // ends (kill -9 too), so no stale lock survives a crash. A second cdsim on
 // the folder throws FolderBusy naming it and the holder's pid. On a file
 // system without locks (some network mounts) it warns and runs unguarded.
+//
+// The lock guards the folder it was taken in, not its name: a folder
+// removed (rm -rf of a stopping run's outputs) and made again by another run
+// is another folder, with its own lock. The files are written by path
+// (series.csv reopened at each row, the others renamed into place), so
+// before each write the writer calls check_unchanged(): the folder's
+// identity (device, inode) taken here against what the name now points to.
+// The folder is held open meanwhile, so that its inode number cannot be
+// given to a folder made after it is removed.
 class FolderLock {
  public:
   explicit FolderLock(const std::string& dir);
@@ -41,8 +57,15 @@ class FolderLock {
   FolderLock& operator=(const FolderLock&) = delete;
   ~FolderLock();
 
+  // Throws FolderGone naming the folder unless `dir` is still the folder
+  // this lock was taken in (WriteError if it cannot be looked up at all).
+  void check_unchanged() const;
+
  private:
-  int fd_ = -1;
+  std::string dir_;
+  int dir_fd_ = -1;  // the folder itself (O_PATH): its identity, pinned
+  unsigned long long dev_ = 0, ino_ = 0;
+  int fd_ = -1;      // DIR/.cdsim.lock, locked
 };
 
 // Throws OutputError naming the folder if it cannot be created or written.

@@ -196,6 +196,14 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   // folder) or as soon as the folder is made.
   std::optional<FolderLock> lock;
   if (fs::is_directory(dir)) lock.emplace(opt.out);
+  // Before every write: the folder must still be the one locked. A stopping
+  // run whose folder was removed and made again by a new run (of the same
+  // --out) would otherwise reopen the new series.csv by its path and append
+  // its last row ahead of the new header; it writes nothing instead
+  // (FolderGone). Each check is one stat, at most a few per series row.
+  const auto still_ours = [&] {
+    if (lock) lock->check_unchanged();
+  };
   const bool resume = !opt.fresh && fs::exists(ckpt);
   std::vector<std::string> columns;  // of series.csv, cut back to the checkpoint
   std::vector<std::string> timing_columns;  // of timings.csv, likewise
@@ -207,6 +215,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       if ((stored != key && !folder_scene_is((dir / "scene.toml").string(), key)) || w.steps() > nsteps)
         throw CheckpointError(fmt::format("checkpoint '{}' was written by a different scene "
                                           "(compare with {})", ckpt, (dir / "scene.toml").string()));
+      still_ours();
       columns = truncate_series(series_path, w.steps());
       // A run begun before timings.csv existed has the timings in its
       // series: it goes on so, to its end.
@@ -240,6 +249,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
 
   fs::create_directories(opt.out);
   if (!lock) lock.emplace(opt.out);
+  still_ours();  // not removed (and made again above) since it was locked
   if (!resume) clear_previous(opt.out);
   write_file_atomic((dir / "scene.toml").string(), opt.scene_toml);
   // On resume, the snapshots up to the checkpoint are known by their steps
@@ -276,6 +286,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     sum.totals = totals_now();
     sum.threads = omp_get_max_threads();
     sum.load_end = load_average();
+    still_ours();
     write_file_atomic((dir / "summary.toml").string(), summary_toml(sum));
   };
   // A diverged run still says what it cost, up to `last`, the last step
@@ -293,12 +304,19 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     f();
     w.times()[Stage::Output] += std::chrono::duration<double>(Clock::now() - t).count();
   };
-  if (every_snap && !resume) timed_output([&] { w.write_snapshot(); });
+  if (every_snap && !resume) timed_output([&] {
+    still_ours();
+    w.write_snapshot();
+  });
+  const auto dumped = [&](std::int64_t k) {
+    return std::find(opt.dump_steps.begin(), opt.dump_steps.end(), k) != opt.dump_steps.end();
+  };
 
   std::int64_t k_end = k_last;  // the last step taken (earlier if stopped by a signal or settled)
   bool stop_seen = false;       // a signal's stop was announced
   bool settled = k_last < nsteps;
   for (std::int64_t k = k0 + 1; k <= k_last; ++k) {
+    if (dumped(k)) still_ours();  // the step writes its problem before its solve
     try {
       w.step();
     } catch (const std::runtime_error& e) {
@@ -337,6 +355,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps;
     const bool stopping = (g_stop != 0 && row_due && k < nsteps) || at_limit;
     if (stopping) k_end = k;
+    if (dumped(k)) still_ours();
     w.after_step(k);
     iv.add(st);
     iter_total += st.solve.iterations;
@@ -386,10 +405,12 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
             throw diverged(k, fmt::format("step {} (t = {:.6g} s): series column {} is {}; "
                                           "series.csv holds the rows before it", k, w.time(), name, x));
         series.row(cols);
+        still_ours();
         series.flush();
         settle.add(cols);
         if (timings) {
           timings->row(tcols);
+          still_ours();
           timings->flush();
         }
       });
@@ -400,14 +421,20 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
         k_end = k;
       }
     }
-    if (every_snap && k % every_snap == 0) timed_output([&] { w.write_snapshot(); });
+    if (every_snap && k % every_snap == 0) timed_output([&] {
+      still_ours();
+      w.write_snapshot();
+    });
     // After this step's outputs, so that a restart has them all. A resumed
     // run keeps its checkpoint current even with checkpoints off.
     const bool wall_due = ckpt_wall > 0 && k % every_row == 0 &&
                           std::chrono::duration<double>(Clock::now() - last_ckpt).count() >= ckpt_wall;
     if ((every_ckpt && k % every_ckpt == 0) || (every_ckpt_strain && k % every_ckpt_strain == 0) ||
         wall_due || ((k == nsteps || stopping || settled) && (checkpoints || resume))) {
-      timed_output([&] { w.save(ckpt, key, totals_now()); });
+      timed_output([&] {
+        still_ours();
+        w.save(ckpt, key, totals_now());
+      });
       last_ckpt = Clock::now();
     }
     if (stopping) {
