@@ -19,37 +19,68 @@ namespace {
 
 struct Expected {
   double I, tol, tol_anderson, tol_subspace, residual_tol, dt_tp, cell_mass;
+  // Cohesionless 3D spheres with their band's acceleration: the stop
+  // (solver.tol, solver.residual_tol, contact.overlap_projection).
+  double sphere_tol, sphere_residual_tol, sphere_projection;
 };
 
 // docs/shear.md's table, read at and around each breakpoint (I = 0.01 for
 // the tolerance, 0.1 for the time step's cap, 0.5 for the cell mass).
 const Expected kTable[] = {
-    {0.001, 1e-4, 1e-4, 1e-4, 3e-3, 0.05, 0.1},   {0.00999, 1e-4, 1e-4, 1e-4, 3e-3, 0.05, 0.1},
-    {0.01, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1},     {0.05, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1},
-    {0.1, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1},      {0.2, 1e-3, 5e-4, 7e-4, 0.0, 0.025, 0.1},
-    {0.3, 1e-3, 5e-4, 7e-4, 0.0, 0.01667, 0.1},   {0.49, 1e-3, 5e-4, 7e-4, 0.0, 0.0102, 0.1},
-    {0.5, 1e-3, 5e-4, 7e-4, 0.0, 0.01, 0.01},     {1.0, 1e-3, 5e-4, 7e-4, 0.0, 0.005, 0.01},
+    {0.001, 1e-4, 1e-4, 1e-4, 3e-3, 0.05, 0.1, 3e-4, 0.0, 0.5},
+    {0.00999, 1e-4, 1e-4, 1e-4, 3e-3, 0.05, 0.1, 3e-4, 0.0, 0.5},
+    {0.01, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1, 7e-4, 0.0, 0.0},
+    {0.05, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1, 7e-4, 0.0, 0.0},
+    {0.1, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1, 7e-4, 0.0, 0.0},
+    {0.2, 1e-3, 5e-4, 7e-4, 0.0, 0.025, 0.1, 7e-4, 0.0, 0.0},
+    {0.3, 1e-3, 5e-4, 7e-4, 0.0, 0.01667, 0.1, 7e-4, 0.0, 0.0},
+    {0.49, 1e-3, 5e-4, 7e-4, 0.0, 0.0102, 0.1, 7e-4, 0.0, 0.0},
+    {0.5, 1e-3, 5e-4, 7e-4, 0.0, 0.01, 0.01, 7e-4, 0.0, 0.0},
+    {1.0, 1e-3, 5e-4, 7e-4, 0.0, 0.005, 0.01, 7e-4, 0.0, 0.0},
 };
+
+const cd::SceneKind kDisks{2, false, false};
+const cd::SceneKind kSpheres{3, false, false};
+const cd::SceneKind kCohesiveSpheres{3, true, false};
 
 TEST(ShearPolicy, TheTableAtItsBreakpoints) {
   for (const Expected& e : kTable) {
-    const cd::ShearSettings s = cd::shear_settings(e.I);
-    // An acceleration changes the tolerance only.
-    for (const auto& [acc, tol] : {std::pair{cd::Acceleration::Anderson, e.tol_anderson},
-                                   std::pair{cd::Acceleration::Subspace, e.tol_subspace}}) {
-      const cd::ShearSettings a = cd::shear_settings(e.I, acc);
-      EXPECT_EQ(a.tol, tol) << "I = " << e.I;
-      EXPECT_EQ(a.residual_tol, s.residual_tol) << "I = " << e.I;
-      EXPECT_EQ(a.dt_tp, s.dt_tp) << "I = " << e.I;
-      EXPECT_EQ(a.cell_mass, s.cell_mass) << "I = " << e.I;
+    // 2D disks and cohesive spheres: the band's stop for what runs, no
+    // projection.
+    for (const cd::SceneKind kind : {kDisks, kCohesiveSpheres}) {
+      const cd::ShearSettings s = cd::shear_settings(e.I, cd::Acceleration::None, kind);
+      EXPECT_EQ(s.tol, e.tol) << "I = " << e.I;
+      EXPECT_EQ(s.residual_tol, e.residual_tol) << "I = " << e.I;
+      EXPECT_EQ(s.dt_tp, e.dt_tp) << "I = " << e.I;
+      EXPECT_EQ(s.cell_mass, e.cell_mass) << "I = " << e.I;
+      EXPECT_EQ(s.overlap_projection, 0.0) << "I = " << e.I;
+      // An acceleration changes the tolerance only.
+      for (const auto& [acc, tol] : {std::pair{cd::Acceleration::Anderson, e.tol_anderson},
+                                     std::pair{cd::Acceleration::Subspace, e.tol_subspace}}) {
+        const cd::ShearSettings a = cd::shear_settings(e.I, acc, kind);
+        EXPECT_EQ(a.tol, tol) << "I = " << e.I;
+        EXPECT_EQ(a.residual_tol, s.residual_tol) << "I = " << e.I;
+        EXPECT_EQ(a.overlap_projection, 0.0) << "I = " << e.I;
+        EXPECT_EQ(a.dt_tp, s.dt_tp) << "I = " << e.I;
+        EXPECT_EQ(a.cell_mass, s.cell_mass) << "I = " << e.I;
+      }
     }
-    EXPECT_EQ(s.tol, e.tol) << "I = " << e.I;
-    EXPECT_EQ(s.residual_tol, e.residual_tol) << "I = " << e.I;
-    EXPECT_EQ(s.dt_tp, e.dt_tp) << "I = " << e.I;
-    EXPECT_EQ(s.cell_mass, e.cell_mass) << "I = " << e.I;
     // dt <= 0.005 t_p / I (to the 4 digits it is written with), <= 0.05 t_p.
+    const cd::ShearSettings s = cd::shear_settings(e.I, cd::Acceleration::None, kSpheres);
     EXPECT_LE(s.dt_tp, 0.005 / e.I * (1 + 5e-4)) << "I = " << e.I;
     EXPECT_LE(s.dt_tp, 0.05) << "I = " << e.I;
+    // Cohesionless spheres: their own stop with their band's acceleration,
+    // the band's with the other one.
+    const cd::Acceleration own = s.subspace > 0 ? cd::Acceleration::Subspace : cd::Acceleration::Anderson;
+    const cd::ShearSettings o = cd::shear_settings(e.I, own, kSpheres);
+    EXPECT_EQ(o.tol, e.sphere_tol) << "I = " << e.I;
+    EXPECT_EQ(o.residual_tol, e.sphere_residual_tol) << "I = " << e.I;
+    EXPECT_EQ(o.overlap_projection, e.sphere_projection) << "I = " << e.I;
+    EXPECT_EQ(s.tol, e.tol) << "I = " << e.I;  // plain NLGS: the band's stop
+    const cd::Acceleration other = s.subspace > 0 ? cd::Acceleration::Anderson : cd::Acceleration::Subspace;
+    EXPECT_EQ(cd::shear_settings(e.I, other, kSpheres).tol,
+              other == cd::Acceleration::Anderson ? e.tol_anderson : e.tol_subspace)
+        << "I = " << e.I;
   }
 }
 
@@ -111,6 +142,30 @@ TEST(ShearPolicy, AutoWithoutAnInertialNumberOrOnAnotherKeyIsRefused) {
   }
 }
 
+// "auto" for the overlap projection: on for the spheres' stop below
+// I = 0.01, off above and in 2D.
+TEST(ShearPolicy, AutoProjectionFollowsTheSpheresStop) {
+  const std::string scene3 =
+      "dimension = 3\ngravity.g = [0.0, 0.0, 0.0]\n[contact]\noverlap_projection = \"auto\"\n"
+      "[solver]\ntol = \"auto\"\nresidual_tol = \"auto\"\nanderson = \"auto\"\nsubspace = \"auto\"\n"
+      "[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.01\n";
+  const cd::Scene low = cd::parse_scene(scene3, "a.toml", {"shear.inertial_number=0.001"});
+  EXPECT_EQ(low.overlap_projection, 0.5);
+  EXPECT_EQ(low.anderson, 5);
+  EXPECT_EQ(low.tol, 3e-4);
+  EXPECT_EQ(low.residual_tol, 0.0);
+  EXPECT_EQ(cd::parse_scene(scene3, "a.toml").overlap_projection, 0.0);  // I = 0.01
+  // Plain NLGS below 0.01 keeps the band's stop, without the projection.
+  const cd::Scene plain = cd::parse_scene(scene3, "a.toml", {"shear.inertial_number=0.001", "solver.anderson=0"});
+  EXPECT_EQ(plain.overlap_projection, 0.0);
+  EXPECT_EQ(plain.tol, 1e-4);
+  EXPECT_EQ(plain.residual_tol, 3e-3);
+  const std::string scene2 =
+      "[contact]\noverlap_projection = \"auto\"\n[solver]\nanderson = \"auto\"\n[shear]\nmode = \"periodic\"\n"
+      "pressure = 100.0\ninertial_number = 0.001\n";
+  EXPECT_EQ(cd::parse_scene(scene2, "b.toml").overlap_projection, 0.0);
+}
+
 // "auto" for the acceleration: the band's choice, resolved before the
 // tolerance that depends on it; a number wins; a 2D scene cannot take the
 // subspace correction the band would choose for it.
@@ -135,7 +190,7 @@ TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
     const cd::Scene c = cd::parse_scene(scene, "a.toml", {coh, "shear.inertial_number=0.01"});
     EXPECT_EQ(c.subspace, 0) << coh;
     EXPECT_EQ(c.anderson, cd::kAnderson) << coh;
-    EXPECT_EQ(c.tol, cd::shear_settings(0.01, cd::Acceleration::Anderson).tol) << coh;
+    EXPECT_EQ(c.tol, cd::shear_settings(0.01, cd::Acceleration::Anderson, kCohesiveSpheres).tol) << coh;
   }
   // 2D: Anderson's mixing with disks, none with polygons, in every band;
   // the tolerance follows.
@@ -146,11 +201,11 @@ TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
     is << "shear.inertial_number=" << I;
     const cd::Scene d = cd::parse_scene(scene2, "c.toml", {is.str()});
     EXPECT_EQ(d.anderson, cd::kAnderson) << "disks, I = " << I;
-    EXPECT_EQ(d.tol, cd::shear_settings(I, cd::Acceleration::Anderson).tol) << "disks, I = " << I;
+    EXPECT_EQ(d.tol, cd::shear_settings(I, cd::Acceleration::Anderson, kDisks).tol) << "disks, I = " << I;
     for (const char* ns : {"particles.nsides=[6]", "particles.nsides=[3,6,0]"}) {
       const cd::Scene g = cd::parse_scene(scene2, "c.toml", {is.str(), ns});
       EXPECT_EQ(g.anderson, 0) << ns << ", I = " << I;
-      EXPECT_EQ(g.tol, cd::shear_settings(I).tol) << ns << ", I = " << I;
+      EXPECT_EQ(g.tol, cd::shear_settings(I, cd::Acceleration::None, kDisks).tol) << ns << ", I = " << I;
     }
   }
   // A number for one of them: kept, and the tolerance follows what runs.
@@ -172,7 +227,7 @@ TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
   }
 }
 
-// The four keys of a resolved scene printed by cdsim --print-scene.
+// The policy's keys of a resolved scene printed by cdsim --print-scene.
 std::map<std::string, std::string> settings_of(const std::string& printed) {
   std::map<std::string, std::string> out;
   std::istringstream in(printed);
@@ -184,7 +239,8 @@ std::map<std::string, std::string> settings_of(const std::string& printed) {
     ls >> key >> eq >> value;
     const std::string name = section + "." + key;
     if (eq == "=" && (name == "solver.tol" || name == "solver.residual_tol" || name == "shear.dt_tp" ||
-                      name == "shear.cell_mass" || name == "shear.inertial_number"))
+                      name == "shear.cell_mass" || name == "shear.inertial_number" ||
+                      name == "contact.overlap_projection"))
       out[name] = value;
   }
   return out;
@@ -227,25 +283,28 @@ std::map<std::string, std::string> single_run_settings(const std::string& scene,
 TEST(ShearPolicy, ACampaignPointAndASingleRunAtTheSameIRunTheSameSettings) {
   for (const char* I : {"0.003", "0.01", "0.3", "0.5"}) {
     const auto c = campaign_settings(I, "2"), s = single_run_settings("shear-inertial.toml", I);
-    EXPECT_EQ(c.size(), 5u) << I;
+    EXPECT_EQ(c.size(), 6u) << I;
     EXPECT_EQ(c, s) << "I = " << I;
-    const cd::ShearSettings p = cd::shear_settings(std::stod(I), cd::Acceleration::Anderson);  // the scene mixes (anderson = 5)
+    const cd::ShearSettings p = cd::shear_settings(std::stod(I), cd::Acceleration::Anderson, kDisks);  // the scene mixes (anderson = 5)
     EXPECT_EQ(std::stod(s.at("solver.tol")), p.tol) << I;
     EXPECT_EQ(std::stod(s.at("solver.residual_tol")), p.residual_tol) << I;
     EXPECT_EQ(std::stod(s.at("shear.dt_tp")), p.dt_tp) << I;
     EXPECT_EQ(std::stod(s.at("shear.cell_mass")), p.cell_mass) << I;
   }
   const auto c3 = campaign_settings("0.001", "3"), s3 = single_run_settings("shear3-inertial.toml", "0.001");
-  EXPECT_EQ(c3.size(), 5u);
+  EXPECT_EQ(c3.size(), 6u);
   EXPECT_EQ(c3, s3);
-  EXPECT_EQ(std::stod(s3.at("solver.residual_tol")), 3e-3);
+  // Anderson's mixing at I = 1e-3, with the spheres' stop.
+  const cd::ShearSettings p3 = cd::shear_settings(0.001, cd::Acceleration::Anderson, kSpheres);
+  EXPECT_EQ(std::stod(s3.at("solver.residual_tol")), p3.residual_tol);
+  EXPECT_EQ(std::stod(s3.at("contact.overlap_projection")), p3.overlap_projection);
   // The 3D scene lets the band choose its acceleration: the subspace
   // correction at I = 0.01 (tolerance tol_subspace), Anderson's mixing at
   // 1e-3 (tol_anderson), the same for a campaign point.
   const auto c3b = campaign_settings("0.01", "3"), s3b = single_run_settings("shear3-inertial.toml", "0.01");
   EXPECT_EQ(c3b, s3b);
-  EXPECT_EQ(std::stod(s3b.at("solver.tol")), cd::shear_settings(0.01, cd::Acceleration::Subspace).tol);
-  EXPECT_EQ(std::stod(s3.at("solver.tol")), cd::shear_settings(0.001, cd::Acceleration::Anderson).tol);
+  EXPECT_EQ(std::stod(s3b.at("solver.tol")), cd::shear_settings(0.01, cd::Acceleration::Subspace, kSpheres).tol);
+  EXPECT_EQ(std::stod(s3.at("solver.tol")), p3.tol);
 }
 
 }  // namespace

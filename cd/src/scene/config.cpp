@@ -141,7 +141,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"contact", "debond", &Scene::debond, "d_mean", ge(0), "debonding distance delta_a, in mean diameters: a bond breaks beyond it"},
       {"contact", "cohesion_number", &Scene::cohesion_number, "", ge(0), "cohesion number eta, the pull-off force f_a in units of the imposed shear.pressure p (needs p > 0; instead of contact.adhesion): 2D f_a = eta p d (p in N/m), 3D f_a = eta p d^2 (p in N/m^2), d = particles.d_mean (with shear.start: the scene's particles.d_mean, within 10 % of the sample's; particles.diameters: their mean), the d of t_p and I; 0: use contact.adhesion"},
       {"contact", "overlap_correction", &Scene::overlap_correction, "", in(0, 1), "beta: an overlapping contact must separate at beta |gap|/dt; injects energy (bounded by the series column correction_work); 0: pure CD, overlaps never pushed apart"},
-      {"contact", "overlap_projection", &Scene::overlap_projection, "", in(0, 1), "beta_p: on a step where some overlap reaches 1e-3 of its pair's smaller diameter, the positions (and the periodic cell's lengths) move by the smallest mass-weighted displacement that opens every overlap by beta_p times itself and closes no gap (a frictionless pseudo-velocity solve, at most 100 sweeps); velocities untouched, so no energy put in; the contact forces' work on those moves is the series column projection_work; 0: off"},
+      {"contact", "overlap_projection", &Scene::overlap_projection, "", in(0, 1), "beta_p: on a step where some overlap reaches 1e-3 of its pair's smaller diameter, the positions (and the periodic cell's lengths) move by the smallest mass-weighted displacement that opens every overlap by beta_p times itself and closes no gap (a frictionless pseudo-velocity solve, at most 100 sweeps); velocities untouched, so no energy put in; the contact forces' work on those moves is the series column projection_work; 0: off; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "tol", &Scene::tol, "", in_open_closed(0, 1), "NLGS convergence tolerance (relative); \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "max_iter", &Scene::max_iter, "", in(1, 1e8), "NLGS iteration cap per time step"},
       {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
@@ -213,7 +213,7 @@ const std::vector<Param<WallSpec>>& wall_params() {
 // The keys that may be "auto": their value is the shear policy's for the
 // scene's inertial number (shear_policy.hpp), put in once every key is read:
 // the acceleration first (the integer keys, solver.anderson and
-// solver.subspace), since the tolerance depends on it.
+// solver.subspace), since the stop depends on it.
 template <class T>
 struct AutoField {
   T Scene::*member;
@@ -224,9 +224,11 @@ struct AutoKey {
   std::variant<AutoField<double>, AutoField<int>> field;
   bool acceleration() const { return std::holds_alternative<AutoField<int>>(field); }
 };
-const std::array<AutoKey, 6> kAutoKeys = {
+const std::array<AutoKey, 7> kAutoKeys = {
     {{"solver.tol", AutoField<double>{&Scene::tol, &ShearSettings::tol}},
      {"solver.residual_tol", AutoField<double>{&Scene::residual_tol, &ShearSettings::residual_tol}},
+     {"contact.overlap_projection",
+      AutoField<double>{&Scene::overlap_projection, &ShearSettings::overlap_projection}},
      {"shear.dt_tp", AutoField<double>{&Scene::dt_tp, &ShearSettings::dt_tp}},
      {"shear.cell_mass", AutoField<double>{&Scene::cell_mass, &ShearSettings::cell_mass}},
      {"solver.anderson", AutoField<int>{&Scene::anderson, &ShearSettings::anderson}},

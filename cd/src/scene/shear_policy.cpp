@@ -14,12 +14,18 @@ ShearSettings shear_settings(double I, Acceleration acc, SceneKind kind) {
     if (I >= x.i_min) b = &x;
   // %.4g, then read back: the Makefile's awk printed dt_tp so.
   const double dt_tp = std::stod(fmt::format("{:.4g}", std::min(kSlidePerStep / I, kDtMaxTp)));
-  const double tol = acc == Acceleration::Subspace ? b->tol_subspace
-                     : acc == Acceleration::Anderson ? b->tol_anderson
-                                                     : b->tol;
-  if (kind.dimension == 2) return {tol, b->residual_tol, dt_tp, b->cell_mass, kind.polygons ? 0 : kAnderson, 0};
-  if (kind.cohesive) return {tol, b->residual_tol, dt_tp, b->cell_mass, kAnderson, 0};
-  return {tol, b->residual_tol, dt_tp, b->cell_mass, b->anderson, b->subspace};
+  const bool spheres = kind.dimension == 3 && !kind.cohesive;
+  const int anderson = kind.dimension == 2 ? (kind.polygons ? 0 : kAnderson) : kind.cohesive ? kAnderson : b->auto_anderson;
+  const int subspace = spheres ? b->auto_subspace : 0;
+  // The spheres' own stop when they run the band's acceleration.
+  const bool own = spheres && (acc == Acceleration::Subspace ? b->auto_subspace > 0
+                               : acc == Acceleration::Anderson ? b->auto_subspace == 0 && b->auto_anderson > 0
+                                                               : false);
+  const Stop& stop = own ? b->spheres
+                     : acc == Acceleration::Subspace ? b->subspace
+                     : acc == Acceleration::Anderson ? b->anderson
+                                                     : b->plain;
+  return {stop.tol, stop.residual_tol, stop.overlap_projection, dt_tp, b->cell_mass, anderson, subspace};
 }
 
 }  // namespace cd
