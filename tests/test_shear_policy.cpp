@@ -18,25 +18,25 @@
 namespace {
 
 struct Expected {
-  double I, tol, tol_anderson, tol_subspace, residual_tol, dt_tp, cell_mass;
-  // Cohesionless 3D spheres with their band's acceleration: the stop
-  // (solver.tol, solver.residual_tol, contact.overlap_projection).
-  double sphere_tol, sphere_residual_tol, sphere_projection;
+  double I, tol, residual_tol;                                // plain NLGS (and the subspace correction's residual stop)
+  double tol_anderson, residual_anderson, projection_anderson;  // Anderson, cohesionless
+  double tol_subspace, tol_cohesive;                          // the subspace correction; Anderson, cohesive
+  double dt_tp, cell_mass;
 };
 
 // docs/shear.md's table, read at and around each breakpoint (I = 0.01 for
-// the tolerance, 0.1 for the time step's cap, 0.5 for the cell mass).
+// the stops, 0.1 for the time step's cap, 0.5 for the cell mass).
 const Expected kTable[] = {
-    {0.001, 1e-4, 1e-4, 1e-4, 3e-3, 0.05, 0.1, 3e-4, 0.0, 0.5},
-    {0.00999, 1e-4, 1e-4, 1e-4, 3e-3, 0.05, 0.1, 3e-4, 0.0, 0.5},
-    {0.01, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1, 7e-4, 0.0, 0.0},
-    {0.05, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1, 7e-4, 0.0, 0.0},
-    {0.1, 1e-3, 5e-4, 7e-4, 0.0, 0.05, 0.1, 7e-4, 0.0, 0.0},
-    {0.2, 1e-3, 5e-4, 7e-4, 0.0, 0.025, 0.1, 7e-4, 0.0, 0.0},
-    {0.3, 1e-3, 5e-4, 7e-4, 0.0, 0.01667, 0.1, 7e-4, 0.0, 0.0},
-    {0.49, 1e-3, 5e-4, 7e-4, 0.0, 0.0102, 0.1, 7e-4, 0.0, 0.0},
-    {0.5, 1e-3, 5e-4, 7e-4, 0.0, 0.01, 0.01, 7e-4, 0.0, 0.0},
-    {1.0, 1e-3, 5e-4, 7e-4, 0.0, 0.005, 0.01, 7e-4, 0.0, 0.0},
+    {0.001, 1e-4, 3e-3, 3e-4, 0.0, 0.5, 1e-4, 1e-4, 0.05, 0.1},
+    {0.00999, 1e-4, 3e-3, 3e-4, 0.0, 0.5, 1e-4, 1e-4, 0.05, 0.1},
+    {0.01, 1e-3, 0.0, 5e-4, 0.0, 0.0, 7e-4, 5e-4, 0.05, 0.1},
+    {0.05, 1e-3, 0.0, 5e-4, 0.0, 0.0, 7e-4, 5e-4, 0.05, 0.1},
+    {0.1, 1e-3, 0.0, 5e-4, 0.0, 0.0, 7e-4, 5e-4, 0.05, 0.1},
+    {0.2, 1e-3, 0.0, 5e-4, 0.0, 0.0, 7e-4, 5e-4, 0.025, 0.1},
+    {0.3, 1e-3, 0.0, 5e-4, 0.0, 0.0, 7e-4, 5e-4, 0.01667, 0.1},
+    {0.49, 1e-3, 0.0, 5e-4, 0.0, 0.0, 7e-4, 5e-4, 0.0102, 0.1},
+    {0.5, 1e-3, 0.0, 5e-4, 0.0, 0.0, 7e-4, 5e-4, 0.01, 0.01},
+    {1.0, 1e-3, 0.0, 5e-4, 0.0, 0.0, 7e-4, 5e-4, 0.005, 0.01},
 };
 
 const cd::SceneKind kDisks{2, false, false};
@@ -45,42 +45,30 @@ const cd::SceneKind kCohesiveSpheres{3, true, false};
 
 TEST(ShearPolicy, TheTableAtItsBreakpoints) {
   for (const Expected& e : kTable) {
-    // 2D disks and cohesive spheres: the band's stop for what runs, no
-    // projection.
-    for (const cd::SceneKind kind : {kDisks, kCohesiveSpheres}) {
+    for (const cd::SceneKind kind : {kDisks, kSpheres, kCohesiveSpheres}) {
       const cd::ShearSettings s = cd::shear_settings(e.I, cd::Acceleration::None, kind);
       EXPECT_EQ(s.tol, e.tol) << "I = " << e.I;
       EXPECT_EQ(s.residual_tol, e.residual_tol) << "I = " << e.I;
+      EXPECT_EQ(s.overlap_projection, 0.0) << "I = " << e.I;
       EXPECT_EQ(s.dt_tp, e.dt_tp) << "I = " << e.I;
       EXPECT_EQ(s.cell_mass, e.cell_mass) << "I = " << e.I;
-      EXPECT_EQ(s.overlap_projection, 0.0) << "I = " << e.I;
-      // An acceleration changes the tolerance only.
-      for (const auto& [acc, tol] : {std::pair{cd::Acceleration::Anderson, e.tol_anderson},
-                                     std::pair{cd::Acceleration::Subspace, e.tol_subspace}}) {
-        const cd::ShearSettings a = cd::shear_settings(e.I, acc, kind);
-        EXPECT_EQ(a.tol, tol) << "I = " << e.I;
-        EXPECT_EQ(a.residual_tol, s.residual_tol) << "I = " << e.I;
-        EXPECT_EQ(a.overlap_projection, 0.0) << "I = " << e.I;
-        EXPECT_EQ(a.dt_tp, s.dt_tp) << "I = " << e.I;
-        EXPECT_EQ(a.cell_mass, s.cell_mass) << "I = " << e.I;
+      // dt <= 0.005 t_p / I (to the 4 digits it is written with), <= 0.05 t_p.
+      EXPECT_LE(s.dt_tp, 0.005 / e.I * (1 + 5e-4)) << "I = " << e.I;
+      EXPECT_LE(s.dt_tp, 0.05) << "I = " << e.I;
+      // An acceleration changes the stop only.
+      const cd::ShearSettings a = cd::shear_settings(e.I, cd::Acceleration::Anderson, kind);
+      EXPECT_EQ(a.tol, kind.cohesive ? e.tol_cohesive : e.tol_anderson) << "I = " << e.I;
+      EXPECT_EQ(a.residual_tol, kind.cohesive ? e.residual_tol : e.residual_anderson) << "I = " << e.I;
+      EXPECT_EQ(a.overlap_projection, kind.cohesive ? 0.0 : e.projection_anderson) << "I = " << e.I;
+      const cd::ShearSettings m = cd::shear_settings(e.I, cd::Acceleration::Subspace, kind);
+      EXPECT_EQ(m.tol, e.tol_subspace) << "I = " << e.I;
+      EXPECT_EQ(m.residual_tol, e.residual_tol) << "I = " << e.I;
+      EXPECT_EQ(m.overlap_projection, 0.0) << "I = " << e.I;
+      for (const cd::ShearSettings& x : {a, m}) {
+        EXPECT_EQ(x.dt_tp, s.dt_tp) << "I = " << e.I;
+        EXPECT_EQ(x.cell_mass, s.cell_mass) << "I = " << e.I;
       }
     }
-    // dt <= 0.005 t_p / I (to the 4 digits it is written with), <= 0.05 t_p.
-    const cd::ShearSettings s = cd::shear_settings(e.I, cd::Acceleration::None, kSpheres);
-    EXPECT_LE(s.dt_tp, 0.005 / e.I * (1 + 5e-4)) << "I = " << e.I;
-    EXPECT_LE(s.dt_tp, 0.05) << "I = " << e.I;
-    // Cohesionless spheres: their own stop with their band's acceleration,
-    // the band's with the other one.
-    const cd::Acceleration own = s.subspace > 0 ? cd::Acceleration::Subspace : cd::Acceleration::Anderson;
-    const cd::ShearSettings o = cd::shear_settings(e.I, own, kSpheres);
-    EXPECT_EQ(o.tol, e.sphere_tol) << "I = " << e.I;
-    EXPECT_EQ(o.residual_tol, e.sphere_residual_tol) << "I = " << e.I;
-    EXPECT_EQ(o.overlap_projection, e.sphere_projection) << "I = " << e.I;
-    EXPECT_EQ(s.tol, e.tol) << "I = " << e.I;  // plain NLGS: the band's stop
-    const cd::Acceleration other = s.subspace > 0 ? cd::Acceleration::Anderson : cd::Acceleration::Subspace;
-    EXPECT_EQ(cd::shear_settings(e.I, other, kSpheres).tol,
-              other == cd::Acceleration::Anderson ? e.tol_anderson : e.tol_subspace)
-        << "I = " << e.I;
   }
 }
 
@@ -120,7 +108,7 @@ TEST(ShearPolicy, AutoKeysTakeThePolicysValueForTheScenesI) {
     const cd::Scene a =
         cd::parse_scene(kAutoScene, "a.toml", {"shear.inertial_number=" + I.str(), "solver.anderson=5"});
     EXPECT_EQ(a.tol, e.tol_anderson) << "I = " << e.I;
-    EXPECT_EQ(a.residual_tol, e.residual_tol) << "I = " << e.I;
+    EXPECT_EQ(a.residual_tol, e.residual_anderson) << "I = " << e.I;
   }
 }
 
@@ -142,9 +130,9 @@ TEST(ShearPolicy, AutoWithoutAnInertialNumberOrOnAnotherKeyIsRefused) {
   }
 }
 
-// "auto" for the overlap projection: on for the spheres' stop below
-// I = 0.01, off above and in 2D.
-TEST(ShearPolicy, AutoProjectionFollowsTheSpheresStop) {
+// "auto" for the overlap projection: with Anderson's stop below I = 0.01
+// (cohesionless), off elsewhere.
+TEST(ShearPolicy, AutoProjectionFollowsTheStop) {
   const std::string scene3 =
       "dimension = 3\ngravity.g = [0.0, 0.0, 0.0]\n[contact]\noverlap_projection = \"auto\"\n"
       "[solver]\ntol = \"auto\"\nresidual_tol = \"auto\"\nanderson = \"auto\"\nsubspace = \"auto\"\n"
@@ -160,10 +148,21 @@ TEST(ShearPolicy, AutoProjectionFollowsTheSpheresStop) {
   EXPECT_EQ(plain.overlap_projection, 0.0);
   EXPECT_EQ(plain.tol, 1e-4);
   EXPECT_EQ(plain.residual_tol, 3e-3);
+  // 2D: disks mix (and take it), polygons do not; a cohesive scene keeps
+  // the residual stop, without it.
   const std::string scene2 =
-      "[contact]\noverlap_projection = \"auto\"\n[solver]\nanderson = \"auto\"\n[shear]\nmode = \"periodic\"\n"
-      "pressure = 100.0\ninertial_number = 0.001\n";
-  EXPECT_EQ(cd::parse_scene(scene2, "b.toml").overlap_projection, 0.0);
+      "[contact]\noverlap_projection = \"auto\"\n[solver]\ntol = \"auto\"\nresidual_tol = \"auto\"\n"
+      "anderson = \"auto\"\n[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.001\n";
+  const cd::Scene disks = cd::parse_scene(scene2, "b.toml");
+  EXPECT_EQ(disks.overlap_projection, 0.5);
+  EXPECT_EQ(disks.tol, 3e-4);
+  EXPECT_EQ(disks.residual_tol, 0.0);
+  EXPECT_EQ(cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]"}).overlap_projection, 0.0);
+  const cd::Scene coh = cd::parse_scene(scene3, "a.toml", {"shear.inertial_number=0.001", "contact.cohesion_number=10"});
+  EXPECT_EQ(coh.anderson, 5);
+  EXPECT_EQ(coh.overlap_projection, 0.0);
+  EXPECT_EQ(coh.tol, 1e-4);
+  EXPECT_EQ(coh.residual_tol, 3e-3);
 }
 
 // "auto" for the acceleration: the band's choice, resolved before the

@@ -17,13 +17,8 @@ ShearSettings shear_settings(double I, Acceleration acc, SceneKind kind) {
   const bool spheres = kind.dimension == 3 && !kind.cohesive;
   const int anderson = kind.dimension == 2 ? (kind.polygons ? 0 : kAnderson) : kind.cohesive ? kAnderson : b->auto_anderson;
   const int subspace = spheres ? b->auto_subspace : 0;
-  // The spheres' own stop when they run the band's acceleration.
-  const bool own = spheres && (acc == Acceleration::Subspace ? b->auto_subspace > 0
-                               : acc == Acceleration::Anderson ? b->auto_subspace == 0 && b->auto_anderson > 0
-                                                               : false);
-  const Stop& stop = own ? b->spheres
-                     : acc == Acceleration::Subspace ? b->subspace
-                     : acc == Acceleration::Anderson ? b->anderson
+  const Stop& stop = acc == Acceleration::Subspace ? b->subspace
+                     : acc == Acceleration::Anderson ? (kind.cohesive ? b->cohesive : b->anderson)
                                                      : b->plain;
   return {stop.tol, stop.residual_tol, stop.overlap_projection, dt_tp, b->cell_mass, anderson, subspace};
 }
