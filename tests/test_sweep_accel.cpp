@@ -202,3 +202,71 @@ TEST(SweepSubspace, ResultsDoNotDependOnThreads) {
   EXPECT_EQ(one.last().solve.iterations, two.last().solve.iterations);
   for (std::size_t k = 0; k < one.rows().size(); ++k) ASSERT_EQ(one.rows()[k].r, two.rows()[k].r) << "row " << k;
 }
+
+namespace {
+
+// The 3D rows with the exact |p| of each row summed by the sweep itself
+// (kNormBound off): the plain sum the lazy one must reproduce.
+struct ExactNormCoupling : sweep::BodyCoupling3 {
+  static constexpr bool kNormBound = false;
+  template <class L, bool Write1>
+  void update(SweepRow3& r, double& dp2, double& pabs) const {
+    BodyCoupling3::update<L, Write1>(r, dp2, pabs);
+    pabs = impulse_norm(r);
+  }
+};
+
+// The step's problem solved by core/sweep.hpp through coupling C.
+template <class C>
+std::pair<SolveStats, std::vector<Vec3>> solve_with(const ContactProblem3& q, const SolverParams& prm) {
+  ContactProblem3 p = q;
+  std::vector<SweepRow3> rows(p.rows.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) EXPECT_TRUE(make_sweep_row3(p.rows[k], p.vel.data(), rows[k]));
+  RowExtra3* extra = p.extra.empty() ? nullptr : p.extra.data();
+  for (CellDof3& d : p.dofs) d.extra = extra;
+  const SolveStats st = std::visit(
+      [&](auto law) {
+        using L = decltype(law);
+        C c;
+        c.vel = p.vel.data();
+        c.extra = extra;
+        c.base = rows.data();
+        c.nbodies = static_cast<int>(p.vel.size());
+        return sweep::solve<L>(rows, p.colouring, c, prm, p.dofs.empty() ? nullptr : &p.dofs, {});
+      },
+      p.law);
+  std::vector<Vec3> r;
+  for (const SweepRow3& x : rows) r.push_back(x.r);
+  return {st, r};
+}
+
+}  // namespace
+
+// The sweep sums the rows' exact |p| only when the stop may come (a bound of
+// it leaves the test open otherwise: core/sweep.hpp, kNormBound): the stop,
+// the sweep count and every impulse are those of the exact sum taken on
+// every sweep, bit for bit, through a slow plain tail (tol 1e-5), Anderson's
+// mixing and the subspace correction (each resets the bound).
+TEST(SweepStop, TheLazyNormStopsWhereTheExactOneDoes) {
+  World3 w = sheared();
+  ContactProblem3 frozen;
+  w.set_problem_hook([&](const ContactProblem3& p, const SolverParams&) { frozen = p; });
+  w.step();
+  ASSERT_GT(frozen.rows.size(), 500u);
+  for (const auto& [tol, anderson, subspace] : {std::tuple{1e-5, 0, 0}, {3e-4, 5, 0}, {7e-4, 0, 10}}) {
+    SolverParams prm = w.params().solver;
+    prm.tol = tol;
+    prm.max_iter = 20000;
+    prm.residual_tol = 0.0;
+    prm.anderson = anderson;
+    prm.subspace = subspace;
+    const auto [lazy, rl] = solve_with<sweep::BodyCoupling3>(frozen, prm);
+    const auto [exact, re] = solve_with<ExactNormCoupling>(frozen, prm);
+    EXPECT_FALSE(lazy.cap_hit) << tol;
+    EXPECT_EQ(lazy.iterations, exact.iterations) << tol;
+    EXPECT_EQ(lazy.dp_rel, exact.dp_rel) << tol;
+    EXPECT_EQ(lazy.p_mean, exact.p_mean) << tol;
+    ASSERT_EQ(rl.size(), re.size());
+    for (std::size_t k = 0; k < rl.size(); ++k) ASSERT_EQ(rl[k], re[k]) << "tol " << tol << ", row " << k;
+  }
+}
