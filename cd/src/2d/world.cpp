@@ -162,6 +162,7 @@ void World::colour() {
 void World::solve() {
   if (gravity_on_ || forces_on_) external();
   apply_impulses(prob_.rows, bodies.vel, prm_.rotation);
+  last_.floor_held = false;  // make_dof sets it
   std::visit([&](const auto& b) { b.set_dofs(*this); }, boundary_);
   solve_problem(prm_.solver, [](ContactProblem& p, const SolverParams& s) { return nlgs_solve(p, s); });
   std::visit([&](const auto& b) { b.take_dofs(*this); }, boundary_);
@@ -282,11 +283,12 @@ void World::project_overlaps() {
   last_.projection_work = work;
 }
 
-BoundaryDof World::make_dof(double v_start, double load, double length, double v_floor) const {
+BoundaryDof World::make_dof(double v_start, double load, double length, double v_floor) {
   const double dt = prm_.dt, M = prm_.cell.mass;
   BoundaryDof d;
   d.inv_mass = 1.0 / M;
   d.v0 = cell_dof::free_velocity(v_start, load, M, dt, v_floor);
+  if (cell_dof::load_past_floor(v_start, load, M, dt, v_floor, approach_)) last_.floor_held = true;
   d.v = d.v0;
   d.scale = dt * prm_.cell.pressure * length;  // the imposed impulse, unit of its convergence test
   return d;

@@ -163,8 +163,9 @@ class World : public WorldShell<Bodies, ContactProblem, ContactInfo, std::pair<d
   // A boundary dof of mass cell.mass loaded by `load` (imposed stress x
   // length), at velocity v_start at the step's start; coupling row k to it.
   // v_floor: a lower bound of the dof's free velocity (max_strain_rate).
+  // Sets last_.floor_held if the approach floor held the free velocity.
   BoundaryDof make_dof(double v_start, double load, double length,
-                       double v_floor = -std::numeric_limits<double>::infinity()) const;
+                       double v_floor = -std::numeric_limits<double>::infinity());
   void project_overlaps();
   void couple_dof(BoundaryDof& d, std::size_t k, double an, double at, double v_start);
 

@@ -199,6 +199,7 @@ void World3::solve() {
   auto& V = bodies.vel;
   // The kinetic stress the imposed one balances, from the velocities at
   // the step's start (before gravity and the warm start).
+  last_.floor_held = false;
   if (dofs_on_) set_dofs(kinetic_stress());
   if (gravity_on_) {
     const Vec3 dv = prm_.dt * prm_.gravity;
@@ -230,8 +231,10 @@ void World3::set_dofs(const Eigen::Matrix3d& K) {
     d.axis = a;
     d.inv_mass = 1.0 / M;
     const double area = V / cm_[a], v_start = cell_.rate[a];
-    d.v0 = cell_dof::free_velocity(v_start, (prm_.pressure - K(a, a)) * area, M, dt,
-                                   cell_dof::floor(prm_.max_strain_rate, cm_[a], prm_.alert, dt));
+    const double load = (prm_.pressure - K(a, a)) * area;
+    const double v_floor = cell_dof::floor(prm_.max_strain_rate, cm_[a], prm_.alert, dt);
+    d.v0 = cell_dof::free_velocity(v_start, load, M, dt, v_floor);
+    if (cell_dof::load_past_floor(v_start, load, M, dt, v_floor, prm_.alert)) last_.floor_held = true;
     d.v = d.v0;
     d.scale = dt * prm_.pressure * area;
     d.extra = extras_on_ ? prob_.extra.data() : nullptr;

@@ -43,6 +43,24 @@ inline double free_velocity(double v_start, double load, double M, double dt, do
   return std::max(v_start - dt * load / M, v_floor);
 }
 
+// Whether the approach floor held that free velocity where the load cannot
+// be applied at all: the step's load alone asks the length to shrink faster
+// than the floor allows (dt load / M > alert / (4 dt): even from rest it
+// would be clipped), the length's velocity at the step's start did not keep
+// it above the floor, and v_floor is the approach floor, not the compaction
+// brake (floor()'s -rate L, a rate the scene chose). On such a step the
+// length brings the impulse M (v_start - v_floor) instead of dt times its
+// load; in steady state that is every step, and the stress the contacts
+// carry is M |v_floor| / (dt A), not the imposed one (summary.toml's
+// floor_steps counts these steps). A collapse from a loose start, held at
+// the floor by the speed it gathered over many steps of a smaller load
+// each (the floor's purpose: a speed limit), is not counted.
+// Reporting only: free_velocity is unchanged.
+inline bool load_past_floor(double v_start, double load, double M, double dt, double v_floor, double alert) {
+  const double dv = dt * load / M;
+  return -dv < v_floor && v_start - dv < v_floor && v_floor == approach_floor(alert, dt);
+}
+
 // One update of a dof between sweeps. s = sum of its coefficients times
 // the rows' impulses (the impulse the contacts put on the length), k = the
 // active rows' local response sum a^2 / W (per component). The sweep runs

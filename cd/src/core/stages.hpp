@@ -35,6 +35,11 @@ struct StepStats {
   double max_overlap_small = 0;  // max over contacts of -gap / (the smaller grain's diameter)
   double correction_work = 0;  // sum of p_n x bias velocity of the overlap correction (J)
   double projection_work = 0;  // overlap projection: sum of f_n x the separation it added (J)
+  // A pressure-driven length's free velocity was held at the approach floor
+  // by a load the floor does not let through even from rest
+  // (core/cell_dof.hpp, load_past_floor): the imposed stress was not fully
+  // applied on this step. Always false without such a length.
+  bool floor_held = false;
 };
 
 // The stages of a world's step W, in order, each a member function.
