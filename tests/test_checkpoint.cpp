@@ -147,7 +147,7 @@ TEST(Checkpoint, DamagedFilesAreNamedAndLeaveTheWorldUnchanged) {
   EXPECT_EQ(x.steps, 0);
 
   // The totals round-trip.
-  cd::RunTotals in{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9};
+  cd::RunTotals in{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9, 10};
   cd::save_checkpoint(f.string(), w, 1, in);
   cd::RunTotals out;
   cd::load_checkpoint(f.string(), x, &out);
@@ -157,48 +157,72 @@ TEST(Checkpoint, DamagedFilesAreNamedAndLeaveTheWorldUnchanged) {
 
 // A checkpoint of the build before the accelerations' counts holds nine
 // totals under their own name (same format version 5). It resumes: the
-// state and the nine as stored, the three counts at 0 (from then on they
-// count the sessions since the resume).
+// state and the nine as stored, the four counts after them at 0 (from then
+// on they count the sessions since the resume).
 TEST(Checkpoint, NineTotalsOfTheEarlierBuildResumeWithTheCountsAtZero) {
   cd::World w = pile();
   for (int k = 0; k < 5; ++k) w.step();
   const fs::path f = temp_dir("nine") / "checkpoint.bin";
-  cd::save_checkpoint(f.string(), w, 1, cd::RunTotals{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9});
+  cd::save_checkpoint(f.string(), w, 1, cd::RunTotals{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9, 10});
   spit(f, cdtest::with_totals(slurp(f), cdtest::kTotals9, {1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2}));
   cd::World x = pile();
-  cd::RunTotals t{0, 0, 0, 0, 0, 0, 0, 0, 0, 11, 12, 13};
+  cd::RunTotals t{0, 0, 0, 0, 0, 0, 0, 0, 0, 11, 12, 13, 14};
   EXPECT_EQ(cd::load_checkpoint(f.string(), x, &t), 1u);
   EXPECT_EQ(x.steps, 5);
   EXPECT_EQ(cdtest::state_hash(x), cdtest::state_hash(w));
-  const cd::RunTotals want{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 0, 0, 0};
+  const cd::RunTotals want{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 0, 0, 0, 0};
   EXPECT_EQ(std::memcmp(&t, &want, sizeof t), 0)
       << t.wall << " " << t.sessions << " " << t.cg_iterations << " " << t.anderson_off_steps << " "
-      << t.subspace_off_steps;
+      << t.subspace_off_steps << " " << t.floor_steps;
+}
+
+// A checkpoint of the build before floor_steps holds twelve totals under
+// their own name (same format version 5). It resumes: the state and the
+// twelve as stored, floor_steps at 0 (from then on it counts the sessions
+// since the resume).
+TEST(Checkpoint, TwelveTotalsOfTheEarlierBuildResumeWithTheFloorCountAtZero) {
+  cd::World w = pile();
+  for (int k = 0; k < 5; ++k) w.step();
+  const fs::path f = temp_dir("twelve") / "checkpoint.bin";
+  cd::save_checkpoint(f.string(), w, 1, cd::RunTotals{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9, 10});
+  spit(f, cdtest::with_totals(slurp(f), cdtest::kTotals12, {1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9}));
+  cd::World x = pile();
+  cd::RunTotals t{0, 0, 0, 0, 0, 0, 0, 0, 0, 11, 12, 13, 14};
+  EXPECT_EQ(cd::load_checkpoint(f.string(), x, &t), 1u);
+  EXPECT_EQ(x.steps, 5);
+  EXPECT_EQ(cdtest::state_hash(x), cdtest::state_hash(w));
+  const cd::RunTotals want{1.5, 2.5, 300, 40, 5, 1e-3, 2e-4, 3e-3, 2, 700, 8, 9, 0};
+  EXPECT_EQ(std::memcmp(&t, &want, sizeof t), 0)
+      << t.wall << " " << t.sessions << " " << t.cg_iterations << " " << t.subspace_off_steps << " "
+      << t.floor_steps;
 }
 
 // Totals under any other name (another build's fields, or one more) are
 // refused naming the file, the world and the caller's totals untouched; so
-// are the nine-field name over twelve values, and a totals array missing.
+// are a name over another count of values (the nine-field name over twelve,
+// ...), and a totals array missing.
 TEST(Checkpoint, OtherTotalsAreRefusedNamingTheFile) {
   cd::World w = pile();
   for (int k = 0; k < 5; ++k) w.step();
   const fs::path f = temp_dir("other_totals") / "checkpoint.bin";
   cd::save_checkpoint(f.string(), w, 1);
   const std::string good = slurp(f);
-  const std::vector<double> nine(9, 1.0), twelve(12, 1.0);
-  std::string renamed = cdtest::kTotals12;
+  const std::vector<double> nine(9, 1.0), twelve(12, 1.0), thirteen(13, 1.0);
+  std::string renamed = cdtest::kTotals13;
   renamed.replace(renamed.find("cg_iterations"), 13, "cg_iters");
   const struct {
     std::string name;
     std::vector<double> values;
     std::string what;
   } cases[] = {
-      {renamed, twelve, "holds run totals named '" + renamed + "'; this build reads '" + cdtest::kTotals12 + "'"},
-      {cdtest::kTotals12 + ":sweeps_cg", std::vector<double>(13, 1.0), "holds run totals named"},
+      {renamed, thirteen, "holds run totals named '" + renamed + "'; this build reads '" + cdtest::kTotals13 + "'"},
+      {cdtest::kTotals13 + ":sweeps_cg", std::vector<double>(14, 1.0), "holds run totals named"},
+      {cdtest::kTotals12 + ":floor", thirteen, "holds run totals named"},
       {"totals:wall:cpu", {1.0, 1.0}, "holds run totals named 'totals:wall:cpu'"},
       {cdtest::kTotals9, twelve, "is corrupt: 'totals' holds 12 run totals where its name lists 9"},
-      {cdtest::kTotals12, nine, "is corrupt: 'totals' holds 9 run totals where its name lists 12"},
-      {"cell", twelve, "where 'totals:wall:cpu:sweeps:sweeps_max"},
+      {cdtest::kTotals12, thirteen, "is corrupt: 'totals' holds 13 run totals where its name lists 12"},
+      {cdtest::kTotals13, twelve, "is corrupt: 'totals' holds 12 run totals where its name lists 13"},
+      {"cell", thirteen, "where 'totals:wall:cpu:sweeps:sweeps_max"},
   };
   cd::World x = pile();
   const std::uint64_t h = cdtest::state_hash(x);

@@ -24,7 +24,8 @@ constexpr std::string_view kMagic = "CDLABCKP";
 constexpr const char* kTotalsNames[] = {"wall",          "cpu",           "sweeps",
                                         "sweeps_max",    "cap_steps",     "residual_max",
                                         "residual_last", "overlap_max",   "sessions",
-                                        "cg_iterations", "anderson_off_steps", "subspace_off_steps"};
+                                        "cg_iterations", "anderson_off_steps", "subspace_off_steps",
+                                        "floor_steps"};
 static_assert(sizeof(RunTotals) == std::size(kTotalsNames) * sizeof(double),
               "a RunTotals field is missing from kTotalsNames (checkpoint_io.cpp)");
 std::string totals_name() {
@@ -33,14 +34,21 @@ std::string totals_name() {
   return s;
 }
 
-// The totals of the builds before the accelerations' counts (same version
-// 5): RunTotals' first nine fields, under this name. Such a checkpoint
-// resumes with the later fields at 0. The name is spelled out, as those
-// files hold it; the assertion keeps the nine the first of kTotalsNames,
-// in order, so that the nine values land in the fields they were.
-constexpr std::size_t kTotals9 = 9;
-constexpr std::string_view kTotals9Name =
-    "totals:wall:cpu:sweeps:sweeps_max:cap_steps:residual_max:residual_last:overlap_max:sessions";
+// The totals of earlier builds (same version 5), under the names those
+// files hold, spelled out: RunTotals' first nine fields (before the
+// accelerations' counts) and its first twelve (before floor_steps). Such a
+// checkpoint resumes with the later fields at 0. The assertions keep each a
+// prefix of kTotalsNames, in order, so that the values land in the fields
+// they were.
+struct OlderTotals {
+  std::size_t n;
+  std::string_view name;
+};
+constexpr OlderTotals kOlderTotals[] = {
+    {9, "totals:wall:cpu:sweeps:sweeps_max:cap_steps:residual_max:residual_last:overlap_max:sessions"},
+    {12, "totals:wall:cpu:sweeps:sweeps_max:cap_steps:residual_max:residual_last:overlap_max:sessions:"
+         "cg_iterations:anderson_off_steps:subspace_off_steps"},
+};
 constexpr bool totals_begin_with(std::string_view name, std::size_t n) {
   if (!name.starts_with("totals")) return false;
   name.remove_prefix(6);
@@ -51,8 +59,11 @@ constexpr bool totals_begin_with(std::string_view name, std::size_t n) {
   }
   return name.empty();
 }
-static_assert(totals_begin_with(kTotals9Name, kTotals9),
+static_assert(totals_begin_with(kOlderTotals[0].name, kOlderTotals[0].n),
               "kTotalsNames must begin with the nine totals older checkpoints hold, in their order");
+static_assert(totals_begin_with(kOlderTotals[1].name, kOlderTotals[1].n),
+              "kTotalsNames must begin with the twelve totals older checkpoints hold, in their order");
+static_assert(kOlderTotals[1].n < std::size(kTotalsNames), "an older build's totals are fewer than this one's");
 
 // The name of the timers' array: the stage names, so that a checkpoint
 // from a build with another stage table is refused by name.
@@ -140,20 +151,27 @@ Header open(const std::string& path, std::string& data, Reader& in, int dimensio
 RunTotals close(Reader& in, const Header& h) {
   RunTotals tot;
   if (h.version >= 4) {
-    // This build's totals, or the nine of a checkpoint written before the
-    // accelerations' counts (version 4 files too): the counts then start at
-    // 0 and cover the sessions from this resume on. Any other totals are
-    // another build's: refused, as their sum could not go on.
+    // This build's totals, or those of an earlier build (kOlderTotals: the
+    // nine written before the accelerations' counts, version 4 files too,
+    // or the twelve written before floor_steps): the later fields then
+    // start at 0 and cover the sessions from this resume on. Any other
+    // totals are another build's: refused, as their sum could not go on.
     const std::string name = totals_name();
     const std::string_view stored = in.next_name("the run totals");
-    const bool nine = stored == kTotals9Name;
-    if (!nine && stored != name && stored.starts_with("totals"))
-      in.fail(fmt::format("holds run totals named '{}'; this build reads '{}' (or the first nine of "
-                          "them, as written before the acceleration counts): written by another build?",
+    std::size_t n = std::size(kTotalsNames);
+    std::string_view read = name;
+    for (const OlderTotals& o : kOlderTotals)
+      if (stored == o.name) {
+        n = o.n;
+        read = o.name;
+      }
+    if (read == std::string_view(name) && stored != read && stored.starts_with("totals"))
+      in.fail(fmt::format("holds run totals named '{}'; this build reads '{}' (or the first nine or twelve "
+                          "of them, as written before the acceleration counts or before floor_steps): "
+                          "written by another build?",
                           stored.substr(0, 300), name));
-    const std::size_t n = nine ? kTotals9 : std::size(kTotalsNames);
     std::vector<double> t;
-    in.array(nine ? kTotals9Name : std::string_view(name), t);
+    in.array(read, t);
     if (t.size() != n)
       in.fail(fmt::format("is corrupt: 'totals' holds {} run totals where its name lists {}", t.size(), n));
     for (std::size_t k = 0; k < t.size(); ++k) in.non_negative("totals", k, kTotalsNames[k], t[k]);

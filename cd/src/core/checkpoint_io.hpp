@@ -14,8 +14,9 @@
 //     other stages refuses the file); then the engine's arrays (its bodies,
 //     warm start, ...); then the run's totals (one f64 per RunTotals field,
 //     in an array named "totals:" + the field names joined by ':'; a file
-//     whose totals hold the first nine fields only, written before the
-//     accelerations' counts, is read with the others at 0)
+//     whose totals hold the first nine fields only (written before the
+//     accelerations' counts) or the first twelve (before floor_steps) is
+//     read with the others at 0)
 //   u64 FNV-1a of every byte before it
 // A reader checks every size against the file and the checksum, and names the
 // file in any error.
@@ -61,6 +62,11 @@ struct RunTotals {
   double cg_iterations = 0;       // conjugate-gradient iterations of the subspace corrections, all steps
   double anderson_off_steps = 0;  // steps whose Anderson mixing stalled and went off
   double subspace_off_steps = 0;  // steps whose subspace corrections stalled and stopped
+  // Steps on which a pressure-driven length was held at its approach floor
+  // by a load past it (StepStats::floor_held): the imposed pressure was not
+  // fully applied on them. A checkpoint written before it was counted (the nine or the twelve
+  // fields above) resumes with it at 0.
+  double floor_steps = 0;
 };
 
 // 64-bit FNV-1a (the checksum; also used for the scene key).
