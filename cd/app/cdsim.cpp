@@ -139,6 +139,17 @@ int main(int argc, char** argv) {
       fmt::print("cdsim: subspace corrections: {:.1f} CG iterations a step; stalled and stopped on {} steps ({:.1f} % of steps)\n",
                  s.steps ? double(s.subspace_iterations) / double(s.steps) : 0.0, s.subspace_off,
                  s.steps ? 100.0 * double(s.subspace_off) / double(s.steps) : 0.0);
+    // A pressure-driven length held at its approach floor (a quarter of the
+    // alert distance a step) by a load the floor does not let through even
+    // from rest (core/cell_dof.hpp, load_past_floor) brings less than the
+    // imposed pressure's impulse: on such steps the pressure is not applied,
+    // and a run held so on more than 1 % of its steps measures at another
+    // pressure. (A collapse from a loose start, held at the floor by the
+    // speed it gathered, is the floor's purpose and is not counted.)
+    const double floor_share = s.steps ? double(s.floor_steps) / double(s.steps) : 0.0;
+    if (s.floor_steps > 0)
+      fmt::print("cdsim: the cell's compaction was held at its floor on {} steps ({:.1f} % of steps)\n",
+                 s.floor_steps, 100.0 * floor_share);
     fmt::print("cdsim: outputs in {}/ (the run's cost: summary.toml)\n", out);
     // Over the whole run (every session), as summary.toml says.
     if (s.cap_share() > 0.01)
@@ -157,6 +168,12 @@ int main(int argc, char** argv) {
                  "diameter (> {}): see the series' max_overlap_small column; a smaller time step "
                  "or tolerance reduces it\n",
                  s.max_overlap_small, kOverlapWarn);
+    if (floor_share > 0.01)
+      fmt::print(stderr,
+                 "cdsim: warning: the cell's compaction was held at its floor on {:.1f} % of the steps (a "
+                 "length may shrink by at most a quarter of contact.alert a step): the imposed pressure was "
+                 "not fully applied on them; raise contact.alert or shear.cell_mass\n",
+                 100.0 * floor_share);
     const bool checkpoints = scene.checkpoint_interval > 0 || scene.checkpoint_strain > 0 ||
                              scene.checkpoint_wall > 0 || s.first_step > 0;
     if (s.settled)

@@ -160,6 +160,9 @@ std::string summary_toml(const RunSummary& s) {
   o += line("residual_final = " + toml_float(t.residual_last), "law residual of the last step");
   o += line("residual_max = " + toml_float(t.residual_max), "largest law residual of any step");
   o += line("overlap_max = " + toml_float(t.overlap_max), "largest overlap, in mean diameters");
+  o += line(fmt::format("floor_steps = {}", std::llround(t.floor_steps)),
+            "steps on which the cell's compaction was held at its floor (a quarter of contact.alert a "
+            "step): the imposed pressure was not fully applied on them");
   return o;
 }
 
@@ -364,6 +367,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     sum.anderson_off += st.solve.anderson_off > 0;
     sum.subspace_off += st.solve.subspace_off > 0;
     sum.subspace_iterations += st.solve.subspace_iterations;
+    sum.floor_steps += st.floor_held;
     sum.max_residual = std::max(sum.max_residual, st.solve.residual_max);
     sum.max_overlap = std::max(sum.max_overlap, st.max_overlap);
     sum.max_overlap_small = std::max(sum.max_overlap_small, st.max_overlap_small);
@@ -376,6 +380,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     tot.cg_iterations += st.solve.subspace_iterations;
     tot.anderson_off_steps += st.solve.anderson_off > 0;
     tot.subspace_off_steps += st.solve.subspace_off > 0;
+    tot.floor_steps += st.floor_held;
 
     if (row_due || stopping) {
       timed_output([&] {

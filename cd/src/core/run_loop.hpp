@@ -66,6 +66,10 @@ struct RunSummary {
   std::int64_t anderson_off = 0;  // steps whose Anderson mixing stalled and went off (SolveStats::anderson_off)
   std::int64_t subspace_off = 0;  // steps whose subspace corrections stalled and stopped (SolveStats::subspace_off)
   std::int64_t subspace_iterations = 0;  // conjugate-gradient iterations of the subspace corrections, all steps
+  // Steps on which a pressure-driven length was held at its approach floor
+  // by a load past it (StepStats::floor_held): the imposed pressure not
+  // fully applied on them.
+  std::int64_t floor_steps = 0;
   double max_residual = 0;
   double max_overlap = 0;        // largest overlap / mean diameter
   double max_overlap_small = 0;  // largest overlap / the smaller grain's diameter
