@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
     if (scene.anderson > 0)  // how often the mixing stalled and the solve went on as plain NLGS
       fmt::print("cdsim: Anderson's mixing stalled and went off on {} steps ({:.1f} % of steps)\n", s.anderson_off,
                  s.steps ? 100.0 * double(s.anderson_off) / double(s.steps) : 0.0);
-    if (scene.subspace > 0)  // the corrections' cost, in CG iterations (each about one sweep's memory traffic)
+    if (scene.subspace > 0)  // the corrections' cost, in CG iterations (each about half a sweep's cost)
       fmt::print("cdsim: subspace corrections: {:.1f} CG iterations a step; stalled and stopped on {} steps ({:.1f} % of steps)\n",
                  s.steps ? double(s.subspace_iterations) / double(s.steps) : 0.0, s.subspace_off,
                  s.steps ? 100.0 * double(s.subspace_off) / double(s.steps) : 0.0);
