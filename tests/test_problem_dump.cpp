@@ -161,6 +161,40 @@ TEST(ProblemDump, CdsimDumpsAndCdproblemReplaysTheSameImpulses) {
   EXPECT_NE(bad.code, 0) << bad.out;
 }
 
+// A dump that cannot be written is a write failure (exit 4, "could not
+// write" naming the option and the file), not a divergence: the .cdp is
+// written inside the step, before its solve, whose errors the run loop
+// reports as a diverged run (exit 3), as it did this one; the .impulses,
+// after the step, was already exit 4, and now names the option too. A
+// folder in the dump's place makes the write fail, as root too
+// (permissions would not); the run resumes from its checkpoint once the
+// place is free.
+TEST(ProblemDump, ADumpThatCannotBeWrittenIsAWriteFailure) {
+  const auto dir = cdtest::scratch_dir("problem_dump", "unwritable");
+  const std::string cdsim = std::string(CDLAB_BINARY_DIR) + "/cd/cdsim " + CDLAB_SOURCE_DIR +
+                            "/configs/default.toml --set particles.n=150 --set box.width=0.012 "
+                            "--set box.height=0.03 --set time.duration=0.02 --set output.snapshot_interval=0 "
+                            "--set output.checkpoint_interval=0.005 -q --threads 1 --out " + dir.string();
+  cdtest::CmdResult r = cdtest::run_command(cdsim + " --max-steps 40");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* f : {"problem_60.cdp", "problem_60.impulses"}) {
+    SCOPED_TRACE(f);
+    std::filesystem::create_directories(dir / f / "x");
+    r = cdtest::run_command(cdsim + " --dump-problem 60");
+    EXPECT_EQ(r.code, 4) << r.out;
+    EXPECT_NE(r.out.find("cdsim: --dump-problem 60: could not write '" + (dir / f).string() + "'"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("diverged"), std::string::npos) << r.out;
+    std::filesystem::remove_all(dir / f);
+  }
+  r = cdtest::run_command(cdsim + " --dump-problem 60");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("resumed from"), std::string::npos) << r.out;
+  for (const char* f : {"problem_60.cdp", "problem_60.dat", "problem_60.impulses"})
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / f)) << f;
+}
+
 TEST(ProblemDump, MalformedFilesAreClearErrors) {
   const Captured c = capture("default.toml",
                              {"particles.n=150", "box.width=0.012", "box.height=0.03"}, 20);

@@ -187,6 +187,39 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
   EXPECT_LT(cd::siconos_error(f.problem, f.r_ref), 1e-4);
 }
 
+// A dump that cannot be written is a write failure (exit 4, "could not
+// write" naming the option and the file): the .cdp3, written inside the
+// step, was reported as a diverged run (exit 3); the FCLib file, after it,
+// whose rename into place fails here, was already exit 4 and now names the
+// option too. A folder in the file's place makes the write fail, as root
+// too; the run resumes from its checkpoint once it is free. (FCLib failing
+// to write its temporary file, now a write failure too, was bad input, exit
+// 2; no test makes HDF5 fail short of filling the disk.)
+TEST(ProblemDump3, ADumpThatCannotBeWrittenIsAWriteFailure) {
+  const fs::path dir = cdtest::scratch_dir("problem_dump3", "unwritable");
+  const std::string cdsim = kCdsim + " " + kConfigs + "pile3d.toml --set particles.n=64 --set time.duration=0.04 "
+                            "--set output.snapshot_interval=0 --set output.checkpoint_interval=0.01 --quiet "
+                            "--threads 1 --out " + dir.string();
+  auto r = cdtest::run_command(cdsim + " --max-steps 10");
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* f : {"problem_20.cdp3", "problem_20.hdf5"}) {
+    SCOPED_TRACE(f);
+    fs::create_directories(dir / f / "x");
+    r = cdtest::run_command(cdsim + " --dump-problem 20");
+    EXPECT_EQ(r.code, 4) << r.out;
+    EXPECT_NE(r.out.find("cdsim: --dump-problem 20: could not write '" + (dir / f).string() + "'"), std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("diverged"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("error:"), std::string::npos) << r.out;
+    fs::remove_all(dir / f);
+  }
+  r = cdtest::run_command(cdsim + " --dump-problem 20");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("resumed from"), std::string::npos) << r.out;
+  for (const char* f : {"problem_20.cdp3", "problem_20.hdf5", "problem_20.impulses"})
+    EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
+}
+
 // The laws FCLib cannot hold replay exactly through the .cdp3 text, and
 // the FCLib file is not written for them (to_matrix refuses cohesion,
 // write_fclib an orthotropic cone).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -78,16 +79,22 @@ class Engine2 final : public RunEngine {
       : w_(w), s_(s), dir_(opt.out), dump_(opt.dump_steps), shear_(s.shear_mode != ShearMode::None),
         d_mean_(mean_diameter(s)) {
     // --dump-problem: the hook sees the problem of the step being taken
-    // (w.steps + 1) just before its solve.
+    // (w.steps + 1) just before its solve. Each file is written whole under
+    // a temporary name and renamed (a failure is a WriteError naming it).
     if (!dump_.empty())
       w_.set_problem_hook([this](const ContactProblem& p, const SolverParams& prm) {
         const std::int64_t k = w_.steps + 1;
         if (!dumped(k)) return;
         const std::string stem = (dir_ / fmt::format("problem_{}", k)).string();
-        write_contact_problem(p, prm, stem + ".cdp");
+        std::ostringstream cdp;
+        write_contact_problem(p, prm, cdp);
+        write_file_atomic(stem + ".cdp", cdp.str());
         const bool cohesive = std::any_of(p.rows.begin(), p.rows.end(),
                                           [](const ContactRow& r) { return r.adh != 0.0; });
-        if (!cohesive) write_problem(to_matrix(p), stem + ".dat");
+        if (cohesive) return;
+        std::ostringstream dat;
+        write_problem(to_matrix(p), dat);
+        write_file_atomic(stem + ".dat", dat.str());
       });
   }
 

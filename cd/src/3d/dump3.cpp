@@ -51,11 +51,17 @@ void ProblemDump3::after_step(std::int64_t k) {
   for (std::size_t i = 0; i < rows.size(); ++i) r.segment<3>(3 * i) = rows[i].r;
   const Eigen::VectorXd guess = Eigen::Map<const Eigen::VectorXd>(guess_.data(), guess_.size());
   const std::string path = (dir_ / fmt::format("problem_{}.hdf5", k)).string(), tmp = tmp_name(path);
-  write_fclib(*matrix_, tmp, fmt::format("cdlab step {}", k),
-              fmt::format("cdsim --dump-problem {}: a 3D step's contact problem, u = W r + q, W = H^T M^-1 H; "
-                          "solution: the step's impulses; guess: its warm start",
-                          k),
-              &r, &guess);
+  try {
+    write_fclib(*matrix_, tmp, fmt::format("cdlab step {}", k),
+                fmt::format("cdsim --dump-problem {}: a 3D step's contact problem, u = W r + q, W = H^T M^-1 H; "
+                            "solution: the step's impulses; guess: its warm start",
+                            k),
+                &r, &guess);
+  } catch (const std::runtime_error& e) {  // FCLib (HDF5) could not write it: a write failure
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw WriteError(fmt::format("could not write '{}': {}", path, e.what()));
+  }
   rename_into_place(tmp, path);
   matrix_.reset();
 }

@@ -302,6 +302,13 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     return RunDiverged(msg);
   };
 
+  // A --dump-problem file that could not be written (a WriteError from the
+  // engine's step or after_step): that failure, naming the option and the
+  // step (cdsim exits 4).
+  const auto dump_failed = [&](std::int64_t k, const WriteError& e) {
+    return WriteError(fmt::format("--dump-problem {}: {}", k, e.what()));
+  };
+
   auto timed_output = [&](auto&& f) {
     const auto t = Clock::now();
     f();
@@ -322,6 +329,12 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     if (dumped(k)) still_ours();  // the step writes its problem before its solve
     try {
       w.step();
+    } catch (const FolderGone&) {
+      throw;
+    } catch (const WriteError& e) {
+      // Inside a step, only --dump-problem writes (its hook, before the
+      // solve): a write that failed, not a state that went bad.
+      throw dump_failed(k, e);
     } catch (const std::runtime_error& e) {
       // A step that cannot go on (e.g. a periodic cell shrunk below what
       // detection needs): the run stops as a diverged one, its outputs kept.
@@ -359,7 +372,13 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     const bool stopping = (g_stop != 0 && row_due && k < nsteps) || at_limit;
     if (stopping) k_end = k;
     if (dumped(k)) still_ours();
-    w.after_step(k);
+    try {
+      w.after_step(k);  // writes the rest of a --dump-problem step
+    } catch (const FolderGone&) {
+      throw;
+    } catch (const WriteError& e) {
+      throw dump_failed(k, e);
+    }
     iv.add(st);
     iter_total += st.solve.iterations;
     sum.max_iterations = std::max(sum.max_iterations, st.solve.iterations);
