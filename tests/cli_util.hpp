@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -37,6 +38,21 @@ inline std::string slurp(const std::filesystem::path& p) {
   std::ostringstream s;
   s << f.rdbuf();
   return s.str();
+}
+
+// summary.toml's "key = value" lines, values as written (the comments
+// after them cut).
+inline std::map<std::string, std::string> summary_fields(const std::filesystem::path& p) {
+  std::istringstream in(slurp(p));
+  std::map<std::string, std::string> f;
+  for (std::string line; std::getline(in, line);) {
+    const auto eq = line.find(" = ");
+    if (line.starts_with("#") || eq == std::string::npos) continue;
+    std::string v = line.substr(eq + 3, line.find(" #") - eq - 3);
+    while (!v.empty() && v.back() == ' ') v.pop_back();
+    f[line.substr(0, eq)] = v;
+  }
+  return f;
 }
 
 // An empty folder BUILD/<test>/<name> for a test's files (emptied first).

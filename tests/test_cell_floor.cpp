@@ -52,27 +52,13 @@ struct CdsimRun {
   std::map<std::string, std::string> summary;  // summary.toml's key = value
 };
 
-// summary.toml's "key = value" lines, values as written.
-std::map<std::string, std::string> summary_fields(const fs::path& p) {
-  std::istringstream in(cdtest::slurp(p));
-  std::map<std::string, std::string> f;
-  for (std::string line; std::getline(in, line);) {
-    const auto eq = line.find(" = ");
-    if (line.starts_with("#") || eq == std::string::npos) continue;
-    std::string v = line.substr(eq + 3, line.find(" #") - eq - 3);
-    while (!v.empty() && v.back() == ' ') v.pop_back();
-    f[line.substr(0, eq)] = v;
-  }
-  return f;
-}
-
 // cdsim `args` into `dir`, stdout and stderr apart.
 CdsimRun cdsim(const std::string& args, const fs::path& dir) {
   const fs::path err = dir.string() + ".stderr";
   const auto r = cdtest::run_command("(" + kCdsim + " " + args + " --quiet --threads 1 --out " + dir.string() +
                                      " 2>" + err.string() + ")");
   CdsimRun run{r.code, r.out, cdtest::slurp(err), {}};
-  if (fs::exists(dir / "summary.toml")) run.summary = summary_fields(dir / "summary.toml");
+  if (fs::exists(dir / "summary.toml")) run.summary = cdtest::summary_fields(dir / "summary.toml");
   return run;
 }
 

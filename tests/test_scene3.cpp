@@ -378,20 +378,6 @@ TEST(Scene3, CdsimMaxStepsThenResumeIsBitIdentical) {
   EXPECT_EQ(slurp(A / "spheres_00005.vtp"), slurp(B / "spheres_00005.vtp"));
 }
 
-// summary.toml's "key = value" lines, values as written.
-std::map<std::string, std::string> summary_fields(const fs::path& p) {
-  std::istringstream in(slurp(p));
-  std::map<std::string, std::string> f;
-  for (std::string line; std::getline(in, line);) {
-    const auto eq = line.find(" = ");
-    if (line.starts_with("#") || eq == std::string::npos) continue;
-    std::string v = line.substr(eq + 3, line.find(" #") - eq - 3);
-    while (!v.empty() && v.back() == ' ') v.pop_back();
-    f[line.substr(0, eq)] = v;
-  }
-  return f;
-}
-
 // summary.toml counts the accelerations over every session. A pile with the
 // subspace corrections and Anderson's mixing both on (both stall on some of
 // its steps at its tol 1e-4): the CG iterations and the stalled steps that
@@ -423,7 +409,7 @@ TEST(Scene3, SummaryCountsTheAccelerationsOverSessions) {
   const fs::path C = cdtest::scratch_dir("test_scene3", "accel_nine");
   auto r = cdtest::run_command(base + " --out " + A.string());
   ASSERT_EQ(r.code, 0) << r.out;
-  const auto a = summary_fields(A / "summary.toml");
+  const auto a = cdtest::summary_fields(A / "summary.toml");
   EXPECT_EQ(std::stod(a.at("cg_iterations")), cg);
   EXPECT_DOUBLE_EQ(std::stod(a.at("cg_iterations_mean")), cg / 100);
   EXPECT_EQ(std::stod(a.at("anderson_off_steps")), anderson_off);
@@ -433,7 +419,7 @@ TEST(Scene3, SummaryCountsTheAccelerationsOverSessions) {
     r = cdtest::run_command(base + " --max-steps 40 --out " + d.string());
     ASSERT_EQ(r.code, 0) << r.out;
   }
-  const auto c1 = summary_fields(C / "summary.toml");
+  const auto c1 = cdtest::summary_fields(C / "summary.toml");
   const std::string ckpt = (C / "checkpoint.bin").string();
   RunTotals t;
   World3 x = build_world3(load_scene(kPile3d, sets));
@@ -447,7 +433,7 @@ TEST(Scene3, SummaryCountsTheAccelerationsOverSessions) {
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_NE(r.out.find("resumed from"), std::string::npos) << r.out;
   }
-  const auto b = summary_fields(B / "summary.toml"), c = summary_fields(C / "summary.toml");
+  const auto b = cdtest::summary_fields(B / "summary.toml"), c = cdtest::summary_fields(C / "summary.toml");
   EXPECT_EQ(b.at("sessions"), "2");
   for (const char* k : {"steps", "sweeps_mean", "sweeps_max", "cg_iterations", "cg_iterations_mean",
                         "anderson_off_steps", "subspace_off_steps"})
