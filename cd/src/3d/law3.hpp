@@ -252,13 +252,13 @@ inline Branch3 project_sphere3(const Vec3& g, double mu, double a, Vec3& r) {
     r[1] = r[2] = 0.0;
     return Branch3::Open;
   }
-  const double gt = std::sqrt(g[1] * g[1] + g[2] * g[2]), lim = mu * sn;
-  if (gt <= lim) {
+  const double gt2 = g[1] * g[1] + g[2] * g[2], lim = mu * sn;
+  if (gt2 <= lim * lim) {
     r[1] = g[1];
     r[2] = g[2];
     return Branch3::Stick;
   }
-  const double f = lim / gt;
+  const double f = lim / std::sqrt(gt2);
   r[1] = f * g[1];
   r[2] = f * g[2];
   return Branch3::Slide;
