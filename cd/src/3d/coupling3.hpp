@@ -200,6 +200,7 @@ struct BodyCoupling3 {
     x[2] = r.r[2];
   }
   void add_impulse(SweepRow3& r, const double* dx) const {
+    if (dx[0] == 0.0 && dx[1] == 0.0 && dx[2] == 0.0) return;  // an open row's mix: nothing moves
     const Vec3 d(dx[0], dx[1], dx[2]);
     r.r += d;
     push_impulse(r, d, vel);
@@ -282,8 +283,28 @@ struct BodyCoupling3 {
   // (flatten): at -O2 the small Eigen operations would otherwise stay calls.
   template <class L, bool Write1>
   [[gnu::flatten]] void update(SweepRow3& r, double& dp2, double& pabs) const {
+    // A row open at its start that stays open (its normal trial at or below
+    // -a) keeps its impulse and moves nothing: the normal velocity alone
+    // decides it (the same operations as velocity()'s, so the same bits),
+    // without the tangential velocity or the push. The law still writes the
+    // open impulse, whose zero carries its own sign (+0 from the cone, -0
+    // from the frictionless clamp), so the state is the full update's to the
+    // bit. Half the rows of a dense shear step are open (the alert distance).
     const RowExtra3* e = nullptr;
     if constexpr (L::extra) e = extra + (&r - base);
+    {
+      const double a = L::cohesive ? r.adh : 0.0;
+      if (r.r[0] == -a && r.r[1] == 0.0 && r.r[2] == 0.0) {
+        const Vec3 dv = vel[r.b2].v - vel[r.b1].v;
+        const double gn = r.r[0] - (r.n.dot(dv) + r.bn) * r.iwnn;
+        if (a + gn <= 0.0) {
+          L::solve(r, e, Vec3(gn, 0.0, 0.0), r.r);
+          dp2 = 0.0;
+          pabs = a;
+          return;
+        }
+      }
+    }
     const Vec3 u = velocity<L::offsets>(r, e);
     Vec3 g;
     g[0] = r.r[0] - u[0] * r.iwnn;
