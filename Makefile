@@ -550,7 +550,7 @@ frozen-shear-runs: $(foreach s,$(FS_SHAPES),$(foreach i,0.01 0.001,$(CAMPAIGNS)/
 # steps of a strain at I with the campaign's dt: strain / (I dt_tp)
 fs_steps = $(shell awk 'BEGIN { printf "%d", $(2) / ($(1) * $(call resolved,$(1),dt_tp)) + 0.5 }')
 frozen_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --fresh \
-	  --set shear.start='"$(3)"' --set shear.pressure=$(P) \
+	  --set shear.start='"$(3)"' --set shear.pressure=$(P) --set particles.nsides=[$*] \
 	  --set shear.inertial_number=$(1) --set shear.strain=$(2) --set solver.tol=1e-4 --set solver.residual_tol=0 \
 	  --set solver.anderson=0 --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=0 \
 	  --dump-problem $(shell echo $$(( $(call fs_steps,$(1),$(2)) - $(FS_GAP) ))) \

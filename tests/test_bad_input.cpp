@@ -226,6 +226,9 @@ TEST(BadInput, StartSamplesAreCheckedAgainstTheScene) {
   }
   expect_refused("--set particles.density=5.0", {"shear.start", "density", "2.6"}, shear);
   expect_refused("--set shear.mode=walls", {"shear.start", "periodic"}, shear);
+  // The shear policy's "auto" is chosen for the shapes particles.nsides
+  // names: a disk sample under a polygon scene (or the reverse) is refused.
+  expect_refused("--set particles.nsides=[6]", {"shear.start", "particles.nsides = [6]", "disks only"}, shear);
 }
 
 // ---- cdanalysis and cdproblem --------------------------------------------

@@ -153,6 +153,22 @@ World build_world(const Scene& s0) {
                                    "preparation run)", s.start));
     if (!s.disks.empty() || s.n > 0)
       throw SceneError("shear.start gives the particles: set particles.n = 0 and no [[disk]]");
+    // The shapes come with the sample, but the scene's "auto" settings were
+    // chosen (config.cpp, before the sample is read) for the shapes
+    // particles.nsides names: polygons take no Anderson mixing and their own
+    // stop (docs/shear.md, "Settings by I"), so the two must agree.
+    const bool scene_polygons = std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; });
+    std::size_t poly = B.size();  // the sample's first polygon
+    for (std::size_t i = 0; i < B.size() && poly == B.size(); ++i)
+      if (B.nsides[i] >= 3) poly = i;
+    if ((poly < B.size()) != scene_polygons)
+      throw SceneError(fmt::format(
+          "shear.start: the sample's particles are {}, but particles.nsides = [{}] names {}; the \"auto\" "
+          "shear settings depend on it (docs/shear.md, \"Settings by I\"): set particles.nsides to the "
+          "preparation's",
+          scene_polygons ? std::string("disks only")
+                         : fmt::format("polygons ({}-gon: body {})", B.nsides[poly], poly),
+          fmt::join(s.nsides, ", "), scene_polygons ? "polygons" : "disks only"));
     for (std::size_t i = 0; i < B.size(); ++i) {
       if (!B.is_dynamic(i))
         throw SceneError(fmt::format("shear.start: '{}' holds walls or wall grains (body {}); a "
