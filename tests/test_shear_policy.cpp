@@ -42,6 +42,7 @@ const Expected kTable[] = {
 const cd::SceneKind kDisks{2, false, false};
 const cd::SceneKind kSpheres{3, false, false};
 const cd::SceneKind kCohesiveSpheres{3, true, false};
+const cd::SceneKind kPolygons{2, false, true};
 
 TEST(ShearPolicy, TheTableAtItsBreakpoints) {
   for (const Expected& e : kTable) {
@@ -55,6 +56,14 @@ TEST(ShearPolicy, TheTableAtItsBreakpoints) {
       // dt <= 0.005 t_p / I (to the 4 digits it is written with), <= 0.05 t_p.
       EXPECT_LE(s.dt_tp, 0.005 / e.I * (1 + 5e-4)) << "I = " << e.I;
       EXPECT_LE(s.dt_tp, 0.05) << "I = " << e.I;
+      // Polygons' plain solve: the Anderson stop's numbers below I = 0.01
+      // (both measured at tol 3e-4 with the projection), the plain stop above.
+      const cd::ShearSettings g = cd::shear_settings(e.I, cd::Acceleration::None, kPolygons);
+      EXPECT_EQ(g.tol, e.I < 0.01 ? e.tol_anderson : e.tol) << "I = " << e.I;
+      EXPECT_EQ(g.residual_tol, e.I < 0.01 ? e.residual_anderson : e.residual_tol) << "I = " << e.I;
+      EXPECT_EQ(g.overlap_projection, e.I < 0.01 ? e.projection_anderson : 0.0) << "I = " << e.I;
+      EXPECT_EQ(g.anderson, 0) << "I = " << e.I;
+      EXPECT_EQ(g.dt_tp, s.dt_tp) << "I = " << e.I;
       // An acceleration changes the stop only.
       const cd::ShearSettings a = cd::shear_settings(e.I, cd::Acceleration::Anderson, kind);
       EXPECT_EQ(a.tol, kind.cohesive ? e.tol_cohesive : e.tol_anderson) << "I = " << e.I;
@@ -157,7 +166,22 @@ TEST(ShearPolicy, AutoProjectionFollowsTheStop) {
   EXPECT_EQ(disks.overlap_projection, 0.5);
   EXPECT_EQ(disks.tol, 3e-4);
   EXPECT_EQ(disks.residual_tol, 0.0);
-  EXPECT_EQ(cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]"}).overlap_projection, 0.0);
+  // Polygons: plain NLGS, at the looser stop with the projection below
+  // I = 0.01 (1000 hexagons, docs/accuracy.md), the plain stop above.
+  const cd::Scene hex = cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]"});
+  EXPECT_EQ(hex.anderson, 0);
+  EXPECT_EQ(hex.overlap_projection, 0.5);
+  EXPECT_EQ(hex.tol, 3e-4);
+  EXPECT_EQ(hex.residual_tol, 0.0);
+  const cd::Scene hex2 = cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]", "shear.inertial_number=0.01"});
+  EXPECT_EQ(hex2.overlap_projection, 0.0);
+  EXPECT_EQ(hex2.tol, 1e-3);
+  // A cohesive polygon scene keeps the plain residual stop (not measured).
+  const cd::Scene hexc =
+      cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]", "contact.cohesion_number=10"});
+  EXPECT_EQ(hexc.tol, 1e-4);
+  EXPECT_EQ(hexc.residual_tol, 3e-3);
+  EXPECT_EQ(hexc.overlap_projection, 0.0);
   const cd::Scene coh = cd::parse_scene(scene3, "a.toml", {"shear.inertial_number=0.001", "contact.cohesion_number=10"});
   EXPECT_EQ(coh.anderson, 5);
   EXPECT_EQ(coh.overlap_projection, 0.0);
@@ -204,7 +228,7 @@ TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
     for (const char* ns : {"particles.nsides=[6]", "particles.nsides=[3,6,0]"}) {
       const cd::Scene g = cd::parse_scene(scene2, "c.toml", {is.str(), ns});
       EXPECT_EQ(g.anderson, 0) << ns << ", I = " << I;
-      EXPECT_EQ(g.tol, cd::shear_settings(I, cd::Acceleration::None, kDisks).tol) << ns << ", I = " << I;
+      EXPECT_EQ(g.tol, cd::shear_settings(I, cd::Acceleration::None, kPolygons).tol) << ns << ", I = " << I;
     }
   }
   // A number for one of them: kept, and the tolerance follows what runs.

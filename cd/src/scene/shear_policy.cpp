@@ -17,8 +17,10 @@ ShearSettings shear_settings(double I, Acceleration acc, SceneKind kind) {
   const bool spheres = kind.dimension == 3 && !kind.cohesive;
   const int anderson = kind.dimension == 2 ? (kind.polygons ? 0 : kAnderson) : kind.cohesive ? kAnderson : b->auto_anderson;
   const int subspace = spheres ? b->auto_subspace : 0;
-  const Stop& stop = acc == Acceleration::Subspace ? b->subspace
+  const bool polygons = kind.dimension == 2 && kind.polygons && !kind.cohesive;
+  const Stop& stop = acc == Acceleration::Subspace   ? b->subspace
                      : acc == Acceleration::Anderson ? (kind.cohesive ? b->cohesive : b->anderson)
+                     : polygons                      ? b->polygons
                                                      : b->plain;
   return {stop.tol, stop.residual_tol, stop.overlap_projection, dt_tp, b->cell_mass, anderson, subspace};
 }
