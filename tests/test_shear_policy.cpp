@@ -57,11 +57,12 @@ TEST(ShearPolicy, TheTableAtItsBreakpoints) {
       EXPECT_LE(s.dt_tp, 0.005 / e.I * (1 + 5e-4)) << "I = " << e.I;
       EXPECT_LE(s.dt_tp, 0.05) << "I = " << e.I;
       // Polygons' plain solve: the Anderson stop's numbers below I = 0.01
-      // (both measured at tol 3e-4 with the projection), the plain stop above.
+      // (both measured at tol 3e-4 with the projection), tol 2e-3 with the
+      // projection up to 0.5, the plain stop above.
       const cd::ShearSettings g = cd::shear_settings(e.I, cd::Acceleration::None, kPolygons);
-      EXPECT_EQ(g.tol, e.I < 0.01 ? e.tol_anderson : e.tol) << "I = " << e.I;
+      EXPECT_EQ(g.tol, e.I < 0.01 ? e.tol_anderson : e.I < 0.5 ? 2e-3 : e.tol) << "I = " << e.I;
       EXPECT_EQ(g.residual_tol, e.I < 0.01 ? e.residual_anderson : e.residual_tol) << "I = " << e.I;
-      EXPECT_EQ(g.overlap_projection, e.I < 0.01 ? e.projection_anderson : 0.0) << "I = " << e.I;
+      EXPECT_EQ(g.overlap_projection, e.I < 0.01 ? e.projection_anderson : e.I < 0.5 ? 0.5 : 0.0) << "I = " << e.I;
       EXPECT_EQ(g.anderson, 0) << "I = " << e.I;
       EXPECT_EQ(g.dt_tp, s.dt_tp) << "I = " << e.I;
       // An acceleration changes the stop only.
@@ -166,16 +167,20 @@ TEST(ShearPolicy, AutoProjectionFollowsTheStop) {
   EXPECT_EQ(disks.overlap_projection, 0.5);
   EXPECT_EQ(disks.tol, 3e-4);
   EXPECT_EQ(disks.residual_tol, 0.0);
-  // Polygons: plain NLGS, at the looser stop with the projection below
-  // I = 0.01 (1000 hexagons, docs/accuracy.md), the plain stop above.
+  // Polygons: plain NLGS, at looser stops with the projection below
+  // I = 0.5 (1000 hexagons, docs/accuracy.md), the plain stop above.
   const cd::Scene hex = cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]"});
   EXPECT_EQ(hex.anderson, 0);
   EXPECT_EQ(hex.overlap_projection, 0.5);
   EXPECT_EQ(hex.tol, 3e-4);
   EXPECT_EQ(hex.residual_tol, 0.0);
   const cd::Scene hex2 = cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]", "shear.inertial_number=0.01"});
-  EXPECT_EQ(hex2.overlap_projection, 0.0);
-  EXPECT_EQ(hex2.tol, 1e-3);
+  EXPECT_EQ(hex2.overlap_projection, 0.5);
+  EXPECT_EQ(hex2.tol, 2e-3);
+  EXPECT_EQ(hex2.residual_tol, 0.0);
+  const cd::Scene hex3 = cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]", "shear.inertial_number=0.5"});
+  EXPECT_EQ(hex3.overlap_projection, 0.0);
+  EXPECT_EQ(hex3.tol, 1e-3);
   // A cohesive polygon scene keeps the plain residual stop (not measured).
   const cd::Scene hexc =
       cd::parse_scene(scene2, "b.toml", {"particles.nsides=[6]", "contact.cohesion_number=10"});
