@@ -67,6 +67,24 @@ struct BodyCoupling {
     const double dx = B.vx - A.vx, dy = B.vy - A.vy;
     double un = r.nx * dx + r.ny * dy + r.bn;
     if constexpr (Rot) un += -B.w * r.c2t + A.w * r.c1t;
+    // A row at the open impulse (-a, 0) that its solve keeps there (the
+    // normal velocity alone decides: L::stays_open, false on a NaN) takes
+    // the solve's impulse (its bits: -0.0 without adhesion) and moves
+    // nothing: its push would add zeros, which change no velocity but a
+    // -0.0, and velocities are sums, which make -0.0 only from a -0.0
+    // start. So no tangential velocity, solve or push. Half the rows of a
+    // dense shear step are open (within the alert distance). A law without
+    // stays_open (cd/bench/solvers.cpp's relaxed ones) takes the full update.
+    if constexpr (requires { L::stays_open(r, un); }) {
+      const double a = L::cohesive ? r.adh : 0.0;
+      if (r.pn == -a && (!L::tangential || r.pt == 0.0) && L::stays_open(r, un)) {
+        r.pn = -a;
+        if constexpr (L::tangential) r.pt = 0.0;
+        dp2 = 0.0;
+        pabs = std::abs(a);
+        return;
+      }
+    }
     double ut = 0.0;
     if constexpr (L::tangential) {
       ut = -r.ny * dx + r.nx * dy + r.bt;

@@ -27,11 +27,15 @@ struct Block {
 
 enum class LocalBranch { Open, Stick, SlidePlus, SlideMinus, Fallback };
 
+// The open branch of solve_coulomb: p = (-a, 0) leaves u_n = b_n - W_nn a
+// >= 0. Its own function because the sweep asks it alone (Coulomb::stays_open).
+inline bool coulomb_open(double bn, double wnn, double a) { return bn - wnn * a >= 0.0; }
+
 // Frictional local solve. Returns the branch taken (tests check every one).
 inline LocalBranch solve_coulomb(double bn, double bt, const Block& W, double mu, double a,
                                  double& pn, double& pt) {
   // Open: p = (-a, 0) is valid if the normal velocity it leaves is >= 0.
-  if (bn - W.wnn * a >= 0.0) {
+  if (coulomb_open(bn, W.wnn, a)) {
     pn = -a;
     pt = 0.0;
     return LocalBranch::Open;
@@ -75,6 +79,11 @@ inline void solve_frictionless(double bn, const Block& W, double a, double& pn) 
   pn = std::max(-a, -bn / W.wnn);
 }
 
+// Whether solve_frictionless gives p_n = -a, its bits (std::max keeps its
+// first argument on a tie): the same quotient; false on a NaN one, which
+// std::max would turn into -a too, so that a NaN row takes the full update.
+inline bool frictionless_open(double bn, double wnn, double a) { return -bn / wnn <= -a; }
+
 // Natural-map residual of the law at (u, p), in impulse units (rho = 1/W_nn):
 //   r_n = (p_n + a) - max(0, p_n + a - rho u_n)
 //   r_t = p_t - clamp(p_t - rho u_t, -mu (p_n + a), mu (p_n + a))
@@ -100,20 +109,35 @@ inline double law_residual(double un, double ut, double pn, double pt, double mu
 // current impulse, as nlgs.cpp's row update and the matrix replay need.
 // Adding an effect adds a type here and to LocalLaw, not a branch in a kernel.
 // `tangential`: the law has a tangential impulse (the sweep computes u_t).
+// `cohesive`: its open impulse is (-a, 0) with a = ContactRow::adh (else a = 0).
+// stays_open(r, un): for a row at the open impulse, whether solve gives it
+// again (the sweep then skips the row: coupling.hpp). It is solve's own open
+// test on solve's own b_n (bn_of), so it answers as solve does, not as a
+// bound; u_t is not needed, Coulomb's open branch reading b_n alone.
 struct Frictionless {
   static constexpr bool tangential = false;
+  static constexpr bool cohesive = false;
   static constexpr const char* name = "frictionless";
+  static double bn_of(const ContactRow& r, double un) { return un - r.wnn * r.pn; }
+  static bool stays_open(const ContactRow& r, double un) {
+    return frictionless_open(bn_of(r, un), r.wnn, 0.0);
+  }
   static void solve(const ContactRow& r, double un, double /*ut*/, double& pn, double& pt) {
-    solve_frictionless(un - r.wnn * r.pn, Block{r.wnn, r.wnt, r.wtt}, 0.0, pn);
+    solve_frictionless(bn_of(r, un), Block{r.wnn, r.wnt, r.wtt}, 0.0, pn);
     pt = 0.0;
   }
 };
 
 struct Coulomb {
   static constexpr bool tangential = true;
+  static constexpr bool cohesive = false;
   static constexpr const char* name = "coulomb";
+  static double bn_of(const ContactRow& r, double un) { return un - (r.wnn * r.pn + r.wnt * r.pt); }
+  static bool stays_open(const ContactRow& r, double un) {
+    return coulomb_open(bn_of(r, un), r.wnn, 0.0);
+  }
   static void solve(const ContactRow& r, double un, double ut, double& pn, double& pt) {
-    const double bn = un - (r.wnn * r.pn + r.wnt * r.pt);
+    const double bn = bn_of(r, un);
     const double bt = ut - (r.wnt * r.pn + r.wtt * r.pt);
     solve_coulomb(bn, bt, Block{r.wnn, r.wnt, r.wtt}, r.mu, 0.0, pn, pt);
   }
@@ -122,9 +146,14 @@ struct Coulomb {
 // Adhesion-shifted Signorini, without friction.
 struct CohesiveFrictionless {
   static constexpr bool tangential = false;
+  static constexpr bool cohesive = true;
   static constexpr const char* name = "cohesive-frictionless";
+  static double bn_of(const ContactRow& r, double un) { return un - r.wnn * r.pn; }
+  static bool stays_open(const ContactRow& r, double un) {
+    return frictionless_open(bn_of(r, un), r.wnn, r.adh);
+  }
   static void solve(const ContactRow& r, double un, double /*ut*/, double& pn, double& pt) {
-    solve_frictionless(un - r.wnn * r.pn, Block{r.wnn, r.wnt, r.wtt}, r.adh, pn);
+    solve_frictionless(bn_of(r, un), Block{r.wnn, r.wnt, r.wtt}, r.adh, pn);
     pt = 0.0;
   }
 };
@@ -132,9 +161,14 @@ struct CohesiveFrictionless {
 // Adhesion-shifted Signorini with the shifted Coulomb cone |p_t| <= mu (p_n + a).
 struct CohesiveCoulomb {
   static constexpr bool tangential = true;
+  static constexpr bool cohesive = true;
   static constexpr const char* name = "cohesive-coulomb";
+  static double bn_of(const ContactRow& r, double un) { return un - (r.wnn * r.pn + r.wnt * r.pt); }
+  static bool stays_open(const ContactRow& r, double un) {
+    return coulomb_open(bn_of(r, un), r.wnn, r.adh);
+  }
   static void solve(const ContactRow& r, double un, double ut, double& pn, double& pt) {
-    const double bn = un - (r.wnn * r.pn + r.wnt * r.pt);
+    const double bn = bn_of(r, un);
     const double bt = ut - (r.wnt * r.pn + r.wtt * r.pt);
     solve_coulomb(bn, bt, Block{r.wnn, r.wnt, r.wtt}, r.mu, r.adh, pn, pt);
   }
