@@ -110,6 +110,24 @@ TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
                  {"contact.cohesion_number = 1e+308", "between 1e-100 and 1e+100"}, shear);
 }
 
+// Compliant contacts (contact.stiffness, contact.stiffness_number): 3D
+// only, one of the two, the number with an imposed pressure, not with
+// restitution, and within the scene's number range.
+TEST(BadInput, CompliantContactsAreRefusedWhereTheyCannotApply) {
+  expect_refused("--set contact.stiffness=1e6", {"contact.stiffness", "3D only"});
+  std::ifstream f(std::string(CDLAB_SOURCE_DIR) + "/configs/pile3d.toml");
+  const std::string pile3d((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(pile3d.empty());
+  expect_refused("--set contact.stiffness=-1", {"contact.stiffness"}, pile3d);
+  expect_refused("--set contact.stiffness_number=1e5", {"contact.stiffness_number", "shear.pressure"}, pile3d);
+  expect_refused("--set contact.stiffness=1e6 --set contact.e_n=0.5", {"contact.stiffness", "restitution"}, pile3d);
+  expect_refused("--set contact.stiffness=1e-300", {"contact.stiffness"}, pile3d);
+  const std::string shear3 = "name = \"s\"\ndimension = 3\n[gravity]\ng = [0.0, 0.0, 0.0]\n[particles]\nn = 0\n[shear]\nmode = \"periodic\"\n"
+                             "pressure = 1e5\ninertial_number = 0.01\nstrain = 0.1\ndt_tp = 0.05\n";
+  expect_refused("--set contact.stiffness=1e7 --set contact.stiffness_number=1e5",
+                 {"contact.stiffness or contact.stiffness_number, not both"}, shear3);
+}
+
 TEST(BadInput, UsageErrorsExitTwo) {
   for (const std::string args : {"--bogus", "--threads x s.toml", "--dump-problem -3 s.toml"}) {
     const cdtest::CmdResult r = cdsim(args);

@@ -35,15 +35,15 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 }
 
 void compare(const Scene& x, const Scene& y, bool same) {
-  const auto& [name, source, dimension, dt, duration, gravity, mu, mu_wall, mu_b, mu_wall_b, axis_a, e_n, e_t, alert, rotation, overlap_correction, overlap_projection, adhesion, debond, tol,
+  const auto& [name, source, dimension, dt, duration, gravity, mu, mu_wall, mu_b, mu_wall_b, axis_a, e_n, e_t, alert, rotation, overlap_correction, overlap_projection, adhesion, stiffness, debond, tol,
                max_iter, residual_tol, anderson, subspace, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
                box_width, box_height, box_depth, disks, walls, series_interval, snapshot_interval,
                checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, cell_depth, pressure,
-               inertial_number, cell_mass, isotropic, compaction_rate, settle_stress, settle_phi, settle_time, strain, dt_tp, start, cohesion_number] = x;
+               inertial_number, cell_mass, isotropic, compaction_rate, settle_stress, settle_phi, settle_time, strain, dt_tp, start, cohesion_number, stiffness_number] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dimension); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(mu_b); CHECK_FIELD(mu_wall_b); CHECK_FIELD(axis_a); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
-  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(overlap_projection); CHECK_FIELD(adhesion); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(anderson); CHECK_FIELD(subspace); CHECK_FIELD(threads);
+  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(overlap_projection); CHECK_FIELD(adhesion); CHECK_FIELD(stiffness); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(anderson); CHECK_FIELD(subspace); CHECK_FIELD(threads);
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
   CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
@@ -53,7 +53,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(shear_mode); CHECK_FIELD(cell_width); CHECK_FIELD(cell_height); CHECK_FIELD(cell_depth); CHECK_FIELD(pressure);
   CHECK_FIELD(inertial_number); CHECK_FIELD(cell_mass); CHECK_FIELD(isotropic); CHECK_FIELD(compaction_rate);
   CHECK_FIELD(settle_stress); CHECK_FIELD(settle_phi); CHECK_FIELD(settle_time); CHECK_FIELD(strain);
-  CHECK_FIELD(dt_tp); CHECK_FIELD(start); CHECK_FIELD(cohesion_number);
+  CHECK_FIELD(dt_tp); CHECK_FIELD(start); CHECK_FIELD(cohesion_number); CHECK_FIELD(stiffness_number);
   if (same) {
     ASSERT_EQ(disks.size(), y.disks.size());
     ASSERT_EQ(walls.size(), y.walls.size());
@@ -82,6 +82,7 @@ Scene nondefault() {
   s.overlap_correction = 0.25;
   s.overlap_projection = 0.3;
   s.adhesion = 2.5e-3;
+  s.stiffness = 4.0e6;
   s.debond = 0.02;
   s.tol = 1e-6;
   s.max_iter = 500;
@@ -126,6 +127,7 @@ Scene nondefault() {
   s.dt_tp = 0.1;
   s.start = "prep/checkpoint.bin";
   s.cohesion_number = 5.0;
+  s.stiffness_number = 3.0e4;
   s.disks = {{{0.05, 0.1}, {1.0, -2.0}, 1e-3, 3.0, 5.0, 4, 0.25, {0.5, -0.5}},
              {{0.02, 0.03}, {0.0, 0.5}, 2e-3, -1.0, -1.0, 60, -1.5, {-1.0, 2.0}}};
   s.walls = {{{0.0, 0.3}, {0.1, 0.25}, {0.0, -0.01}, 0.5}, {{-1.0, 0.0}, {-1.0, 1.0}, {0.2, 0.0}, -0.5}};
@@ -181,7 +183,7 @@ TEST(Errors, KeyInTheWrongSectionSuggestsTheRightOne) {
 }
 
 TEST(Errors, NoSuggestionWhenNothingIsClose) {
-  EXPECT_EQ(error("[contact]\nstiffness = 1e6\n"), "x.toml:2:1: unknown key 'contact.stiffness'");
+  EXPECT_EQ(error("[contact]\nhardness = 1e6\n"), "x.toml:2:1: unknown key 'contact.hardness'");
 }
 
 TEST(Errors, UnknownSection) {
@@ -389,9 +391,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 59 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 61 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 59u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 61u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

@@ -10,7 +10,11 @@
 //           sixth session, tol_anderson);
 //   plain   solver.tol 1e-3, plain NLGS (the policy before; the run the
 //           step was dumped from);
-//   fast    solver.tol 3e-3 with Anderson memory 5 (issue 30's fast setting).
+//   fast    solver.tol 3e-3 with Anderson memory 5 (issue 30's fast setting);
+//   compliant  the policy's solve with compliant contacts (contact.stiffness
+//           k = kappa p d, kappa = 1e5 and 1e4; coupling3.hpp's
+//           BodyCouplingT3): the same step, each row's law on u + rho (r -
+//           r0), rho = 1 / (k dt^2), r0 the dumped warm start.
 // A regression guard on the number of sweeps, not a timing: the solve is
 // deterministic, so each setting must stop within the sweeps it took when
 // measured (kSettings' sweeps); a change that makes the solver slower on
@@ -58,12 +62,23 @@ struct Setting {
   // the subspace policy the same day, seventh session.
   int sweeps;
   int cg;  // and the subspace corrections' CG iterations (each about a sweep's traffic)
+  double kappa = 0.0;  // compliant contacts' k / (p d) (0: rigid)
 };
+// The step's scene (tests/data/frozen-shear3/README.md): p = 1e5 N/m^2,
+// d = 1 mm, rho_s = 2600 kg/m^3, dt = 0.05 t_p with t_p = d sqrt(rho_s / p).
+double compliance(double kappa) {
+  if (kappa == 0.0) return 0.0;
+  const double p = 1e5, d = 1e-3, dt = 0.05 * d * std::sqrt(2600.0 / p);
+  return 1.0 / (kappa * p * d * dt * dt);
+}
 const Setting kSettings[] = {
     {"policy (tol 7e-4, subspace 10)", 7e-4, 0, 10, 88, 210},
     {"anderson (tol 5e-4, anderson 5)", 5e-4, 5, 0, 224, 0},
     {"plain (tol 1e-3)", 1e-3, 0, 0, 390, 0},
     {"fast (tol 3e-3, anderson 5)", 3e-3, 5, 0, 22, 0},
+    // Measured 2026-11-27 (tenth session) when compliant contacts were added.
+    {"compliant kappa 1e5 (tol 7e-4, subspace 10)", 7e-4, 0, 10, 72, 170, 1e5},
+    {"compliant kappa 1e4 (tol 7e-4, subspace 10)", 7e-4, 0, 10, 27, 60, 1e4},
 };
 
 cd::ContactProblem3 frozen(cd::SolverParams& prm) {
@@ -156,7 +171,8 @@ struct LawCheck {
   double dof_res = 0;       // the cell height's equation, relative (cell_dof.hpp)
 };
 
-// The solved problem s against the problem as read, p0.
+// The solved problem s against the problem as read, p0 (compliant: the law
+// on u + rho (r - r0), r0 = p0's impulses).
 LawCheck check_laws(const cd::ContactProblem3& p0, const cd::ContactProblem3& s) {
   const std::size_t n = s.rows.size();
   LawCheck c;
@@ -191,7 +207,8 @@ LawCheck check_laws(const cd::ContactProblem3& p0, const cd::ContactProblem3& s)
   double sum2 = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const cd::SphereRow& r = s.rows[k];
-    const cd::Vec3 u = r.to_frame(v[r.b2].v + v[r.b2].w.cross(r.c2) - v[r.b1].v - v[r.b1].w.cross(r.c1)) + off[k];
+    const cd::Vec3 u = r.to_frame(v[r.b2].v + v[r.b2].w.cross(r.c2) - v[r.b1].v - v[r.b1].w.cross(r.c1)) + off[k] +
+                       s.compliance * (r.r - p0.rows[k].r);
     const double ut = std::hypot(u[1], u[2]);
     const cd::Vec3 ud(u[0] + r.mu * ut, u[1], u[2]);
     const double e = (r.r - project_cone(r.r - ud / r.wnn, r.mu)).norm();
@@ -231,6 +248,7 @@ TEST(FrozenShear3, SolvesWithinTheMeasuredSweepsAndMeetsTheLaws) {
     prm.anderson = set.anderson;
     prm.subspace = set.subspace;
     cd::ContactProblem3 s = p0;
+    s.compliance = compliance(set.kappa);
     const cd::SolveStats st = cd::nlgs_solve3(s, prm);
     const LawCheck c = check_laws(p0, s);
     const double bound = lb.bound(set.tol, c.r_mean);
@@ -264,6 +282,7 @@ TEST(FrozenShear3, SolvesWithinTheMeasuredSweepsAndMeetsTheLaws) {
       cd::SolverParams cap = prm;
       cap.max_iter = st.iterations - 1;
       cd::ContactProblem3 before = p0;
+      before.compliance = s.compliance;
       cd::nlgs_solve3(before, cap);
       double d2 = 0;
       for (std::size_t k = 0; k < s.rows.size(); ++k) d2 += (s.rows[k].r - before.rows[k].r).squaredNorm();
@@ -281,6 +300,7 @@ TEST(FrozenShear3, SolvesWithinTheMeasuredSweepsAndMeetsTheLaws) {
       cd::SolverParams par = prm;
       par.min_parallel = 1;
       cd::ContactProblem3 t = p0;
+      t.compliance = s.compliance;
       const cd::SolveStats pt = cd::nlgs_solve3(t, par);
       EXPECT_EQ(pt.iterations, st.iterations) << set.name << ", " << threads << " threads";
       EXPECT_TRUE(same_impulses(s, t)) << set.name << ", " << threads << " threads";

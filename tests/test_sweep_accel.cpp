@@ -211,7 +211,7 @@ struct ExactNormCoupling : sweep::BodyCoupling3 {
   static constexpr bool kNormBound = false;
   template <class L, bool Write1>
   void update(SweepRow3& r, double& dp2, double& pabs) const {
-    BodyCoupling3::update<L, Write1>(r, dp2, pabs);
+    sweep::BodyCoupling3::update<L, Write1>(r, dp2, pabs);
     pabs = impulse_norm(r);
   }
 };

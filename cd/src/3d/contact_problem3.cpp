@@ -52,9 +52,20 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
   RowExtra3* extra = p.extra.empty() ? nullptr : p.extra.data();
   for (CellDof3& d : p.dofs) d.extra = extra;
   std::vector<CellDof3>* dofs = p.dofs.empty() ? nullptr : &p.dofs;
+  // Compliant contacts: the law's memory, the impulses at the start.
+  std::vector<Vec3> r0;
+  if (p.compliance > 0) {
+    r0.resize(n);
+    for (int k = 0; k < n; ++k) r0[k] = rows[k].r;
+  }
   const SolveStats st = std::visit(
       [&](auto law) {
         using L = decltype(law);
+        if (p.compliance > 0) {
+          sweep::CompliantCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size()), r0.data(),
+                                      p.compliance};
+          return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
+        }
         sweep::BodyCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size())};
         return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
       },
@@ -88,8 +99,9 @@ Vec3 vec3(TextReader& rd, const std::string& what) {
 }  // namespace
 
 void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, std::ostream& out) {
-  out << "cdlab-contact-problem3 1\n";
+  out << "cdlab-contact-problem3 " << (p.compliance > 0 ? 2 : 1) << "\n";
   out << "law " << law_name3(p.law) << "\n";
+  if (p.compliance > 0) out << "compliance " << x(p.compliance) << "\n";
   problem_file::write_solver(out, prm);
   out << "bodies " << p.vel.size() << "\n";
   for (const BodyVel3& v : p.vel) out << fmt::format("{} {} {} {}\n", x3(v.v), x3(v.w), x(v.inv_m), x(v.inv_I));
@@ -108,9 +120,15 @@ void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, st
 ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name, SolverParams& prm) {
   TextReader rd(in, name);
   rd.expect("cdlab-contact-problem3", "at the start (not a cdlab 3D problem file)");
-  rd.integer("the format version", 1, 1);
+  const long long version = rd.integer("the format version", 1, 2);
   ContactProblem3 p;
   p.law = problem_file::read_law<LocalLaw3>(rd, [](const LocalLaw3& l) { return law_name3(l); });
+  if (version == 2) {
+    rd.expect("compliance", "after the law (format version 2)");
+    p.compliance = rd.number("the compliance");
+    if (!(p.compliance >= 0) || !std::isfinite(p.compliance))
+      rd.fail(fmt::format("the compliance is {}, not a finite number >= 0", p.compliance));
+  }
   problem_file::read_solver(rd, prm, "after the law");
   if (!(prm.tol > 0)) rd.fail(fmt::format("the tolerance is {}, not positive", prm.tol));
   rd.expect("bodies", "after the solver's parameters");

@@ -53,6 +53,10 @@ struct ContactProblem3 {
   std::vector<BodyVel3> vel;
   std::vector<CellDof3> dofs;
   LocalLaw3 law;
+  // rho = 1 / (k dt^2) of compliant contacts (contact.stiffness k), the
+  // velocity per unit impulse the law adds to u (coupling3.hpp,
+  // BodyCouplingT3); 0: rigid contacts.
+  double compliance = 0.0;
 };
 
 // Solves the problem in place (impulses, velocities, dofs) from the impulses
@@ -70,7 +74,8 @@ void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& v
 // cdlab's own text format of a ContactProblem3 (".cdp3"): every number a C
 // hexadecimal float, so that a problem read back is the same bits and its
 // solve the same impulses as the step it was dumped from. Layout: a header
-// line "cdlab-contact-problem3 1", then `law NAME` (law_name3), the
+// line "cdlab-contact-problem3 V", then `law NAME` (law_name3), with
+// V = 2 a line `compliance RHO` (compliant contacts; V = 1: rigid), the
 // solver's `tol`, `max_iter`, `min_parallel` and optional `residual_tol`;
 // `bodies N` and N lines "vx vy vz wx wy wz inv_m inv_I"; `colours C
 // overflow 0|1` and the lines "start" and "split"; `rows R` and R lines "b1

@@ -156,7 +156,17 @@ inline void push_impulse(const SphereRow& r, const Vec3& dr, BodyVel3* vel) {
 namespace sweep {
 
 // Rows coupled through the velocities of their bodies (the 3D simulator).
-struct BodyCoupling3 {
+// Compliant (contact.stiffness > 0; ContactProblem3::compliance): every
+// row's law acts on u + rho (r - r0) in place of u, r0 the row's impulse at
+// the solve's start (the warm start, the previous step's impulse), rho =
+// 1 / (k dt^2): an implicit linear spring of stiffness k on the normal and
+// tangential displacements of the step, Signorini and Coulomb kept (method:
+// docs/accuracy.md, "Compliant contacts"). Its block is W + rho I, its
+// stick trial g = r - (u + rho (r - r0)) / (W_kk + rho). The rigid instance
+// (false) reads neither r0 nor rho, so rigid scenes compute what they did
+// before the option existed.
+template <bool Compliant>
+struct BodyCouplingT3 {
   BodyVel3* vel;
   // The rows' RowExtra3, same index as the rows from `base` (null in scenes
   // without them).
@@ -211,6 +221,17 @@ struct BodyCoupling3 {
   // products W p go through a copy of the bodies (masses kept, velocities
   // zeroed each time); nbodies is the size of vel.
   int nbodies = 0;
+  // Compliant: the impulses at the solve's start, same index as the rows
+  // from `base`, and rho (velocity per impulse).
+  const Vec3* r0 = nullptr;
+  double rho = 0.0;
+  static constexpr bool kCompliant = Compliant;
+  // The velocity the law sees: u, and rho (r - r0) on a compliant row.
+  Vec3 law_velocity(const SweepRow3& r) const {
+    const Vec3 u = velocity(r);
+    if constexpr (Compliant) return u + rho * (r.r - r0[&r - base]);
+    return u;
+  }
   template <class L>
   static constexpr bool kSubspaceLaw = !L::orthotropic;
   using Scratch = std::vector<BodyVel3>;
@@ -221,12 +242,12 @@ struct BodyCoupling3 {
   // a sliding impulse on the cone itself).
   template <class L>
   void subspace_row(const SweepRow3& r, double* free, double* diag, double* u) const {
-    const Vec3 v = velocity(r);
+    const Vec3 v = law_velocity(r);
     u[0] = v[0];
     u[1] = v[1];
     u[2] = v[2];
-    diag[0] = 1.0 / r.iwnn;
-    diag[1] = diag[2] = 1.0 / r.iwtt;
+    diag[0] = 1.0 / r.iwnn + rho;
+    diag[1] = diag[2] = 1.0 / r.iwtt + rho;
     const double sn = r.r[0] + (L::cohesive ? r.adh : 0.0);
     const bool closed = sn > 0;
     // |r_t| as law3's project_sphere3 takes it (sqrt, not the libm hypot:
@@ -237,7 +258,8 @@ struct BodyCoupling3 {
     free[1] = free[2] = sticks ? 1.0 : 0.0;
   }
   // y = W p on the rows listed in live, through s (offsets and b_n left
-  // out); the other rows' p is zero and their y is not read.
+  // out; compliant: (W + rho I) p); the other rows' p is zero and their y is
+  // not read.
   [[gnu::flatten]] void subspace_apply(const SweepRow3* R, const std::vector<int>& live, const double* p, double* y,
                                        Scratch& s) const {
     for (BodyVel3& b : s) {
@@ -254,6 +276,11 @@ struct BodyCoupling3 {
       y[3 * i] = r.n.dot(dv);
       y[3 * i + 1] = r.t1.dot(dv) + r.t2.dot(om);
       y[3 * i + 2] = r.t2.dot(dv) - r.t1.dot(om);
+      if constexpr (Compliant) {
+        y[3 * i] += rho * p[3 * i];
+        y[3 * i + 1] += rho * p[3 * i + 1];
+        y[3 * i + 2] += rho * p[3 * i + 2];
+      }
     }
   }
   // r <- the law's projection of r + d (its local solve's, L::solve): a
@@ -294,9 +321,14 @@ struct BodyCoupling3 {
     // bit. Half the rows of a dense shear step are open (the alert distance).
     const RowExtra3* e = nullptr;
     if constexpr (L::extra) e = extra + (&r - base);
+    // Compliant: only a row also open at the solve's start (r0 = r), whose
+    // rho term is then zero (the same sign of the trial, so the same open
+    // impulse).
+    const Vec3* z0 = nullptr;
+    if constexpr (Compliant) z0 = r0 + (&r - base);
     {
       const double a = L::cohesive ? r.adh : 0.0;
-      if (r.r[0] == -a && r.r[1] == 0.0 && r.r[2] == 0.0) {
+      if (r.r[0] == -a && r.r[1] == 0.0 && r.r[2] == 0.0 && (!Compliant || *z0 == r.r)) {
         const Vec3 dv = vel[r.b2].v - vel[r.b1].v;
         const double gn = r.r[0] - (r.n.dot(dv) + r.bn) * r.iwnn;
         if (a + gn <= 0.0) {
@@ -309,12 +341,24 @@ struct BodyCoupling3 {
     }
     const Vec3 u = velocity<L::offsets>(r, e);
     Vec3 g;
-    g[0] = r.r[0] - u[0] * r.iwnn;
-    if constexpr (L::tangential) {
-      g[1] = r.r[1] - u[1] * r.iwtt;
-      g[2] = r.r[2] - u[2] * r.iwtt;
+    if constexpr (Compliant) {
+      const Vec3 d = r.r - *z0;
+      g[0] = r.r[0] - (u[0] + rho * d[0]) / (1.0 / r.iwnn + rho);
+      if constexpr (L::tangential) {
+        const double h = 1.0 / (1.0 / r.iwtt + rho);
+        g[1] = r.r[1] - (u[1] + rho * d[1]) * h;
+        g[2] = r.r[2] - (u[2] + rho * d[2]) * h;
+      } else {
+        g[1] = g[2] = 0.0;
+      }
     } else {
-      g[1] = g[2] = 0.0;
+      g[0] = r.r[0] - u[0] * r.iwnn;
+      if constexpr (L::tangential) {
+        g[1] = r.r[1] - u[1] * r.iwtt;
+        g[2] = r.r[2] - u[2] * r.iwtt;
+      } else {
+        g[1] = g[2] = 0.0;
+      }
     }
     Vec3 rn;
     L::solve(r, e, g, rn);
@@ -336,13 +380,18 @@ struct BodyCoupling3 {
   }
 };
 
+using BodyCoupling3 = BodyCouplingT3<false>;
+using CompliantCoupling3 = BodyCouplingT3<true>;
+
 }  // namespace sweep
 
 // The law residual of a row (law3.hpp, rho = 1/W_nn) at the velocity its
-// coupling gives, with its RowExtra3 when the scene has them.
-inline double row_residual(const sweep::BodyCoupling3& c, const SweepRow3& r) {
+// coupling gives the law (compliant: with rho (r - r0)), with its RowExtra3
+// when the scene has them.
+template <bool Compliant>
+double row_residual(const sweep::BodyCouplingT3<Compliant>& c, const SweepRow3& r) {
   const RowExtra3* e = c.extra_of(r);
-  return law_residual3(c.velocity(r), r.r, Cone3{r.mu, e ? e->mu_b : r.mu}, r.adh, r.iwnn);
+  return law_residual3(c.law_velocity(r), r.r, Cone3{r.mu, e ? e->mu_b : r.mu}, r.adh, r.iwnn);
 }
 
 }  // namespace cd

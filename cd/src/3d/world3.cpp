@@ -72,6 +72,7 @@ void World3::configure() {
   const bool offsets = prm_.e_t > 0.0 || moving_images;
   extras_on_ = friction_on_ && (offsets || prm_.orthotropic);
   prob_.law = choose_law3(friction_on_, adhesion_on_, offsets, prm_.orthotropic);
+  prob_.compliance = prm_.stiffness > 0.0 ? 1.0 / (prm_.stiffness * prm_.dt * prm_.dt) : 0.0;
 }
 
 PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const {

@@ -58,6 +58,11 @@ struct WorldParams3 {
   // Adhesion-shifted Signorini law: pull-off force f_a on every contact
   // whose midpoint gap is <= debond (absolute); 0: none.
   double adhesion = 0.0, debond = 0.0;
+  // Compliant contacts (coupling3.hpp, BodyCouplingT3): the law on u +
+  // (r - r0) / (k dt^2), an implicit spring of stiffness k (N/m) on each
+  // contact's displacements over a step, r0 its previous impulse (the warm
+  // start); the overlap projection stays rigid. 0: rigid contacts.
+  double stiffness = 0.0;
   double d_ref = 1.0;  // length scale for overlaps (mean diameter)
   SolverParams solver;
 

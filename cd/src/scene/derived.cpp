@@ -97,6 +97,11 @@ double pull_off_force(const Scene& s) {
   return s.cohesion_number * s.pressure * (s.dimension == 3 ? d * d : d);
 }
 
+double contact_stiffness(const Scene& s) {
+  if (!(s.stiffness_number > 0)) return s.stiffness;
+  return s.stiffness_number * s.pressure * mean_diameter(s);
+}
+
 double time_step(const Scene& s) { return s.dt_tp > 0 ? s.dt_tp * pressure_time(s) : s.dt; }
 
 double run_duration(const Scene& s) {
@@ -172,6 +177,23 @@ void check_derived(const Scene& s) {
                        s.cohesion_number > 0 ? (s.dimension == 3 ? "contact.cohesion_number x shear.pressure x d^2"
                                                                  : "contact.cohesion_number x shear.pressure x d")
                                              : "contact.adhesion"));
+  }
+  if (s.stiffness > 0 || s.stiffness_number > 0) {
+    const char* key = s.stiffness_number > 0 ? "contact.stiffness_number" : "contact.stiffness";
+    if (s.dimension != 3)
+      fail(fmt::format("{} > 0: compliant contacts are 3D only (2D contacts are rigid)", key));
+    if (s.stiffness > 0 && s.stiffness_number > 0)
+      fail("give contact.stiffness or contact.stiffness_number, not both");
+    if (s.stiffness_number > 0 && !(s.pressure > 0))
+      fail("contact.stiffness_number > 0 needs shear.pressure > 0 (k = kappa p d, p in N/m^2); without an "
+           "imposed pressure give the stiffness itself, contact.stiffness (N/m)");
+    if (s.e_n > 0 || s.e_t > 0)
+      fail(fmt::format("{} > 0 with restitution (contact.e_n, contact.e_t): a compliant contact has its own "
+                       "rebound; choose one", key));
+    const double k = contact_stiffness(s), rho = 1.0 / (k * dt * dt);
+    if (!std::isfinite(k) || !std::isnormal(rho))
+      fail(fmt::format("the contact stiffness k = {} N/m with the time step {} s gives 1/(k dt^2) = {}: both "
+                       "must be finite and > 0 ({})", k, dt, rho, key));
   }
   const double T = run_duration(s);
   const char* T_from = s.strain > 0 ? "shear.strain / shear rate" : "time.duration";

@@ -48,6 +48,10 @@ double pressure_time(const Scene& s);
 // f_a = eta p d in 2D (p a force per length), eta p d^2 in 3D (p a force
 // per area).
 double pull_off_force(const Scene& s);
+// The stiffness k of compliant contacts (3D): contact.stiffness, or
+// contact.stiffness_number kappa at the imposed shear.pressure p, k = kappa
+// p d with d = mean_diameter; 0: rigid contacts.
+double contact_stiffness(const Scene& s);
 // Time step and simulated time after the [shear] overrides (dt_tp, strain).
 double time_step(const Scene& s);
 double run_duration(const Scene& s);

@@ -76,6 +76,7 @@ struct Scene {
   double overlap_correction = 0.0;  // beta: overlaps separate at beta |gap|/dt (0: none)
   double overlap_projection = 0.0;  // beta_p: centres moved apart by beta_p |gap| a step (0: none)
   double adhesion = 0.0;     // pull-off force f_a (N); 0: no cohesion
+  double stiffness = 0.0;    // 3D: compliant contacts of stiffness k (N/m); 0: rigid
   double debond = 0.01;      // debonding distance delta_a, in mean diameters
 
   // [solver]
@@ -143,6 +144,8 @@ struct Scene {
   std::string start;                // checkpoint.bin of a preparation run to start from
   // [contact] cohesion_number: eta > 0 gives f_a = eta p d
   double cohesion_number = 0.0;
+  // [contact] stiffness_number: kappa > 0 gives k = kappa p d (3D)
+  double stiffness_number = 0.0;
 
   double mu_w() const { return mu_wall < 0 ? mu : mu_wall; }
 };
