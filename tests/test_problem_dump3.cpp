@@ -246,6 +246,8 @@ TEST(ProblemDump3, EveryLawReplaysExactly) {
          p.mu_b = 0.2;
          p.mu_wall_b = 0.6;
        }},
+      // Compliant contacts: the file's version 2, its compliance line.
+      {"compliant", [](cd::WorldParams3& p) { p.stiffness = 1e4; }},
   };
   for (const Variant& v : variants) {
     cd::Pile3dParams q;
@@ -278,9 +280,12 @@ TEST(ProblemDump3, EveryLawReplaysExactly) {
     std::printf("[ dump3 ] %-12s law %-24s %zu rows, %d sweeps, replay bit-identical: %s\n", v.name,
                 cd::law_name3(p.law).c_str(), p.rows.size(), st.iterations, differ ? "no" : "yes");
     // Braces: EXPECT_THROW is an if-else of its own (-Wdangling-else).
-    if (std::string(v.name) == "cohesive") {
+    if (std::string(v.name) == "cohesive" || std::string(v.name) == "compliant") {
       EXPECT_THROW(cd::to_matrix(p), std::invalid_argument);
     }
+    EXPECT_EQ(p.compliance > 0, std::string(v.name) == "compliant") << v.name;
+    EXPECT_EQ(text.rfind(p.compliance > 0 ? "cdlab-contact-problem3 2\n" : "cdlab-contact-problem3 1\n", 0), 0u)
+        << v.name;
     if (std::string(v.name) == "orthotropic") {
       EXPECT_THROW(cd::write_fclib(cd::to_matrix(p), "unused.hdf5", "", ""), std::invalid_argument);
     }
@@ -299,4 +304,18 @@ TEST(ProblemDump3, MalformedFileNamesTheLine) {
   }
   std::istringstream law("cdlab-contact-problem3 1\nlaw sticky\n");
   EXPECT_THROW(cd::read_contact_problem3(law, "law.cdp3", s), std::runtime_error);
+  // Version 2 needs its compliance line, a finite number >= 0.
+  for (const char* bad : {"cdlab-contact-problem3 2\nlaw coulomb\ntol 0x1p-10\n",
+                          "cdlab-contact-problem3 2\nlaw coulomb\ncompliance -0x1p+0\n",
+                          "cdlab-contact-problem3 2\nlaw coulomb\ncompliance inf\n",
+                          "cdlab-contact-problem3 3\nlaw coulomb\n"}) {
+    std::istringstream v(bad);
+    try {
+      cd::read_contact_problem3(v, "v.cdp3", s);
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_TRUE(m.find("v.cdp3:3:") != std::string::npos || m.find("v.cdp3:1:") != std::string::npos) << m;
+    }
+  }
 }

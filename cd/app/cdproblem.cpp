@@ -160,8 +160,9 @@ struct Step3 {
   using Problem = cd::ContactProblem3;
   static Problem read(const std::string& path, cd::SolverParams& prm) { return cd::read_contact_problem3(path, prm); }
   static std::string describe(const Problem& p) {
-    return fmt::format("{} rows, {} bodies, {} colours, {} cell dofs, law {}", p.rows.size(), p.vel.size(),
-                       p.colouring.split.size(), p.dofs.size(), cd::law_name3(p.law));
+    return fmt::format("{} rows, {} bodies, {} colours, {} cell dofs, law {}{}", p.rows.size(), p.vel.size(),
+                       p.colouring.split.size(), p.dofs.size(), cd::law_name3(p.law),
+                       p.compliance > 0 ? fmt::format(", compliant (rho = {:.6g})", p.compliance) : "");
   }
   static cd::SolveStats solve(Problem& p, const cd::SolverParams& prm) { return cd::nlgs_solve3(p, prm); }
   static std::string impulses(const Problem& p) {

@@ -24,7 +24,9 @@ ProblemDump3::ProblemDump3(World3& w, std::filesystem::path dir, std::vector<std
     write_contact_problem(p, prm, text);
     write_file_atomic((dir_ / fmt::format("problem_{}.cdp3", k)).string(), text.str());
     matrix_.reset();
-    const bool fclib = std::visit(
+    // No FCLib file for what its format cannot say: adhesion, the
+    // orthotropic cone, compliant contacts (the .cdp3 holds them).
+    const bool fclib = p.compliance == 0.0 && std::visit(
         [](auto l) { return !decltype(l)::cohesive && !decltype(l)::orthotropic; }, p.law);
     if (!fclib) return;
     matrix_ = std::make_unique<Problem3>(to_matrix(p));

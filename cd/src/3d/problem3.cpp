@@ -134,6 +134,8 @@ struct Coulomb3 {
 Problem3 to_matrix(const ContactProblem3& cp) {
   if (std::visit([](auto l) { return decltype(l)::cohesive; }, cp.law))
     throw std::invalid_argument("a cohesive problem (adhesion impulse > 0) has no FCLib matrix form");
+  if (cp.compliance > 0)
+    throw std::invalid_argument("a problem with compliant contacts (compliance > 0) has no FCLib matrix form");
   const auto& rows = cp.rows;
   const auto& V = cp.vel;
   const int nc = static_cast<int>(rows.size()), nb = static_cast<int>(V.size());
