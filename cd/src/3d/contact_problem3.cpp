@@ -53,10 +53,15 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
   for (CellDof3& d : p.dofs) d.extra = extra;
   std::vector<CellDof3>* dofs = p.dofs.empty() ? nullptr : &p.dofs;
   // Compliant contacts: the law's memory, the impulses at the start.
+  // and the compliant block's reciprocals in the rows (coupling3.hpp).
   std::vector<Vec3> r0;
   if (p.compliance > 0) {
     r0.resize(n);
-    for (int k = 0; k < n; ++k) r0[k] = rows[k].r;
+    for (int k = 0; k < n; ++k) {
+      r0[k] = rows[k].r;
+      rows[k].iwnn = 1.0 / (p.rows[k].wnn + p.compliance);
+      rows[k].iwtt = 1.0 / (p.rows[k].wtt + p.compliance);
+    }
   }
   const SolveStats st = std::visit(
       [&](auto law) {

@@ -161,8 +161,11 @@ namespace sweep {
 // the solve's start (the warm start, the previous step's impulse), rho =
 // 1 / (k dt^2): an implicit linear spring of stiffness k on the normal and
 // tangential displacements of the step, Signorini and Coulomb kept (method:
-// docs/accuracy.md, "Compliant contacts"). Its block is W + rho I, its
-// stick trial g = r - (u + rho (r - r0)) / (W_kk + rho). The rigid instance
+// docs/method.md section 15). Its block is W + rho I, whose reciprocals
+// the rows then hold (iwnn = 1 / (W_nn + rho), iwtt likewise:
+// nlgs_solve3), so the stick trial is g = r - (u + rho (r - r0)) iwnn
+// without a division, and the cell dofs' damped update and the law
+// residual's scale see the compliant block. The rigid instance
 // (false) reads neither r0 nor rho, so rigid scenes compute what they did
 // before the option existed.
 template <bool Compliant>
@@ -246,8 +249,8 @@ struct BodyCouplingT3 {
     u[0] = v[0];
     u[1] = v[1];
     u[2] = v[2];
-    diag[0] = 1.0 / r.iwnn + rho;
-    diag[1] = diag[2] = 1.0 / r.iwtt + rho;
+    diag[0] = 1.0 / r.iwnn;  // compliant: W_nn + rho (the row's iwnn)
+    diag[1] = diag[2] = 1.0 / r.iwtt;
     const double sn = r.r[0] + (L::cohesive ? r.adh : 0.0);
     const bool closed = sn > 0;
     // |r_t| as law3's project_sphere3 takes it (sqrt, not the libm hypot:
@@ -343,11 +346,10 @@ struct BodyCouplingT3 {
     Vec3 g;
     if constexpr (Compliant) {
       const Vec3 d = r.r - *z0;
-      g[0] = r.r[0] - (u[0] + rho * d[0]) / (1.0 / r.iwnn + rho);
+      g[0] = r.r[0] - (u[0] + rho * d[0]) * r.iwnn;
       if constexpr (L::tangential) {
-        const double h = 1.0 / (1.0 / r.iwtt + rho);
-        g[1] = r.r[1] - (u[1] + rho * d[1]) * h;
-        g[2] = r.r[2] - (u[2] + rho * d[2]) * h;
+        g[1] = r.r[1] - (u[1] + rho * d[1]) * r.iwtt;
+        g[2] = r.r[2] - (u[2] + rho * d[2]) * r.iwtt;
       } else {
         g[1] = g[2] = 0.0;
       }
