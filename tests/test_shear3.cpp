@@ -277,44 +277,51 @@ TEST(Shear3Cell, ShearAtImposedInertialNumber) {
 // rebuilt from the scene, on 2 threads with every loop parallel
 // (min_parallel = 1), ends bit-identical to 100 steps never stopped on 1
 // thread: positions, velocities, the cell's lengths, rates, offset, strain.
+// With compliant contacts too (contact.stiffness_number): their springs'
+// forces are the warm-start memory, which the checkpoint must carry.
 TEST(Shear3Cell, CheckpointResumesBitIdenticallyOnOneOrTwoThreads) {
   const std::string start = prepared("restart", 100, 200);
-  const Scene s = shear_scene(start, 0.1);
-  const auto make = [&] {
-    World3 w = build_world3(s);
-    WorldParams3 p = w.params();
-    p.solver.min_parallel = 1;
-    w.set_params(p);
-    return w;
-  };
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(1);
-  World3 a = make();
-  for (int k = 0; k < 100; ++k) a.step();
-  World3 b = make();
-  for (int k = 0; k < 40; ++k) b.step();
-  const auto dir = cdtest::scratch_dir("test_shear3", "ckpt");
-  const std::string path = (dir / "checkpoint.bin").string();
-  save_checkpoint3(path, b, 5);
-  World3 c = make();
-  load_checkpoint3(path, c);
-  omp_set_num_threads(2);
-  for (int k = 0; k < 60; ++k) c.step();
-  omp_set_num_threads(saved);
-  ASSERT_GT(a.rows().size(), 200u);  // dense: contacts across the moving faces
-  int across = 0;
-  for (const ContactInfo3& f : a.infos()) across += f.iy != 0;
-  EXPECT_GT(across, 0);
-  EXPECT_NE(a.cell().rate.y(), 0.0);
-  for (std::size_t i = 0; i < a.bodies.size(); ++i) {
-    ASSERT_EQ(c.bodies.pos[i], a.bodies.pos[i]) << i;
-    ASSERT_EQ(c.bodies.vel[i].v, a.bodies.vel[i].v) << i;
-    ASSERT_EQ(c.bodies.vel[i].w, a.bodies.vel[i].w) << i;
+  for (const double kappa : {0.0, 1e4}) {
+    SCOPED_TRACE(kappa > 0 ? "compliant contacts" : "rigid contacts");
+    Scene s = shear_scene(start, 0.1);
+    s.stiffness_number = kappa;
+    const auto make = [&] {
+      World3 w = build_world3(s);
+      WorldParams3 p = w.params();
+      p.solver.min_parallel = 1;
+      w.set_params(p);
+      return w;
+    };
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(1);
+    World3 a = make();
+    for (int k = 0; k < 100; ++k) a.step();
+    World3 b = make();
+    for (int k = 0; k < 40; ++k) b.step();
+    const auto dir = cdtest::scratch_dir("test_shear3", kappa > 0 ? "ckpt_compliant" : "ckpt");
+    const std::string path = (dir / "checkpoint.bin").string();
+    save_checkpoint3(path, b, 5);
+    World3 c = make();
+    load_checkpoint3(path, c);
+    omp_set_num_threads(2);
+    for (int k = 0; k < 60; ++k) c.step();
+    omp_set_num_threads(saved);
+    ASSERT_GT(a.rows().size(), 200u);  // dense: contacts across the moving faces
+    int across = 0;
+    for (const ContactInfo3& f : a.infos()) across += f.iy != 0;
+    EXPECT_GT(across, 0);
+    EXPECT_NE(a.cell().rate.y(), 0.0);
+    for (std::size_t i = 0; i < a.bodies.size(); ++i) {
+      ASSERT_EQ(c.bodies.pos[i], a.bodies.pos[i]) << i;
+      ASSERT_EQ(c.bodies.vel[i].v, a.bodies.vel[i].v) << i;
+      ASSERT_EQ(c.bodies.vel[i].w, a.bodies.vel[i].w) << i;
+    }
+    EXPECT_EQ(c.cell().size, a.cell().size);
+    EXPECT_EQ(c.cell().rate, a.cell().rate);
+    EXPECT_EQ(c.cell().le_offset, a.cell().le_offset);
+    EXPECT_EQ(c.cell().strain, a.cell().strain);
+    EXPECT_EQ(a.params().stiffness > 0, kappa > 0);
   }
-  EXPECT_EQ(c.cell().size, a.cell().size);
-  EXPECT_EQ(c.cell().rate, a.cell().rate);
-  EXPECT_EQ(c.cell().le_offset, a.cell().le_offset);
-  EXPECT_EQ(c.cell().strain, a.cell().strain);
 }
 
 // ---------------------------------------------------------------- bad input
