@@ -133,7 +133,9 @@ double cpu_seconds() {
 // The sweep alone on one thread: the next step's contact problem of w,
 // frozen, solved kKernelRuns times from its warm start with exactly
 // kKernelSweeps sweeps; contact updates per CPU second, the best run.
-double kernel_updates_per_cpu_s(cd::World3 w) {
+// compliance > 0: the same problem with compliant contacts of that rho
+// (coupling3.hpp's BodyCouplingT3: what the option costs an update).
+double kernel_updates_per_cpu_s(cd::World3 w, double compliance = 0.0) {
   Threads one(1);
   cd::ContactProblem3 frozen;
   cd::SolverParams prm;
@@ -142,6 +144,7 @@ double kernel_updates_per_cpu_s(cd::World3 w) {
     prm = s;
   });
   w.step();
+  frozen.compliance = compliance;
   prm.tol = 0.0;  // never met: exactly kKernelSweeps sweeps
   prm.residual_tol = 0.0;
   prm.max_iter = kKernelSweeps;
@@ -188,6 +191,14 @@ int main(int argc, char** argv) {
   const double kernel = kernel_updates_per_cpu_s(base);
   std::printf("cdbench3: frozen step N = 1000, %d sweeps, 1 thread: %.3g contact updates per CPU second (best of %d)\n",
               kKernelSweeps, kernel, kKernelRuns);
+  // Compliant contacts, rho = W_nn / 100 of a pair of mean spheres (kappa ~
+  // 1e4 in dense shear's units): the same frozen step.
+  double wnn = 0.0;
+  for (std::size_t i = 0; i < base.bodies.size(); ++i) wnn += base.bodies.vel[i].inv_m;
+  wnn = 2.0 * wnn / static_cast<double>(base.bodies.size());
+  const double kernel_c = kernel_updates_per_cpu_s(base, 0.01 * wnn);
+  std::printf("cdbench3: the same step with compliant contacts: %.3g contact updates per CPU second (%.2fx rigid)\n",
+              kernel_c, kernel_c / kernel);
 
   struct Size {
     int kx, ky;
@@ -216,6 +227,7 @@ int main(int argc, char** argv) {
   // Summary: speedups, updates/s/core, slope of ms/step (1 thread) against N.
   std::vector<std::tuple<std::string, double, std::string>> summary;
   summary.emplace_back("frozen_step_updates_per_cpu_s/1000", kernel, "1/s");
+  summary.emplace_back("frozen_step_updates_per_cpu_s_compliant/1000", kernel_c, "1/s");
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   int m = 0;
   for (std::size_t i = 0; i + 1 < res.size(); i += 2) {
