@@ -7,8 +7,20 @@
 #include <string>
 
 #include "scene.hpp"
+#include "setup3.hpp"
+#include "world3.hpp"
 
 namespace cdtest {
+
+// The scene's world with every loop parallel (min_parallel = 1): the
+// tests that compare 1 and 2 threads.
+inline cd::World3 parallel_world3(const cd::Scene& s) {
+  cd::World3 w = cd::build_world3(s);
+  cd::WorldParams3 p = w.params();
+  p.solver.min_parallel = 1;
+  w.set_params(p);
+  return w;
+}
 
 inline cd::Scene shear3_prep_scene(int n) {
   cd::Scene s;

@@ -222,13 +222,7 @@ TEST(Cohesion3Shear, CohesiveShearAtImposedPressure) {
   const std::string start = prepared("shear", 150, 300);
   const double eta = 10, I = 0.1;
   const Scene s = shear_scene(start, I, eta);
-  const auto make = [&] {
-    World3 w = build_world3(s);
-    WorldParams3 p = w.params();
-    p.solver.min_parallel = 1;
-    w.set_params(p);
-    return w;
-  };
+  const auto make = [&] { return cdtest::parallel_world3(s); };
   const int saved = omp_get_max_threads();
   omp_set_num_threads(1);
   World3 w = make();

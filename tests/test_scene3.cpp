@@ -27,6 +27,7 @@
 #include "output3.hpp"
 #include "pile3d.hpp"
 #include "setup3.hpp"
+#include "shear3_util.hpp"
 #include "totals_util.hpp"
 
 namespace fs = std::filesystem;
@@ -306,13 +307,7 @@ TEST(Scene3, Pile300ReachesRestWithBoundedOverlap) {
 // world loaded from it and 90 more on 2 threads.
 TEST(Scene3, CheckpointResumesBitIdenticallyOnOneOrTwoThreads) {
   const Scene s = load_scene(kPile3d, {"particles.n=300"});
-  const auto make = [&] {
-    World3 w = build_world3(s);
-    WorldParams3 p = w.params();
-    p.solver.min_parallel = 1;
-    w.set_params(p);
-    return w;
-  };
+  const auto make = [&] { return cdtest::parallel_world3(s); };
   const int saved = omp_get_max_threads();
   omp_set_num_threads(1);
   World3 a = make();

@@ -285,13 +285,7 @@ TEST(Shear3Cell, CheckpointResumesBitIdenticallyOnOneOrTwoThreads) {
     SCOPED_TRACE(kappa > 0 ? "compliant contacts" : "rigid contacts");
     Scene s = shear_scene(start, 0.1);
     s.stiffness_number = kappa;
-    const auto make = [&] {
-      World3 w = build_world3(s);
-      WorldParams3 p = w.params();
-      p.solver.min_parallel = 1;
-      w.set_params(p);
-      return w;
-    };
+    const auto make = [&] { return cdtest::parallel_world3(s); };
     const int saved = omp_get_max_threads();
     omp_set_num_threads(1);
     World3 a = make();
