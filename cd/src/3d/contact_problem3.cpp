@@ -52,8 +52,8 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
   RowExtra3* extra = p.extra.empty() ? nullptr : p.extra.data();
   for (CellDof3& d : p.dofs) d.extra = extra;
   std::vector<CellDof3>* dofs = p.dofs.empty() ? nullptr : &p.dofs;
-  // Compliant contacts: the law's memory, the impulses at the start.
-  // and the compliant block's reciprocals in the rows (coupling3.hpp).
+  // Compliant contacts: the law's memory (the impulses at the start), and
+  // the compliant block's reciprocals in the rows (coupling3.hpp).
   std::vector<Vec3> r0;
   if (p.compliance > 0) {
     r0.resize(n);

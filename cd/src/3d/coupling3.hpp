@@ -228,7 +228,6 @@ struct BodyCouplingT3 {
   // from `base`, and rho (velocity per impulse).
   const Vec3* r0 = nullptr;
   double rho = 0.0;
-  static constexpr bool kCompliant = Compliant;
   // The velocity the law sees: u, and rho (r - r0) on a compliant row.
   Vec3 law_velocity(const SweepRow3& r) const {
     const Vec3 u = velocity(r);
