@@ -1240,3 +1240,61 @@ TEST(ShearProfile, ReportFlagsBandedRuns) {
   const std::string page((std::istreambuf_iterator<char>(html)), {});
   EXPECT_NE(page.find("<b>banded</b>"), std::string::npos);
 }
+
+// fabric --force-threshold: a ring of six spheres, each pressed on its two
+// neighbours with f_n = 1, and three diameters of the ring carrying a weak
+// f_n = 1e-3 (the mean |f_n| of the nine is (6 + 3e-3)/9). Every sphere has
+// 3 force-bearing contacts at the default threshold (1e-9 <|f_n|>, z = 3,
+// as in the series), still at 1e-3 <|f_n|> (6.7e-4 < 1e-3), and only its 2
+// ring contacts at 1e-2 <|f_n|> (6.7e-3 > 1e-3): z = 2, 6 force-bearing,
+// no rattler (each keeps 2). The library and the command agree; a
+// threshold <= 0 is refused by name.
+TEST(Commands3, FabricForceThresholdDropsTheWeakContacts) {
+  ASSERT_TRUE(fs::exists(exe)) << "cdanalysis not built: " << exe;
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "threshold");
+  std::ofstream(dir / "scene.toml") << "dimension = 3\n";
+  const double d = 0.01;
+  ParticleSet ps;
+  for (int k = 0; k < 6; ++k) {
+    Particle p;
+    p.id = k;
+    p.radius = 0.5 * d;
+    p.x = d * std::cos(k * std::numbers::pi / 3);
+    p.y = d * std::sin(k * std::numbers::pi / 3);
+    ps.push_back(p);
+  }
+  ContactSet3 cs;
+  const auto add = [&](int a, int b, double fn) {
+    Contact3 c;
+    c.c.b1 = a;
+    c.c.b2 = b;
+    const V3 l(ps[b].x - ps[a].x, ps[b].y - ps[a].y, 0);
+    for (int i = 0; i < 3; ++i) c.c.l[i] = l[i], c.c.n[i] = l[i] / l.norm();
+    c.c.fn = fn;
+    c.status = 1;
+    cs.push_back(c);
+  };
+  for (int k = 0; k < 6; ++k) add(k, (k + 1) % 6, 1.0);
+  for (int k = 0; k < 3; ++k) add(k, k + 3, 1e-3);
+  write_contacts3((dir / "contacts_00000.vtp").string(), cs, ps);
+  write_particles((dir / "spheres_00000.vtp").string(), ps);
+  struct Case {
+    double rel;
+    double z;
+    std::size_t bearing;
+  };
+  for (const Case c : {Case{cd::obs::kForceEpsRel, 3.0, 9}, Case{1e-3, 3.0, 9}, Case{1e-2, 2.0, 6}}) {
+    const auto f = run_fabric3(dir.string(), 0, -1, 0, 1e-4, c.rel);
+    ASSERT_TRUE(f.connectivity) << c.rel;
+    EXPECT_DOUBLE_EQ(f.connectivity->z, c.z) << c.rel;
+    EXPECT_EQ(f.connectivity->rattlers, 0u) << c.rel;
+    EXPECT_EQ(f.physical_contacts, c.bearing) << c.rel;
+    const auto r = cdtest::run_command(
+        fmt::format("{} fabric {} --force-threshold {:g}", exe.string(), dir.string(), c.rel));
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find(fmt::format("z {:.4f}  rattlers 0 of 6", c.z)), std::string::npos) << r.out;
+  }
+  const auto bad = cdtest::run_command(fmt::format("{} fabric {} --force-threshold 0", exe.string(), dir.string()));
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.out.find("--force-threshold"), std::string::npos) << bad.out;
+}

@@ -131,7 +131,7 @@ static std::optional<std::string> companion_snapshot(const std::string& contacts
 }
 
 RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume, double mu,
-                     double sliding_tol) {
+                     double sliding_tol, double force_rel) {
   RunFabric f;
   f.file = snapshot_path(run_dir, "contacts", k);
   const auto raw = read_contacts(f.file);
@@ -141,7 +141,7 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume,
   // distance, or a bond that just broke) carries no force and is no part
   // of the network whose anisotropy is measured.
   const auto forces = as_forces(raw);
-  const double f_eps = cd::obs::force_threshold<2>(forces);
+  const double f_eps = cd::obs::force_threshold<2>(forces, force_rel);
   // Points are tested before the side-side points are merged: a pair bears
   // force when one of its points does, even if their forces cancel.
   ContactSet bearing;
@@ -171,13 +171,14 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume,
   return f;
 }
 
-RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double mu, double sliding_tol) {
+RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double mu, double sliding_tol,
+                       double force_rel) {
   RunFabric3 f;
   f.file = snapshot_path(run_dir, "contacts", k);
   const auto raw = read_contacts3(f.file);
   f.contacts = raw.size();
   const auto forces = as_forces(raw);
-  const double f_eps = cd::obs::force_threshold<3>(forces);
+  const double f_eps = cd::obs::force_threshold<3>(forces, force_rel);
   ContactSet3 bearing;
   for (const auto i : cd::obs::force_bearing_points<3>(forces, f_eps)) bearing.push_back(raw[i]);
   f.physical_contacts = bearing.size();

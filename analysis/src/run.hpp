@@ -79,8 +79,10 @@ struct RunFabric {
 
 // snapshot k of contacts_NNNNN.vtp (k < 0 from the end). volume <= 0: none.
 // mu > 0: also the Coulomb test of sliding with that friction and tolerance.
+// force_rel: a contact bears force when |fn| + |ft| > force_rel x mean |fn|
+// of the snapshot (cd::obs::force_threshold); the default is the series' z.
 RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume, double mu = 0,
-                     double sliding_tol = 1e-4);
+                     double sliding_tol = 1e-4, double force_rel = cd::obs::kForceEpsRel);
 
 // Fabric of one 3D contact snapshot (spheres; fabric3.hpp). The fabric and
 // anisotropies are over the force-bearing contacts (cd::obs::bears_force),
@@ -101,7 +103,7 @@ struct RunFabric3 {
   std::optional<Connectivity> connectivity;
 };
 RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double mu = 0,
-                       double sliding_tol = 1e-4);
+                       double sliding_tol = 1e-4, double force_rel = cd::obs::kForceEpsRel);
 
 // The simulated time of each snapshot `prefix`_NNNNN.vtp of a run, in the
 // order of list_snapshots, read from the run's `prefix`.pvd collection

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <string>
 
 #include "analysis/app/command.hpp"
 #include "analysis/src/report.hpp"
@@ -38,15 +39,22 @@ struct Opt {
   std::string run, out;
   int snapshot = -1, bins = 36;
   double volume = -1;
+  double force_rel = cd::obs::kForceEpsRel;
 };
+
+// "force-bearing", and the threshold when it is not the series' own.
+std::string bearing_label(const Opt& o) {
+  if (o.force_rel == cd::obs::kForceEpsRel) return "force-bearing";
+  return fmt::format("force-bearing: |f_n| + |f_t| > {:g} <|f_n|>", o.force_rel);
+}
 
 void fabric3(const Opt& o) {
   if (!o.out.empty())
     throw AnalysisError(fmt::format("fabric --out (polar plots of the angular profiles) is 2D only: '{}' is "
                                     "a 3D run (dimension = 3 in its scene.toml)", o.run));
-  const auto f = run_fabric3(o.run, o.snapshot, o.volume);
+  const auto f = run_fabric3(o.run, o.snapshot, o.volume, 0, 1e-4, o.force_rel);
   const auto pr = principal(f.stress.s);
-  fmt::print("snapshot   {}\ncontacts   {} ({} force-bearing)\n", f.file, f.contacts, f.physical_contacts);
+  fmt::print("snapshot   {}\ncontacts   {} ({} {})\n", f.file, f.contacts, f.physical_contacts, bearing_label(o));
   fmt::print("stress     p {:.6g}  q {:.6g}  q/p {:.4f}  (q = (s1 - s3)/3)  q_vm/p {:.4f}  mu {:.4f}  "
              "skew {:.3g}{}\n",
              f.stress.p(), f.stress.q(), f.stress.q_over_p(), f.stress.q_vm() / f.stress.p(), f.stress.mu(),
@@ -71,9 +79,9 @@ void fabric3(const Opt& o) {
 }
 
 void fabric2(const Opt& o) {
-  const auto f = run_fabric(o.run, o.snapshot, o.bins, o.volume);
-  fmt::print("snapshot   {}\ncontacts   {} ({} force-bearing physical)\n", f.file, f.contacts,
-             f.physical_contacts);
+  const auto f = run_fabric(o.run, o.snapshot, o.bins, o.volume, 0, 1e-4, o.force_rel);
+  fmt::print("snapshot   {}\ncontacts   {} ({} physical, {})\n", f.file, f.contacts, f.physical_contacts,
+             bearing_label(o));
   print_harmonics("fft", f.fft);
   print_harmonics("tensor", f.tensor);
   fmt::print("stress     p {:.6g}  q {:.6g}  q/p {:.4f}  theta_s {:.1f} deg  skew {:.3g}{}\n",
@@ -107,6 +115,12 @@ Handler fabric(CLI::App& sub) {
   sub.add_option("--volume", o->volume, "volume (area) V for the stress, > 0; default: stress times V")
       ->check(positive_number());
   sub.add_option("--out", o->out, "folder for the angular profiles and polar plots");
+  sub.add_option("--force-threshold", o->force_rel,
+                 "a contact bears force (counts in z, the fabric and the anisotropies) when |f_n| + |f_t| "
+                 "exceeds this times the snapshot's mean |f_n|; the default is the series' z. A larger "
+                 "value leaves the weak contacts out (docs/analysis.md)")
+      ->check(positive_number())
+      ->capture_default_str();
   return [o] {
     if (run_dimension(o->run) == 3) fabric3(*o);
     else fabric2(*o);

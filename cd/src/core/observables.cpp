@@ -24,11 +24,11 @@ Tensor<D> contact_stress(std::span<const Contact<D>> cs, double volume) {
 }
 
 template <int D>
-double force_threshold(std::span<const Contact<D>> cs) {
+double force_threshold(std::span<const Contact<D>> cs, double rel) {
   if (cs.empty()) return 0.0;
   double sum_abs = 0;
   for (const auto& c : cs) sum_abs += std::abs(c.fn);
-  return kForceEpsRel * sum_abs / static_cast<double>(cs.size());
+  return rel * sum_abs / static_cast<double>(cs.size());
 }
 
 namespace {
@@ -197,7 +197,7 @@ double deviator_3d(const Tensor<3>& t) {
 
 #define CD_OBS_INSTANTIATE(D)                                                                    \
   template Tensor<D> contact_stress<D>(std::span<const Contact<D>>, double);                    \
-  template double force_threshold<D>(std::span<const Contact<D>>);                              \
+  template double force_threshold<D>(std::span<const Contact<D>>, double);                      \
   template std::vector<Link> force_bearing_links<D>(std::span<const Contact<D>>, double);       \
   template std::vector<std::size_t> force_bearing_points<D>(std::span<const Contact<D>>, double); \
   template Tensor<D> fabric_tensor<D>(std::span<const Contact<D>>, double);

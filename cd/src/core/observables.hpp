@@ -111,9 +111,11 @@ Tensor<D> contact_stress(std::span<const Contact<D>> cs, double volume);
 
 // ---- force-bearing ----
 
-// f_eps = kForceEpsRel x mean |fn| over cs (0 when cs is empty).
+// f_eps = rel x mean |fn| over cs (0 when cs is empty); rel defaults to
+// kForceEpsRel, the series' z. A larger rel (cdanalysis fabric
+// --force-threshold) leaves the weak contacts out of z and the fabric.
 template <int D>
-double force_threshold(std::span<const Contact<D>> cs);
+double force_threshold(std::span<const Contact<D>> cs, double rel = kForceEpsRel);
 
 template <int D>
 bool bears_force(const Contact<D>& c, double f_eps) {
