@@ -9,7 +9,8 @@
 // restitution exp(-pi omega dt / 2)); a tall column at rest (each contact
 // carries the weight above it, with the overlap F / k of a linear spring);
 // a sphere sliding down an incline (Coulomb's limit kept: acceleration
-// g (sin a - mu cos a)); and the same bits on 1 and 2 threads.
+// g (sin a - mu cos a)); an adhesive bond at rest in tension (its gap F / k);
+// and the same bits on 1 and 2 threads.
 #include <gtest/gtest.h>
 
 #include <omp.h>
@@ -243,4 +244,55 @@ TEST(Compliant3, SameBitsOnOneAndTwoThreads) {
   std::printf("compliant pile: up to %zu rows, hash %016llx\n", rows1, static_cast<unsigned long long>(h1));
   EXPECT_GT(rows1, 400u);
   EXPECT_EQ(h1, h2);
+}
+// A sphere of weight mg hanging under a ceiling by adhesion (pull-off f_a,
+// debonding distance 0.01 d): a compliant bond is a linear spring in
+// tension too. From the touching start the sphere sinks and settles (the
+// step damps omega dt = 1.4 by (1 + omega^2 dt^2)^-1/2) at the stretch of
+// a spring loaded by its weight: the bond pulls with mg (statics), its gap
+// is mg / k (the spring, not the rigid gap term that would pull the gap
+// back to zero), and the bond never pulls harder than f_a. With f_a = 2 mg
+// it holds; with f_a = mg / 2 it cannot: the pull stops at f_a, the sphere
+// sinks past the debonding distance and falls freely.
+TEST(Compliant3, AdhesiveBondIsASpringInTension) {
+  const double r = 0.005, rho_s = 2600;
+  for (const double fa_mg : {2.0, 0.5}) {
+    SCOPED_TRACE(fa_mg);
+    WorldParams3 p;
+    p.dt = 1e-4;
+    p.gravity = Vec3(0, 0, -kG);
+    p.mu = p.mu_wall = 0.5;
+    p.alert = 0.1 * 2 * r;
+    p.debond = 0.01 * 2 * r;
+    p.solver.tol = 1e-12;
+    p.solver.max_iter = 1000;
+    World3 w(p);
+    w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, -1));  // a ceiling at z = 0
+    const int s = w.bodies.add_sphere(Vec3(0.01, 0.02, -r), r, rho_s);
+    const double mg = w.bodies.mass[s] * kG;
+    p.adhesion = fa_mg * mg;
+    p.stiffness = mg / (1e-5 * r);  // the weight stretches the bond by 1e-5 r
+    w.set_params(p);
+    double pull_max = 0;  // the bond's largest pull, in units of f_a
+    int steps = 0;
+    for (; steps < 400; ++steps) {
+      w.step();
+      if (!w.rows().empty()) pull_max = std::max(pull_max, -w.rows()[0].r[0] / (p.dt * p.adhesion));
+    }
+    const double gap = -r - w.bodies.pos[s].z();
+    std::printf("f_a = %g mg: %zu rows, gap %.6e m (mg/k %.6e), largest pull %.12f f_a, v_z %.3e m/s\n", fa_mg,
+                w.rows().size(), gap, mg / p.stiffness, pull_max, w.bodies.vel[s].v.z());
+    EXPECT_LE(pull_max, 1 + 1e-12);
+    if (fa_mg > 1) {
+      ASSERT_EQ(w.rows().size(), 1u);
+      EXPECT_NEAR(-w.rows()[0].r[0] / p.dt, mg, 1e-9 * mg);
+      EXPECT_NEAR(gap, mg / p.stiffness, 1e-6 * mg / p.stiffness);
+      EXPECT_LT(std::abs(w.bodies.vel[s].v.z()), 1e-9 * std::sqrt(kG * r));
+    } else {
+      EXPECT_NEAR(pull_max, 1.0, 1e-9);  // the bond pulled at its limit before it broke
+      EXPECT_GT(gap, p.debond);
+      // Falling freely: v_z = -g t since the bond broke; at least 0.03 s of the 0.04 s.
+      EXPECT_LT(w.bodies.vel[s].v.z(), -kG * 0.03);
+    }
+  }
 }

@@ -30,6 +30,7 @@ Quat rotate(const Quat& q, const Vec3& w, double h) {
 void World3::configure() {
   gravity_on_ = prm_.gravity.squaredNorm() > 0.0;
   adhesion_on_ = prm_.adhesion > 0.0;
+  compliant_ = prm_.stiffness > 0.0;
   restitution_on_ = prm_.e_n > 0.0 || prm_.e_t > 0.0;
   const bool periodic = prm_.periodic[0] || prm_.periodic[1] || prm_.periodic[2];
   for (int a = 0; a < 3; ++a)
@@ -149,12 +150,21 @@ void World3::build_rows([[maybe_unused]] const B& b) {
       *x = RowExtra3{};
       x->mu_b = prm_.orthotropic ? (wall ? prm_.mu_wall_b : prm_.mu_b) : r.mu;
     }
+    // Warm start: the previous impulse by contact key, on the new frame.
+    if (const Vec3* p = warm_.find(info_[k].key)) {
+      r.r = r.to_frame(*p);
+      if (!friction_on_) r.r[1] = r.r[2] = 0.0;
+    }
     const double gap = info_[k].gap;
+    r.adh = adhesion_on_ && gap <= prm_.debond ? a : 0.0;
     // Gap term u_n + g_m/dt >= 0 for an open candidate (g_m > 0): the next
     // midpoint gap is g_m + dt u+_n >= 0 (2D's choice, method.md section 6);
-    // an overlap separates at beta |g|/dt (beta = 0: pure CD).
-    r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
-    r.adh = adhesion_on_ && gap <= prm_.debond ? a : 0.0;
+    // an overlap separates at beta |g|/dt (beta = 0: pure CD). A compliant
+    // bond in tension (its previous impulse negative, the bond holding) has
+    // no gap term: its gap is its spring's stretch, F/k, not a distance
+    // still to close (method.md section 15).
+    const bool stretched = compliant_ && r.r[0] < 0.0 && r.adh > 0.0;
+    r.bn = gap > 0.0 ? (stretched ? 0.0 : gap / dt) : prm_.overlap_correction * gap / dt;
     // A contact with a moving image of body 2: across y (Lees-Edwards) the
     // image moves at iy le_velocity e_x more than body 2; with cell lengths
     // at imposed stress, across each face a by i_a dL_a/dt e_a (the rates at
@@ -183,11 +193,6 @@ void World3::build_rows([[maybe_unused]] const B& b) {
         x->bt1 += prm_.e_t * r.t1.dot(u);
         x->bt2 += prm_.e_t * r.t2.dot(u);
       }
-    }
-    // Warm start: the previous impulse by contact key, on the new frame.
-    if (const Vec3* p = warm_.find(info_[k].key)) {
-      r.r = r.to_frame(*p);
-      if (!friction_on_) r.r[1] = r.r[2] = 0.0;
     }
   }
 }
