@@ -112,7 +112,8 @@ TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
 
 // Compliant contacts (contact.stiffness, contact.stiffness_number): 3D
 // only, one of the two, the number with an imposed pressure, not with
-// restitution, and within the scene's number range.
+// restitution, within the scene's number range, and, with cohesion, a pull-off
+// reached before the debonding distance.
 TEST(BadInput, CompliantContactsAreRefusedWhereTheyCannotApply) {
   expect_refused("--set contact.stiffness=1e6", {"contact.stiffness", "3D only"});
   std::ifstream f(std::string(CDLAB_SOURCE_DIR) + "/configs/pile3d.toml");
@@ -126,6 +127,15 @@ TEST(BadInput, CompliantContactsAreRefusedWhereTheyCannotApply) {
                              "pressure = 1e5\ninertial_number = 0.01\nstrain = 0.1\ndt_tp = 0.05\n";
   expect_refused("--set contact.stiffness=1e7 --set contact.stiffness_number=1e5",
                  {"contact.stiffness or contact.stiffness_number, not both"}, shear3);
+  // A compliant bond stretches by f_a/k before it pulls f_a: beyond the
+  // debonding distance (0.01 d by default) it would break first. kappa =
+  // 1e4 reaches eta = 100 (allowed), not 200.
+  expect_refused("--set contact.stiffness_number=1e4 --set contact.cohesion_number=200",
+                 {"contact.cohesion_number with contact.stiffness_number", "f_a/k = 0.02 d",
+                  "cohesion_number <= stiffness_number x debond = 100"},
+                 shear3);
+  expect_refused("--set contact.stiffness=1e3 --set contact.adhesion=0.1 --set particles.d_mean=1e-3",
+                 {"contact.adhesion with contact.stiffness", "adhesion <= 0.01 N"}, shear3);
 }
 
 TEST(BadInput, UsageErrorsExitTwo) {

@@ -194,6 +194,22 @@ void check_derived(const Scene& s) {
     if (!std::isfinite(k) || !std::isnormal(rho))
       fail(fmt::format("the contact stiffness k = {} N/m with the time step {} s gives 1/(k dt^2) = {}: both "
                        "must be finite and > 0 ({})", k, dt, rho, key));
+    // A compliant bond stretches by f/k as it pulls (method.md section 15)
+    // and breaks at the debonding distance: f_a must be reached before it.
+    if (s.adhesion > 0 || s.cohesion_number > 0) {
+      const double d = mean_diameter(s), fa = pull_off_force(s), reach = k * s.debond * d;
+      if (!(fa <= reach))
+        fail(fmt::format("{} with {}: a bond pulling f_a = {:.4g} N stretches by f_a/k = {:.3g} d, beyond "
+                         "contact.debond = {:.3g} d, so it would break at a pull of k delta_a = {:.4g} N, "
+                         "never at f_a; make f_a/k at most contact.debond ({}), or raise contact.debond "
+                         "(docs/method.md section 15)",
+                         s.cohesion_number > 0 ? "contact.cohesion_number" : "contact.adhesion", key, fa,
+                         fa / (k * d), s.debond, reach,
+                         s.cohesion_number > 0 && s.stiffness_number > 0
+                             ? fmt::format("cohesion_number <= stiffness_number x debond = {:.4g}",
+                                           s.stiffness_number * s.debond)
+                             : fmt::format("adhesion <= {:.4g} N", reach)));
+    }
   }
   const double T = run_duration(s);
   const char* T_from = s.strain > 0 ? "shear.strain / shear rate" : "time.duration";
