@@ -114,65 +114,47 @@ inline double law_residual(double un, double ut, double pn, double pt, double mu
 // again (the sweep then skips the row: coupling.hpp). It is solve's own open
 // test on solve's own b_n (bn_of), so it answers as solve does, not as a
 // bound; u_t is not needed, Coulomb's open branch reading b_n alone.
-struct Frictionless {
+// The cohesive laws are the same two with the open impulse shifted to
+// (-a, 0): one template each, `Cohesive` reading the row's a.
+template <bool Cohesive>
+struct FrictionlessLaw {
   static constexpr bool tangential = false;
-  static constexpr bool cohesive = false;
-  static constexpr const char* name = "frictionless";
+  static constexpr bool cohesive = Cohesive;
+  static constexpr const char* name = Cohesive ? "cohesive-frictionless" : "frictionless";
+  static double adh(const ContactRow& r) { return Cohesive ? r.adh : 0.0; }
   static double bn_of(const ContactRow& r, double un) { return un - r.wnn * r.pn; }
   static bool stays_open(const ContactRow& r, double un) {
-    return frictionless_open(bn_of(r, un), r.wnn, 0.0);
+    return frictionless_open(bn_of(r, un), r.wnn, adh(r));
   }
   static void solve(const ContactRow& r, double un, double /*ut*/, double& pn, double& pt) {
-    solve_frictionless(bn_of(r, un), Block{r.wnn, r.wnt, r.wtt}, 0.0, pn);
+    solve_frictionless(bn_of(r, un), Block{r.wnn, r.wnt, r.wtt}, adh(r), pn);
     pt = 0.0;
   }
 };
 
-struct Coulomb {
+// Coulomb; cohesive: adhesion-shifted Signorini with the shifted cone
+// |p_t| <= mu (p_n + a).
+template <bool Cohesive>
+struct CoulombLaw {
   static constexpr bool tangential = true;
-  static constexpr bool cohesive = false;
-  static constexpr const char* name = "coulomb";
+  static constexpr bool cohesive = Cohesive;
+  static constexpr const char* name = Cohesive ? "cohesive-coulomb" : "coulomb";
+  static double adh(const ContactRow& r) { return Cohesive ? r.adh : 0.0; }
   static double bn_of(const ContactRow& r, double un) { return un - (r.wnn * r.pn + r.wnt * r.pt); }
   static bool stays_open(const ContactRow& r, double un) {
-    return coulomb_open(bn_of(r, un), r.wnn, 0.0);
+    return coulomb_open(bn_of(r, un), r.wnn, adh(r));
   }
   static void solve(const ContactRow& r, double un, double ut, double& pn, double& pt) {
     const double bn = bn_of(r, un);
     const double bt = ut - (r.wnt * r.pn + r.wtt * r.pt);
-    solve_coulomb(bn, bt, Block{r.wnn, r.wnt, r.wtt}, r.mu, 0.0, pn, pt);
+    solve_coulomb(bn, bt, Block{r.wnn, r.wnt, r.wtt}, r.mu, adh(r), pn, pt);
   }
 };
 
-// Adhesion-shifted Signorini, without friction.
-struct CohesiveFrictionless {
-  static constexpr bool tangential = false;
-  static constexpr bool cohesive = true;
-  static constexpr const char* name = "cohesive-frictionless";
-  static double bn_of(const ContactRow& r, double un) { return un - r.wnn * r.pn; }
-  static bool stays_open(const ContactRow& r, double un) {
-    return frictionless_open(bn_of(r, un), r.wnn, r.adh);
-  }
-  static void solve(const ContactRow& r, double un, double /*ut*/, double& pn, double& pt) {
-    solve_frictionless(bn_of(r, un), Block{r.wnn, r.wnt, r.wtt}, r.adh, pn);
-    pt = 0.0;
-  }
-};
-
-// Adhesion-shifted Signorini with the shifted Coulomb cone |p_t| <= mu (p_n + a).
-struct CohesiveCoulomb {
-  static constexpr bool tangential = true;
-  static constexpr bool cohesive = true;
-  static constexpr const char* name = "cohesive-coulomb";
-  static double bn_of(const ContactRow& r, double un) { return un - (r.wnn * r.pn + r.wnt * r.pt); }
-  static bool stays_open(const ContactRow& r, double un) {
-    return coulomb_open(bn_of(r, un), r.wnn, r.adh);
-  }
-  static void solve(const ContactRow& r, double un, double ut, double& pn, double& pt) {
-    const double bn = bn_of(r, un);
-    const double bt = ut - (r.wnt * r.pn + r.wtt * r.pt);
-    solve_coulomb(bn, bt, Block{r.wnn, r.wnt, r.wtt}, r.mu, r.adh, pn, pt);
-  }
-};
+using Frictionless = FrictionlessLaw<false>;
+using Coulomb = CoulombLaw<false>;
+using CohesiveFrictionless = FrictionlessLaw<true>;  // adhesion-shifted Signorini, without friction
+using CohesiveCoulomb = CoulombLaw<true>;
 
 using LocalLaw = std::variant<Frictionless, Coulomb, CohesiveFrictionless, CohesiveCoulomb>;
 
