@@ -278,13 +278,22 @@ TEST(Shear3Cell, ShearAtImposedInertialNumber) {
 // (min_parallel = 1), ends bit-identical to 100 steps never stopped on 1
 // thread: positions, velocities, the cell's lengths, rates, offset, strain.
 // With compliant contacts too (contact.stiffness_number): their springs'
-// forces are the warm-start memory, which the checkpoint must carry.
+// forces are the warm-start memory, which the checkpoint must carry; and
+// compliant with cohesion (eta = 10), where that memory also decides which
+// bonds are springs in tension (no gap term: method.md section 15).
 TEST(Shear3Cell, CheckpointResumesBitIdenticallyOnOneOrTwoThreads) {
   const std::string start = prepared("restart", 100, 200);
-  for (const double kappa : {0.0, 1e4}) {
-    SCOPED_TRACE(kappa > 0 ? "compliant contacts" : "rigid contacts");
+  struct Case {
+    double kappa, eta;
+    const char* name;
+  };
+  for (const Case cs : {Case{0.0, 0.0, "ckpt"}, Case{1e4, 0.0, "ckpt_compliant"},
+                        Case{1e4, 10.0, "ckpt_compliant_cohesive"}}) {
+    const double kappa = cs.kappa;
+    SCOPED_TRACE(cs.name);
     Scene s = shear_scene(start, 0.1);
     s.stiffness_number = kappa;
+    s.cohesion_number = cs.eta;
     const auto make = [&] { return cdtest::parallel_world3(s); };
     const int saved = omp_get_max_threads();
     omp_set_num_threads(1);
@@ -292,7 +301,7 @@ TEST(Shear3Cell, CheckpointResumesBitIdenticallyOnOneOrTwoThreads) {
     for (int k = 0; k < 100; ++k) a.step();
     World3 b = make();
     for (int k = 0; k < 40; ++k) b.step();
-    const auto dir = cdtest::scratch_dir("test_shear3", kappa > 0 ? "ckpt_compliant" : "ckpt");
+    const auto dir = cdtest::scratch_dir("test_shear3", cs.name);
     const std::string path = (dir / "checkpoint.bin").string();
     save_checkpoint3(path, b, 5);
     World3 c = make();
@@ -315,6 +324,11 @@ TEST(Shear3Cell, CheckpointResumesBitIdenticallyOnOneOrTwoThreads) {
     EXPECT_EQ(c.cell().le_offset, a.cell().le_offset);
     EXPECT_EQ(c.cell().strain, a.cell().strain);
     EXPECT_EQ(a.params().stiffness > 0, kappa > 0);
+    if (cs.eta > 0) {
+      int pulling = 0;  // bonds in tension at the end: the case is exercised
+      for (const SphereRow& r : a.rows()) pulling += r.r[0] < 0.0;
+      EXPECT_GT(pulling, 0);
+    }
   }
 }
 
