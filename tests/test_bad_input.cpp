@@ -123,6 +123,11 @@ TEST(BadInput, CompliantContactsAreRefusedWhereTheyCannotApply) {
   expect_refused("--set contact.stiffness_number=1e5", {"contact.stiffness_number", "shear.pressure"}, pile3d);
   expect_refused("--set contact.stiffness=1e6 --set contact.e_n=0.5", {"contact.stiffness", "restitution"}, pile3d);
   expect_refused("--set contact.stiffness=1e-300", {"contact.stiffness"}, pile3d);
+  // k_t / k: only with compliant contacts, > 0 and at most 1e3.
+  expect_refused("--set contact.stiffness_ratio=0.5", {"contact.stiffness_ratio = 0.5", "without compliant"}, pile3d);
+  expect_refused("--set contact.stiffness=1e6 --set contact.stiffness_ratio=0", {"contact.stiffness_ratio"}, pile3d);
+  expect_refused("--set contact.stiffness=1e6 --set contact.stiffness_ratio=1e4", {"contact.stiffness_ratio", "1e3"},
+                 pile3d);
   const std::string shear3 = "name = \"s\"\ndimension = 3\n[gravity]\ng = [0.0, 0.0, 0.0]\n[particles]\nn = 0\n[shear]\nmode = \"periodic\"\n"
                              "pressure = 1e5\ninertial_number = 0.01\nstrain = 0.1\ndt_tp = 0.05\n";
   expect_refused("--set contact.stiffness=1e7 --set contact.stiffness_number=1e5",

@@ -245,6 +245,60 @@ TEST(Compliant3, SameBitsOnOneAndTwoThreads) {
   EXPECT_GT(rows1, 400u);
   EXPECT_EQ(h1, h2);
 }
+// The tangential spring (WorldParams3::stiffness_ratio = k_t / k): a sphere
+// resting on a plane, rotation locked (inv_I = 0, so W = I / m and the
+// tangential and normal components do not couple), its normal spring
+// settled at m g (omega dt = 1: the step damps it by 2^-1/2), is set
+// sliding at v0 along x. While the contact sticks (the peak force v0
+// sqrt(k_t m) is 2 % of mu m g here) the tangential scheme is the backward
+// Euler oscillator of stiffness k_t, p' = (rho_t p - v) / (rho_t + 1/m),
+// rho_t = 1 / (k_t dt^2), v' = v + p'/m, run beside the world: its
+// impulses to round-off, then the continuous spring's peak force v0
+// sqrt(k_t m) within 1 % and its half period pi sqrt(m / k_t) within 2
+// steps, both set by k_t = 1e-4 k (omega_t dt = 0.01), not by k.
+TEST(Compliant3, TangentialSpringHasItsOwnStiffness) {
+  WorldParams3 p;
+  p.dt = 1e-4;
+  p.gravity = Vec3(0, 0, -kG);
+  p.mu = p.mu_wall = 0.5;
+  p.alert = 1e-4;
+  p.solver.tol = 1e-15;
+  p.solver.max_iter = 100;
+  const double r = 0.01, rho_s = 2600, v0 = 1e-3;
+  World3 w(p);
+  w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
+  const int s = w.bodies.add_sphere(Vec3(0.002, 0.003, r), r, rho_s);
+  w.bodies.vel[s].inv_I = 0.0;
+  const double m = w.bodies.mass[s];
+  p.stiffness = m / (p.dt * p.dt);  // omega dt = 1
+  p.stiffness_ratio = 1e-4;         // omega_t dt = 0.01
+  w.set_params(p);
+  for (int k = 0; k < 200; ++k) w.step();
+  ASSERT_EQ(w.rows().size(), 1u);
+  ASSERT_NEAR(w.rows()[0].r[0], m * kG * p.dt, 1e-12 * m * kG * p.dt);
+  const double kt = p.stiffness * p.stiffness_ratio, rho_t = 1.0 / (kt * p.dt * p.dt);
+  w.bodies.vel[s].v.x() = v0;
+  double v = v0, pt = 0.0, fmax = 0.0;
+  int first_zero = -1;
+  for (int k = 0; k < 1000; ++k) {
+    const double pn = (rho_t * pt - v) / (rho_t + 1.0 / m);
+    v += pn / m;
+    pt = pn;
+    w.step();
+    ASSERT_EQ(w.rows().size(), 1u) << k;
+    const double world_pt = w.rows()[0].to_world(w.rows()[0].r).x();
+    ASSERT_NEAR(world_pt, pt, 1e-9 * m * v0) << "step " << k;
+    ASSERT_NEAR(w.bodies.vel[s].v.x(), v, 1e-12 * v0) << "step " << k;
+    fmax = std::max(fmax, -pt / p.dt);
+    if (first_zero < 0 && k > 0 && pt > 0.0) first_zero = k;  // the force changes sign: half a period
+  }
+  const double F = v0 * std::sqrt(kt * m), T = std::numbers::pi * std::sqrt(m / kt);
+  std::printf("tangential spring (k_t = 1e-4 k): peak force %.6g N (v0 sqrt(k_t m) %.6g), sign change at step %d "
+              "(pi sqrt(m/k_t) = %.1f steps)\n", fmax, F, first_zero, T / p.dt);
+  EXPECT_NEAR(fmax, F, 0.01 * F);
+  EXPECT_NEAR(first_zero, T / p.dt, 2.0);
+}
+
 // A sphere of weight mg hanging under a ceiling by adhesion (pull-off f_a,
 // debonding distance 0.01 d): a compliant bond is a linear spring in
 // tension too. From the touching start the sphere sinks and settles (the

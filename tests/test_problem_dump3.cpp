@@ -246,8 +246,13 @@ TEST(ProblemDump3, EveryLawReplaysExactly) {
          p.mu_b = 0.2;
          p.mu_wall_b = 0.6;
        }},
-      // Compliant contacts: the file's version 2, its compliance line.
+      // Compliant contacts: the file's version 2, its compliance line; with
+      // k_t != k version 3, a compliance_t line too.
       {"compliant", [](cd::WorldParams3& p) { p.stiffness = 1e4; }},
+      {"compliant_kt", [](cd::WorldParams3& p) {
+         p.stiffness = 1e4;
+         p.stiffness_ratio = 0.5;
+       }},
   };
   for (const Variant& v : variants) {
     cd::Pile3dParams q;
@@ -280,12 +285,18 @@ TEST(ProblemDump3, EveryLawReplaysExactly) {
     std::printf("[ dump3 ] %-12s law %-24s %zu rows, %d sweeps, replay bit-identical: %s\n", v.name,
                 cd::law_name3(p.law).c_str(), p.rows.size(), st.iterations, differ ? "no" : "yes");
     // Braces: EXPECT_THROW is an if-else of its own (-Wdangling-else).
-    if (std::string(v.name) == "cohesive" || std::string(v.name) == "compliant") {
+    const bool compliant = std::string(v.name).starts_with("compliant");
+    if (std::string(v.name) == "cohesive" || compliant) {
       EXPECT_THROW(cd::to_matrix(p), std::invalid_argument);
     }
-    EXPECT_EQ(p.compliance > 0, std::string(v.name) == "compliant") << v.name;
-    EXPECT_EQ(text.rfind(p.compliance > 0 ? "cdlab-contact-problem3 2\n" : "cdlab-contact-problem3 1\n", 0), 0u)
-        << v.name;
+    EXPECT_EQ(p.compliance > 0, compliant) << v.name;
+    const char* header = !compliant                               ? "cdlab-contact-problem3 1\n"
+                         : std::string(v.name) == "compliant_kt" ? "cdlab-contact-problem3 3\n"
+                                                                 : "cdlab-contact-problem3 2\n";
+    EXPECT_EQ(text.rfind(header, 0), 0u) << v.name;
+    if (std::string(v.name) == "compliant_kt") {
+      EXPECT_EQ(p.tangential_compliance(), 2 * p.compliance);  // rho_t = rho / (k_t / k)
+    }
     if (std::string(v.name) == "orthotropic") {
       EXPECT_THROW(cd::write_fclib(cd::to_matrix(p), "unused.hdf5", "", ""), std::invalid_argument);
     }
@@ -304,18 +315,25 @@ TEST(ProblemDump3, MalformedFileNamesTheLine) {
   }
   std::istringstream law("cdlab-contact-problem3 1\nlaw sticky\n");
   EXPECT_THROW(cd::read_contact_problem3(law, "law.cdp3", s), std::runtime_error);
-  // Version 2 needs its compliance line, a finite number >= 0.
+  // Version 2 needs its compliance line, a finite number >= 0; version 3
+  // its compliance_t line too, a finite number > 0; there is no version 4.
   for (const char* bad : {"cdlab-contact-problem3 2\nlaw coulomb\ntol 0x1p-10\n",
                           "cdlab-contact-problem3 2\nlaw coulomb\ncompliance -0x1p+0\n",
                           "cdlab-contact-problem3 2\nlaw coulomb\ncompliance inf\n",
-                          "cdlab-contact-problem3 3\nlaw coulomb\n"}) {
+                          "cdlab-contact-problem3 3\nlaw coulomb\n",
+                          "cdlab-contact-problem3 3\nlaw coulomb\ncompliance 0x1p+0\ntol 0x1p-10\n",
+                          "cdlab-contact-problem3 3\nlaw coulomb\ncompliance 0x1p+0\ncompliance_t 0x0p+0\n",
+                          "cdlab-contact-problem3 4\nlaw coulomb\n"}) {
     std::istringstream v(bad);
     try {
       cd::read_contact_problem3(v, "v.cdp3", s);
       ADD_FAILURE() << "accepted: " << bad;
     } catch (const std::runtime_error& e) {
       const std::string m = e.what();
-      EXPECT_TRUE(m.find("v.cdp3:3:") != std::string::npos || m.find("v.cdp3:1:") != std::string::npos) << m;
+      EXPECT_TRUE(m.find("v.cdp3:2:") != std::string::npos || m.find("v.cdp3:3:") != std::string::npos ||
+                  m.find("v.cdp3:4:") != std::string::npos ||
+                  m.find("v.cdp3:1:") != std::string::npos)
+          << m;
     }
   }
 }

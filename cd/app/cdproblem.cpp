@@ -162,7 +162,12 @@ struct Step3 {
   static std::string describe(const Problem& p) {
     return fmt::format("{} rows, {} bodies, {} colours, {} cell dofs, law {}{}", p.rows.size(), p.vel.size(),
                        p.colouring.split.size(), p.dofs.size(), cd::law_name3(p.law),
-                       p.compliance > 0 ? fmt::format(", compliant (rho = {:.6g})", p.compliance) : "");
+                       p.compliance > 0 ? fmt::format(", compliant (rho = {:.6g}{})", p.compliance,
+                                                           p.tangential_compliance() != p.compliance
+                                                               ? fmt::format(", rho_t = {:.6g}",
+                                                                             p.tangential_compliance())
+                                                               : "")
+                                        : "");
   }
   static cd::SolveStats solve(Problem& p, const cd::SolverParams& prm) { return cd::nlgs_solve3(p, prm); }
   static std::string impulses(const Problem& p) {

@@ -144,7 +144,7 @@ double kernel_updates_per_cpu_s(cd::World3 w, double compliance = 0.0) {
     prm = s;
   });
   w.step();
-  frozen.compliance = compliance;
+  frozen.compliance = compliance;  // k_t = k (compliance_t 0)
   prm.tol = 0.0;  // never met: exactly kKernelSweeps sweeps
   prm.residual_tol = 0.0;
   prm.max_iter = kKernelSweeps;

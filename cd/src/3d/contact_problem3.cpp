@@ -55,12 +55,13 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
   // Compliant contacts: the law's memory (the impulses at the start), and
   // the compliant block's reciprocals in the rows (coupling3.hpp).
   std::vector<Vec3> r0;
+  const double rho_t = p.tangential_compliance();
   if (p.compliance > 0) {
     r0.resize(n);
     for (int k = 0; k < n; ++k) {
       r0[k] = rows[k].r;
       rows[k].iwnn = 1.0 / (p.rows[k].wnn + p.compliance);
-      rows[k].iwtt = 1.0 / (p.rows[k].wtt + p.compliance);
+      rows[k].iwtt = 1.0 / (p.rows[k].wtt + rho_t);
     }
   }
   const SolveStats st = std::visit(
@@ -68,7 +69,7 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
         using L = decltype(law);
         if (p.compliance > 0) {
           sweep::CompliantCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size()), r0.data(),
-                                      p.compliance};
+                                      p.compliance, rho_t};
           return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
         }
         sweep::BodyCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size())};
@@ -104,9 +105,12 @@ Vec3 vec3(TextReader& rd, const std::string& what) {
 }  // namespace
 
 void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, std::ostream& out) {
-  out << "cdlab-contact-problem3 " << (p.compliance > 0 ? 2 : 1) << "\n";
+  // Version 1: rigid; 2: compliant, k_t = k; 3: compliant, k_t != k.
+  const bool split = p.tangential_compliance() != p.compliance;
+  out << "cdlab-contact-problem3 " << (p.compliance > 0 ? (split ? 3 : 2) : 1) << "\n";
   out << "law " << law_name3(p.law) << "\n";
   if (p.compliance > 0) out << "compliance " << x(p.compliance) << "\n";
+  if (p.compliance > 0 && split) out << "compliance_t " << x(p.tangential_compliance()) << "\n";
   problem_file::write_solver(out, prm);
   out << "bodies " << p.vel.size() << "\n";
   for (const BodyVel3& v : p.vel) out << fmt::format("{} {} {} {}\n", x3(v.v), x3(v.w), x(v.inv_m), x(v.inv_I));
@@ -125,14 +129,20 @@ void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, st
 ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name, SolverParams& prm) {
   TextReader rd(in, name);
   rd.expect("cdlab-contact-problem3", "at the start (not a cdlab 3D problem file)");
-  const long long version = rd.integer("the format version", 1, 2);
+  const long long version = rd.integer("the format version", 1, 3);
   ContactProblem3 p;
   p.law = problem_file::read_law<LocalLaw3>(rd, [](const LocalLaw3& l) { return law_name3(l); });
-  if (version == 2) {
-    rd.expect("compliance", "after the law (format version 2)");
+  if (version >= 2) {
+    rd.expect("compliance", fmt::format("after the law (format version {})", version));
     p.compliance = rd.number("the compliance");
     if (!(p.compliance >= 0) || !std::isfinite(p.compliance))
       rd.fail(fmt::format("the compliance is {}, not a finite number >= 0", p.compliance));
+  }
+  if (version == 3) {
+    rd.expect("compliance_t", "after the compliance (format version 3)");
+    p.compliance_t = rd.number("the tangential compliance");
+    if (!(p.compliance_t > 0) || !std::isfinite(p.compliance_t))
+      rd.fail(fmt::format("the tangential compliance is {}, not a finite number > 0", p.compliance_t));
   }
   problem_file::read_solver(rd, prm, "after the law");
   if (!(prm.tol > 0)) rd.fail(fmt::format("the tolerance is {}, not positive", prm.tol));

@@ -57,6 +57,10 @@ struct ContactProblem3 {
   // velocity per unit impulse the law adds to u (coupling3.hpp,
   // BodyCouplingT3); 0: rigid contacts.
   double compliance = 0.0;
+  // rho_t = 1 / (k_t dt^2) of the tangential springs (contact.stiffness_ratio
+  // k_t / k); 0: the same as compliance (k_t = k).
+  double compliance_t = 0.0;
+  double tangential_compliance() const { return compliance_t > 0 ? compliance_t : compliance; }
 };
 
 // Solves the problem in place (impulses, velocities, dofs) from the impulses

@@ -160,9 +160,10 @@ namespace sweep {
 // row's law acts on u + rho (r - r0) in place of u, r0 the row's impulse at
 // the solve's start (the warm start, the previous step's impulse), rho =
 // 1 / (k dt^2): an implicit linear spring of stiffness k on the normal and
-// tangential displacements of the step, Signorini and Coulomb kept (method:
-// docs/method.md section 15). Its block is W + rho I, whose reciprocals
-// the rows then hold (iwnn = 1 / (W_nn + rho), iwtt likewise:
+// (k_t = k / rho_t dt^2) the tangential displacements of the step,
+// Signorini and Coulomb kept (method: docs/method.md section 15). Its
+// block is W + diag(rho, rho_t, rho_t), whose reciprocals the rows then
+// hold (iwnn = 1 / (W_nn + rho), iwtt = 1 / (W_tt + rho_t):
 // nlgs_solve3), so the stick trial is g = r - (u + rho (r - r0)) iwnn
 // without a division, and the cell dofs' damped update and the law
 // residual's scale see the compliant block. The rigid instance
@@ -225,13 +226,18 @@ struct BodyCouplingT3 {
   // zeroed each time); nbodies is the size of vel.
   int nbodies = 0;
   // Compliant: the impulses at the solve's start, same index as the rows
-  // from `base`, and rho (velocity per impulse).
+  // from `base`, and rho (velocity per impulse), rho_t of the tangential
+  // springs (k_t = k: rho_t = rho).
   const Vec3* r0 = nullptr;
-  double rho = 0.0;
-  // The velocity the law sees: u, and rho (r - r0) on a compliant row.
+  double rho = 0.0, rho_t = 0.0;
+  // The velocity the law sees: u, and rho (r - r0) on a compliant row
+  // (rho_t on the tangential components).
   Vec3 law_velocity(const SweepRow3& r) const {
     const Vec3 u = velocity(r);
-    if constexpr (Compliant) return u + rho * (r.r - r0[&r - base]);
+    if constexpr (Compliant) {
+      const Vec3 d = r.r - r0[&r - base];
+      return Vec3(u[0] + rho * d[0], u[1] + rho_t * d[1], u[2] + rho_t * d[2]);
+    }
     return u;
   }
   template <class L>
@@ -260,8 +266,8 @@ struct BodyCouplingT3 {
     free[1] = free[2] = sticks ? 1.0 : 0.0;
   }
   // y = W p on the rows listed in live, through s (offsets and b_n left
-  // out; compliant: (W + rho I) p); the other rows' p is zero and their y is
-  // not read.
+  // out; compliant: (W + diag(rho, rho_t, rho_t)) p); the other rows' p is
+  // zero and their y is not read.
   [[gnu::flatten]] void subspace_apply(const SweepRow3* R, const std::vector<int>& live, const double* p, double* y,
                                        Scratch& s) const {
     for (BodyVel3& b : s) {
@@ -280,8 +286,8 @@ struct BodyCouplingT3 {
       y[3 * i + 2] = r.t2.dot(dv) - r.t1.dot(om);
       if constexpr (Compliant) {
         y[3 * i] += rho * p[3 * i];
-        y[3 * i + 1] += rho * p[3 * i + 1];
-        y[3 * i + 2] += rho * p[3 * i + 2];
+        y[3 * i + 1] += rho_t * p[3 * i + 1];
+        y[3 * i + 2] += rho_t * p[3 * i + 2];
       }
     }
   }
@@ -347,8 +353,8 @@ struct BodyCouplingT3 {
       const Vec3 d = r.r - *z0;
       g[0] = r.r[0] - (u[0] + rho * d[0]) * r.iwnn;
       if constexpr (L::tangential) {
-        g[1] = r.r[1] - (u[1] + rho * d[1]) * r.iwtt;
-        g[2] = r.r[2] - (u[2] + rho * d[2]) * r.iwtt;
+        g[1] = r.r[1] - (u[1] + rho_t * d[1]) * r.iwtt;
+        g[2] = r.r[2] - (u[2] + rho_t * d[2]) * r.iwtt;
       } else {
         g[1] = g[2] = 0.0;
       }

@@ -188,6 +188,7 @@ WorldParams3 world_params3(const Scene& s0) {
   p.adhesion = pull_off_force(s);  // contact.adhesion, or eta p d^2 with d = p.d_ref
   p.debond = s.debond * p.d_ref;
   p.stiffness = contact_stiffness(s);
+  p.stiffness_ratio = s.stiffness_ratio;
   p.e_n = s.e_n;  // restitution by mean velocities (method.md section 14)
   p.e_t = s.e_t;
   p.solver.tol = s.tol;

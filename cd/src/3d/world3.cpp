@@ -74,6 +74,7 @@ void World3::configure() {
   extras_on_ = friction_on_ && (offsets || prm_.orthotropic);
   prob_.law = choose_law3(friction_on_, adhesion_on_, offsets, prm_.orthotropic);
   prob_.compliance = prm_.stiffness > 0.0 ? 1.0 / (prm_.stiffness * prm_.dt * prm_.dt) : 0.0;
+  prob_.compliance_t = prm_.stiffness > 0.0 && prm_.stiffness_ratio != 1.0 ? prob_.compliance / prm_.stiffness_ratio : 0.0;
 }
 
 PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const {

@@ -63,6 +63,7 @@ struct WorldParams3 {
   // contact's displacements over a step, r0 its previous impulse (the warm
   // start); the overlap projection stays rigid. 0: rigid contacts.
   double stiffness = 0.0;
+  double stiffness_ratio = 1.0;  // k_t / k (compliant contacts)
   double d_ref = 1.0;  // length scale for overlaps (mean diameter)
   SolverParams solver;
 

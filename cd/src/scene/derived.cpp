@@ -178,12 +178,18 @@ void check_derived(const Scene& s) {
                                                                  : "contact.cohesion_number x shear.pressure x d")
                                              : "contact.adhesion"));
   }
+  if (s.stiffness_ratio != 1.0 && !(s.stiffness > 0 || s.stiffness_number > 0))
+    fail(fmt::format("contact.stiffness_ratio = {} without compliant contacts (contact.stiffness or "
+                     "contact.stiffness_number > 0): rigid contacts have no stiffness to divide",
+                     s.stiffness_ratio));
   if (s.stiffness > 0 || s.stiffness_number > 0) {
     const char* key = s.stiffness_number > 0 ? "contact.stiffness_number" : "contact.stiffness";
     if (s.dimension != 3)
       fail(fmt::format("{} > 0: compliant contacts are 3D only (2D contacts are rigid)", key));
     if (s.stiffness > 0 && s.stiffness_number > 0)
       fail("give contact.stiffness or contact.stiffness_number, not both");
+    if (!(s.stiffness_ratio <= 1e3))
+      fail(fmt::format("contact.stiffness_ratio = {} (k_t / k): at most 1e3", s.stiffness_ratio));
     if (s.stiffness_number > 0 && !(s.pressure > 0))
       fail("contact.stiffness_number > 0 needs shear.pressure > 0 (k = kappa p d, p in N/m^2); without an "
            "imposed pressure give the stiffness itself, contact.stiffness (N/m)");

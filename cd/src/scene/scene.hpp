@@ -146,6 +146,8 @@ struct Scene {
   double cohesion_number = 0.0;
   // [contact] stiffness_number: kappa > 0 gives k = kappa p d (3D)
   double stiffness_number = 0.0;
+  // [contact] stiffness_ratio: k_t / k of compliant contacts (3D)
+  double stiffness_ratio = 1.0;
 
   double mu_w() const { return mu_wall < 0 ? mu : mu_wall; }
 };
