@@ -159,15 +159,16 @@ struct Step2 {
 struct Step3 {
   using Problem = cd::ContactProblem3;
   static Problem read(const std::string& path, cd::SolverParams& prm) { return cd::read_contact_problem3(path, prm); }
+  // ", compliant (rho = ...)" with rho_t when k_t != k; "" if rigid.
+  static std::string compliance(const Problem& p) {
+    if (!(p.compliance > 0)) return "";
+    const double rt = p.tangential_compliance();
+    return rt != p.compliance ? fmt::format(", compliant (rho = {:.6g}, rho_t = {:.6g})", p.compliance, rt)
+                              : fmt::format(", compliant (rho = {:.6g})", p.compliance);
+  }
   static std::string describe(const Problem& p) {
     return fmt::format("{} rows, {} bodies, {} colours, {} cell dofs, law {}{}", p.rows.size(), p.vel.size(),
-                       p.colouring.split.size(), p.dofs.size(), cd::law_name3(p.law),
-                       p.compliance > 0 ? fmt::format(", compliant (rho = {:.6g}{})", p.compliance,
-                                                           p.tangential_compliance() != p.compliance
-                                                               ? fmt::format(", rho_t = {:.6g}",
-                                                                             p.tangential_compliance())
-                                                               : "")
-                                        : "");
+                       p.colouring.split.size(), p.dofs.size(), cd::law_name3(p.law), compliance(p));
   }
   static cd::SolveStats solve(Problem& p, const cd::SolverParams& prm) { return cd::nlgs_solve3(p, prm); }
   static std::string impulses(const Problem& p) {

@@ -159,9 +159,9 @@ namespace sweep {
 // Compliant (contact.stiffness > 0; ContactProblem3::compliance): every
 // row's law acts on u + rho (r - r0) in place of u, r0 the row's impulse at
 // the solve's start (the warm start, the previous step's impulse), rho =
-// 1 / (k dt^2): an implicit linear spring of stiffness k on the normal and
-// (k_t = k / rho_t dt^2) the tangential displacements of the step,
-// Signorini and Coulomb kept (method: docs/method.md section 15). Its
+// 1 / (k dt^2): an implicit linear spring of stiffness k on the normal
+// displacement of the step and of k_t (rho_t = 1 / (k_t dt^2)) on the
+// tangential ones, Signorini and Coulomb kept (method: docs/method.md section 15). Its
 // block is W + diag(rho, rho_t, rho_t), whose reciprocals the rows then
 // hold (iwnn = 1 / (W_nn + rho), iwtt = 1 / (W_tt + rho_t):
 // nlgs_solve3), so the stick trial is g = r - (u + rho (r - r0)) iwnn

@@ -30,7 +30,6 @@ Quat rotate(const Quat& q, const Vec3& w, double h) {
 void World3::configure() {
   gravity_on_ = prm_.gravity.squaredNorm() > 0.0;
   adhesion_on_ = prm_.adhesion > 0.0;
-  compliant_ = prm_.stiffness > 0.0;
   restitution_on_ = prm_.e_n > 0.0 || prm_.e_t > 0.0;
   const bool periodic = prm_.periodic[0] || prm_.periodic[1] || prm_.periodic[2];
   for (int a = 0; a < 3; ++a)
@@ -74,7 +73,9 @@ void World3::configure() {
   extras_on_ = friction_on_ && (offsets || prm_.orthotropic);
   prob_.law = choose_law3(friction_on_, adhesion_on_, offsets, prm_.orthotropic);
   prob_.compliance = prm_.stiffness > 0.0 ? 1.0 / (prm_.stiffness * prm_.dt * prm_.dt) : 0.0;
-  prob_.compliance_t = prm_.stiffness > 0.0 && prm_.stiffness_ratio != 1.0 ? prob_.compliance / prm_.stiffness_ratio : 0.0;
+  // k_t = k: 0, the tangential springs take the normal compliance.
+  prob_.compliance_t =
+      prm_.stiffness > 0.0 && prm_.stiffness_ratio != 1.0 ? prob_.compliance / prm_.stiffness_ratio : 0.0;
 }
 
 PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const {
@@ -164,7 +165,7 @@ void World3::build_rows([[maybe_unused]] const B& b) {
     // bond in tension (its previous impulse negative, the bond holding) has
     // no gap term: its gap is its spring's stretch, F/k, not a distance
     // still to close (method.md section 15).
-    const bool stretched = compliant_ && r.r[0] < 0.0 && r.adh > 0.0;
+    const bool stretched = prob_.compliance > 0.0 && r.r[0] < 0.0 && r.adh > 0.0;
     r.bn = gap > 0.0 ? (stretched ? 0.0 : gap / dt) : prm_.overlap_correction * gap / dt;
     // A contact with a moving image of body 2: across y (Lees-Edwards) the
     // image moves at iy le_velocity e_x more than body 2; with cell lengths

@@ -211,7 +211,7 @@ class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
   // dofs_on_: the cell's lengths at imposed stress (a Cell3's or a
   // LeesEdwardsCell3's).
   bool gravity_on_ = false, adhesion_on_ = false, restitution_on_ = false, extras_on_ = false,
-       dofs_on_ = false, friction_on_ = false, compliant_ = false;
+       dofs_on_ = false, friction_on_ = false;
   double alert_ = 0.0;
   double le_velocity_ = 0.0;  // V of the step (LeesEdwardsCell3)
   std::vector<Vec3> xm_;
