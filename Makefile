@@ -69,6 +69,8 @@ help:
 	@echo "  make campaign-angularity        each shape of ANGULAR_NS (2D) at ANGULAR_I"
 	@echo "  make campaign-pressure          steady shear at PRESSURE_I under each p of PRESSURE_P"
 	@echo "  make campaign-pressure-ladder   the same from the lowest p up, each from the point below"
+	@echo "  make validate-angularity        the polygon study's shapes at VAL_I in the bi-periodic cell into VALIDATE"
+	@echo "                                  (N = VAL_N, size ratio 4; hours a shape; docs/validation.md)"
 	@echo "  make campaign-status [CAMPAIGN=inertial]  each run: done / running / not started / failed / stopped,"
 	@echo "                       its progress, cost (CPU, steps) and ETA (every campaign in CAMPAIGNS unless CAMPAIGN)"
 	@echo "  (each campaign folder's manifest.toml holds what made it: make refuses to add runs made with another"
@@ -110,6 +112,11 @@ help:
 	$(call help_var,COHESIVE_TOL,its solver.tol)
 	$(call help_var,ANGULAR_NS,polygon sides of campaign-angularity (0: disks))
 	$(call help_var,ANGULAR_I,its inertial number)
+	$(call help_var,VALIDATE,make validate-angularity's folder)
+	$(call help_var,VAL_N,its grains)
+	$(call help_var,VAL_NS,its shapes (polygon sides; 0: disks))
+	$(call help_var,VAL_I,its inertial number)
+	$(call help_var,VAL_STRAIN,its strain)
 	$(call help_var,PRESSURE_P,pressures of campaign-pressure[-ladder])
 	$(call help_var,PRESSURE_I,their inertial number)
 	$(call help_var,CKPT_STRAIN,checkpoint every this much strain)
@@ -512,6 +519,28 @@ $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done | $(CAMPAIGNS)/
 	$(if $(dim3),@echo "campaign-angularity is 2D only (3D grains are spheres)"; exit 2)
 	$(call shear_run,$(ANGULAR_I),$*)
 	touch $@
+
+# ---- Validation: the angularity study (docs/validation.md) -----------------
+# The polygon study of Azema, Estrada & Radjai (PRE 86, 041301, 2012):
+# regular polygons of VAL_NS sides and disks (0), circumscribed diameters
+# d_max/d_min = 4 with equal area per size class, mu_p = 0.4, e = 0, sheared
+# at I = VAL_I to strain VAL_STRAIN in the bi-periodic Lees-Edwards cell at
+# imposed p, one campaign folder per protocol under VALIDATE (prep/, the
+# compacted samples; angularity/, the shear runs), resumable like every
+# campaign (make -j, checkpoints, manifests, campaign-status with
+# CAMPAIGNS=$(VALIDATE)). N = 1000: the smallest N the study's fits are
+# read at, and what one 2-core machine shears to strain 3 at I = 1e-3 in a
+# few CPU hours a shape (docs/validation.md).
+VALIDATE ?= outputs/validation
+VAL_N ?= 1000
+VAL_NS ?= 0 6 3 4 5 7 8 10 12 20 60
+VAL_I ?= 0.001
+VAL_STRAIN ?= 3
+val_vars = CAMPAIGNS=$(VALIDATE) DIM=2 N=$(VAL_N) SIZE_RATIO=4 SIZE_DIST=uniform_area STRAIN=$(VAL_STRAIN) \
+  ANGULAR_NS="$(VAL_NS)" ANGULAR_I=$(VAL_I) SHEAR_TOL= SHEAR_SET= PREP_SET=
+.PHONY: validate-angularity
+validate-angularity: programs
+	+$(MAKE) --no-print-directory $(val_vars) campaign-angularity
 
 # ---- Frozen dense-shear problems (issue 14, item 2; tests/data/frozen-shear) --
 # Steady bi-periodic shear of N disks (ns_0) and hexagons (ns_6) at p = P,
