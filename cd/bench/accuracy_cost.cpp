@@ -1,4 +1,4 @@
-// accuracy_cost: what accuracy costs in time (issue 6, part 4).
+// accuracy_cost: what accuracy costs in time.
 //
 // Scene: a settled pile of N disks in a box (pile.hpp: the default scene's
 // disks, mu = 0.4, alert 0.1 d) loaded from rest: at t = 0 every velocity

@@ -1,4 +1,4 @@
-// accuracy_cost3: the 3D part of `make accuracy-cost` (issue 12): what the
+// accuracy_cost3: the 3D part of `make accuracy-cost`: what the
 // polyhedral-cone LCP (lemke3.hpp, Lemke's method on the cone replaced by e
 // face pairs) costs and how far it is from the exact round cone, against
 // e and as contacts grow, next to the production NLGS (exact local solver,

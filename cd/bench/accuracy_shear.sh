@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The table of `make accuracy-shear` (Makefile, issue 14 item 1): for every
+# The table of `make accuracy-shear` (Makefile): for every
 # run folder DIR/ns_<s>/I_<I>/<setting>/, the steady means and error bars of
 # q/p (mu*), packing fraction and z (cdanalysis steady: detected window,
 # batch-means error bar), what the run cost (summary.toml), and each setting's

@@ -1,4 +1,4 @@
-// cdbench: what the contact dynamics costs (issue 6). Google Benchmark runs
+// cdbench: what the contact dynamics costs. Google Benchmark runs
 // over prepared piles of disks (pile.hpp); every timed solve runs a fixed
 // number of sweeps (eps_f = 0, max_iter = kSweeps) unless the name says
 // "converged", so that two runs compare the cost of the same work.

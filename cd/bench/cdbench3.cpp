@@ -1,4 +1,4 @@
-// cdbench3: what the 3D sphere step costs (issue 12, item 4's 3D part), run
+// cdbench3: what the 3D sphere step costs, run
 // by `make bench` after cdbench. Measures only; nothing is asserted.
 //
 // Scenes: N = 1e3 is pile3d (configs/pile3d.toml's scene, make_pile3d)
@@ -19,7 +19,8 @@
 // sweeps and time, and the sweep alone: one step's contact problem frozen
 // and solved again with exactly kKernelSweeps sweeps, timed in CPU seconds
 // of the process (best of kKernelRuns), so that the figure holds on a
-// loaded machine where the wall clock does not (issue 30's contact update).
+// loaded machine where the wall clock does not (wall-clock figures scattered
+// 1.8-3.1x between runs on a shared machine; this one repeated to 1 %).
 // --out DIR writes
 //   bench3.csv    one line per (N, threads)
 //   summary3.csv  2-thread speedups of the step and the solve, updates/s

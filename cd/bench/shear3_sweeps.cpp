@@ -1,5 +1,5 @@
-// Where the sweeps of a 3D dense-shear step go (issue 30): a World3 built
-// from a scene (typically configs/shear3-inertial.toml started from a
+// Where the sweeps of a 3D dense-shear step go (docs/accuracy.md): a World3
+// built from a scene (typically configs/shear3-inertial.toml started from a
 // sheared checkpoint) is stepped normally, and on chosen steps the same step
 // is taken again from copies of the world with the sweep stopped after k
 // sweeps (tol 0, max_iter k) for k on a ladder up to a reference. Each copy

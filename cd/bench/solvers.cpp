@@ -1,5 +1,5 @@
-// solvers: a study of contact solvers on frozen step problems (issue 14,
-// item 3). Every solver starts from the problem as dumped (cdsim
+// solvers: a study of contact solvers on frozen step problems
+// (docs/accuracy.md). Every solver starts from the problem as dumped (cdsim
 // --dump-problem: the step's warm start) and is judged by the same two
 // figures, computed the same way for all:
 //   residual  the production law residual (law.hpp law_residual per row, the

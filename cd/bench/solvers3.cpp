@@ -1,4 +1,4 @@
-// solvers3: accelerations of the 3D sweep on a frozen step (issue 30), by
+// solvers3: accelerations of the 3D sweep on a frozen step, by
 // what they do to the loaded-contact set, the figure whose slow convergence
 // biases z in dense shear (docs/accuracy.md, "Why z moves"). A .cdp3 step
 // (cdsim --dump-problem) is put in matrix form (to_matrix: W = H^T M^-1 H

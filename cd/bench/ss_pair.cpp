@@ -1,6 +1,5 @@
 // ss_pair: does solving the two points of a side-side (ss) contact as one
 // block ("forcing equal sliding", ss_pair.hpp) cut NLGS iterations and time?
-// Issue #3, item 3.
 //
 // 1. Unit check of the pair solver: the 4x4 cross blocks against the
 //    assembled H^T M^-1 H (cd::assemble_problem), then random pair problems

@@ -1,5 +1,6 @@
 // tensile: tensile strength of a cohesive aggregate against the time step
-// (issue 4, item 1: "effective cohesion in CD is known to depend on dt").
+// (effective cohesion in CD is known to depend on dt; this measures by how
+// much).
 //
 // Units: mean diameter d = 1, areal density 1, pull-off force f_a = 1, so
 // the mass of a mean disk is m = pi/4 and the time unit of cohesion is
@@ -47,7 +48,7 @@
 // the ceiling's travel, first seed), DIR/machine.csv, DIR/plots.gp and, with
 // gnuplot, DIR/tensile.png.
 //
-// 3D (after the 2D study, or alone with --dim 3; issue 13 item 3): sphere
+// 3D (after the 2D study, or alone with --dim 3; the same dt study): sphere
 // blocks with closed-form strengths (cd/bench/tensile3.hpp: a chain, f_a; a
 // simple-cubic block of k x k columns, k^2 f_a; an FCC block stacked along
 // [001], bonds at 45 degrees, (spheres a layer) 4 f_a / sqrt(2)) pulled

@@ -1,5 +1,5 @@
 // The 3D tensile test of a cohesive sphere block against the time step
-// (issue 13 item 3: "the same dt study as 2D"), shared by cd/bench/tensile
+// (the same dt study as 2D), shared by cd/bench/tensile
 // (`--dim 3`, the study of `make tensile`) and tests/test_cohesion3.cpp
 // (a quick version).
 //
