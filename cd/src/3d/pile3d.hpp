@@ -1,5 +1,5 @@
-// The pile3d deposition scene of issue 12 (the scene LIGGGHTS and YADE were
-// measured on): N spheres, r ~ U[0.5, 1] r_mean, density 2600 kg/m^3, on a
+// The pile3d deposition scene, the benchmark scene LIGGGHTS and YADE were
+// measured on: N spheres, r ~ U[0.5, 1] r_mean, density 2600 kg/m^3, on a
 // cubic lattice n x n x ceil(N/n^2), n = ceil(N^(1/3)), pitch 2.2 r_max,
 // uniform jitter +-0.05 r_mean, bottom layer at 1.1 r_max, in a square box
 // of side n pitch (floor and four walls); g = 9.81, mu = 0.4, no restitution.

@@ -1,5 +1,5 @@
 // The stage table of a time step: names, order and wall-clock timers. The
-// step of any engine (2D today) runs these stages; their names are the
+// step of either engine (2D and 3D) runs these stages; their names are the
 // series columns t_<name> and the checkpoint's record of the timers.
 #pragma once
 #include <array>

@@ -1,10 +1,11 @@
 // The NLGS sweep (method.md section 5), written once over a "coupling": how a
-// row sees the impulses of the others, and over the row type (2D rows
-// today, 3D rows next). 2d/coupling.hpp couples rows through the velocities
-// of the bodies they touch (the simulator's steps); 2d/problem.cpp through
-// the off-diagonal blocks of W (frozen problems in matrix form). The sweep
-// order, the convergence test, the boundary dofs and the residuals are this
-// code for both, so a frozen problem is replayed by the production solver.
+// row sees the impulses of the others, and over the row type (2D and 3D
+// rows). 2d/coupling.hpp and 3d/coupling3.hpp couple rows through the
+// velocities of the bodies they touch (the simulator's steps); 2d/problem.cpp
+// and 3d/problem3.cpp through the off-diagonal blocks of W (frozen problems
+// in matrix form). The sweep order, the convergence test, the boundary dofs
+// and the residuals are this code for all of them, so a frozen problem is
+// replayed by the production solver.
 // Studies that visit rows in their own order (cd/bench/ss_pair) use the
 // coupling's update, the sweep's own row update, rather than a copy, and
 // solve_units, this sweep's convergence test and residuals in their order.
@@ -17,7 +18,8 @@
 //       A coupling with `static constexpr bool kNormBound = true` gives in
 //       pabs a cheap upper bound of |p| instead (3D: |p_n| + |p_t1| +
 //       |p_t2|, no square root); the sweep then sums the exact |p| only on
-//       the sweeps where the bound cannot rule the stop out (LazyNorm).
+//       the sweeps where the bound cannot rule the stop out (norm_bound,
+//       exact_psum below), so the stop is that of the exact sum.
 // and the row type provides, found by argument-dependent lookup,
 //   double row_residual(const C& c, const Row& r)   the law residual of r
 //   double impulse_norm(const Row& r)               |p| of r
