@@ -1,16 +1,17 @@
-// A frozen 3D dense-shear step (issue 30): the contact problem of one step
+// A frozen 3D dense-shear step: the contact problem of one step
 // of 500 spheres in steady tri-periodic shear at I = 1e-2 and p = 1e5 N/m^2
 // (tests/data/frozen-shear3, README there: `make frozen-shear3`), solved
 // by the production solver:
 //   policy  solver.tol 7e-4 with the subspace correction (10 CG
-//           iterations; the 3D campaign's setting at I = 1e-2 since the
-//           seventh session: configs/shear3-inertial.toml,
-//           scene/shear_policy.hpp's tol_subspace);
-//   anderson  solver.tol 5e-4 with Anderson memory 5 (the policy of the
-//           sixth session, tol_anderson);
-//   plain   solver.tol 1e-3, plain NLGS (the policy before; the run the
-//           step was dumped from);
-//   fast    solver.tol 3e-3 with Anderson memory 5 (issue 30's fast setting);
+//           iterations; the 3D campaign's setting at I = 1e-2:
+//           configs/shear3-inertial.toml, the band's `subspace` stop in
+//           scene/shear_policy.hpp);
+//   anderson  solver.tol 5e-4 with Anderson memory 5 (the band's `anderson`
+//           stop: what a scene with Anderson's mixing gets at I = 1e-2);
+//   plain   solver.tol 1e-3, plain NLGS (the band's `plain` stop; the run
+//           the step was dumped from);
+//   fast    solver.tol 3e-3 with Anderson memory 5 (the fast setting of
+//           `make accuracy-shear3`, docs/accuracy.md);
 //   compliant  the policy's solve with compliant contacts (contact.stiffness
 //           k = kappa p d, kappa = 1e5 and 1e4; coupling3.hpp's
 //           BodyCouplingT3): the same step, each row's law on u + rho (r -
@@ -57,9 +58,9 @@ struct Setting {
   int anderson, subspace;
   // Sweeps the solve took when measured, 1 and 2 threads: plain and fast
   // 2026-11-26 at main 0e2c4d4 with this test added (fast again, the same
-  // count, after the vectorised mix and the stall rule of 7189ba3); policy
-  // the same day at main 7aecd5e and after, when it became the policy;
-  // the subspace policy the same day, seventh session.
+  // count, after the vectorised mix and the stall rule of 7189ba3);
+  // anderson the same day at main 7aecd5e and after; policy (the subspace
+  // correction) the same day at 0cecee8.
   int sweeps;
   int cg;  // and the subspace corrections' CG iterations (each about a sweep's traffic)
   double kappa = 0.0;  // compliant contacts' k / (p d) (0: rigid)
@@ -76,7 +77,7 @@ const Setting kSettings[] = {
     {"anderson (tol 5e-4, anderson 5)", 5e-4, 5, 0, 224, 0},
     {"plain (tol 1e-3)", 1e-3, 0, 0, 390, 0},
     {"fast (tol 3e-3, anderson 5)", 3e-3, 5, 0, 22, 0},
-    // Measured 2026-11-27 (tenth session) when compliant contacts were added.
+    // Measured 2026-11-27, when compliant contacts were added.
     {"compliant kappa 1e5 (tol 7e-4, subspace 10)", 7e-4, 0, 10, 72, 170, 1e5},
     {"compliant kappa 1e4 (tol 7e-4, subspace 10)", 7e-4, 0, 10, 27, 60, 1e4},
 };

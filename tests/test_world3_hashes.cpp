@@ -1,21 +1,22 @@
-// State hashes of the 3D scenes that the optional physics reaches (issue 27:
-// the ContactProblem3 seam, the law types and the boundary variant are pure
-// refactors). tests/world3_hash.hpp's four piles cover the default path;
-// these cover the rest: restitution, orthotropic cones on spheres and walls,
-// the tri-periodic cell compacted at imposed pressure, Lees-Edwards shear
-// with the height at imposed stress, with and without adhesion. The expected
-// values were recorded on main before the refactor (commit 6d4d12b, this
-// build's Release flags); a change that alters any of these paths by a bit
-// shows here. A stated bug fix changes the hashes of the scenes it touches,
-// and the comment beside the value says which fix. Changed so far: the
-// "orthotropic mu = 0" scene (0x05e69d0165f636ff before), when the build
-// stage stopped zeroing the tangential warm start of an orthotropic cone
-// with mu = 0 and mu_b > 0 (one friction decision, World3::configure); all
-// six for a change of round-off only, when the sweep went over
-// contact3.hpp's SweepRow3 (issue 30; before: 0x28a4504330a780d8,
-// 0x565a602263430743, 0xb149e53c4568edb4, 0xb01270695a1cd9b4,
-// 0xe5c9f72700140155, 0x91302f7e2690f82c), checked by frozen steps of
-// every law solved both ways (impulses within 1.2e-14 of the largest).
+// State hashes of the 3D scenes that the optional physics reaches, so that
+// refactors of those paths (the ContactProblem3 seam, the law types, the
+// boundary variant) are shown to be pure. tests/world3_hash.hpp's four piles
+// cover the default path; these cover the rest: restitution, orthotropic
+// cones on spheres and walls, the tri-periodic cell compacted at imposed
+// pressure, Lees-Edwards shear with the height at imposed stress, with and
+// without adhesion. The expected values were recorded on main before the
+// refactor (commit 6d4d12b, this build's Release flags); a change that alters
+// any of these paths by a bit shows here. A stated bug fix changes the hashes
+// of the scenes it touches, and the comment beside the value says which fix.
+// Changed so far: the "orthotropic mu = 0" scene (0x05e69d0165f636ff before),
+// when the build stage stopped zeroing the tangential warm start of an
+// orthotropic cone with mu = 0 and mu_b > 0 (one friction decision,
+// World3::configure); all six for a change of round-off only, when the sweep
+// went over contact3.hpp's SweepRow3 (c53e3ac; the values before it:
+// 0x28a4504330a780d8, 0x565a602263430743, 0xb149e53c4568edb4,
+// 0xb01270695a1cd9b4, 0xe5c9f72700140155, 0x91302f7e2690f82c), checked by
+// frozen steps of every law solved both ways (impulses within 1.2e-14 of the
+// largest).
 #include <gtest/gtest.h>
 
 #include <cstdio>

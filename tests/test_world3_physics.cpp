@@ -1,4 +1,4 @@
-// The 3D engine's physics options (issue 12 items 1-3): restitution by mean
+// The 3D engine's physics options: restitution by mean
 // velocities (Newton's cradle, a ball's rebound, a rough elastic bounce),
 // orthotropic Coulomb on walls (the elliptic projection against law3's
 // general solver; sliding direction and acceleration on an anisotropic
@@ -36,11 +36,11 @@ constexpr double kG = 9.81;
 // existed, bit for bit: hashes recorded on commit cb1c628 (a standalone
 // build of its cd/src/3d with the same -O2 flags; tests/world3_hash.hpp).
 // Re-recorded once since, for a change of round-off only: the sweep's rows
-// as contact3.hpp's SweepRow3 (issue 30; before: 0xd9c05964c76f154e,
-// 0xab0eb47c9521ec65, 0x81f8628b9153b7c9, 0x7069d1e47d13c479), checked by
-// frozen steps of every law solved both ways (impulses within 1.2e-14 of
-// the largest after 3000 sweeps) and pile runs agreeing to 9 digits over
-// 150 steps.
+// as contact3.hpp's SweepRow3 (c53e3ac; the values before it:
+// 0xd9c05964c76f154e, 0xab0eb47c9521ec65, 0x81f8628b9153b7c9,
+// 0x7069d1e47d13c479), checked by frozen steps of every law solved both ways
+// (impulses within 1.2e-14 of the largest after 3000 sweeps) and pile runs
+// agreeing to 9 digits over 150 steps.
 TEST(World3Options, OffLeavesTheDefaultPathBitIdentical) {
   const std::uint64_t expect[4] = {0x3ef6f60f46f8baf7ull, 0xd265802c13d6ad6bull, 0xb5225d8fd73317f4ull,
                                    0x5f0fca0280d94942ull};
@@ -325,14 +325,14 @@ TEST(Orthotropic3, SlidesAlongTheEllipticLawsDirection) {
 // Starting at rest with |D^-1 g_t| = 0.95 g_n (direction 60 deg from a,
 // where a round cone of mu_b would slide) the sphere sticks, with friction
 // -m g_t dt; at 1.05 g_n it slides.
-// One friction decision (issue 27): an orthotropic cone with mu = 0 along
-// t1 and mu_b > 0 along t2 has friction, so the next step's warm start keeps
-// the remembered tangential impulse on the new frame. Before the fix the
-// build stage decided friction from mu and mu_wall alone and zeroed it,
-// while the law (which counted mu_b) solved with friction: each step started
-// its tangential impulses from 0. Checked on a settling pile: the rows
-// handed to the solver carry the previous step's impulse, re-projected,
-// tangential part included.
+// One friction decision (World3::configure): an orthotropic cone with mu = 0
+// along t1 and mu_b > 0 along t2 has friction, so the next step's warm start
+// keeps the remembered tangential impulse on the new frame. A build stage
+// that decided friction from mu and mu_wall alone would zero it while the
+// law (which counts mu_b) solves with friction: each step would start its
+// tangential impulses from 0. Checked on a settling pile: the rows handed to
+// the solver carry the previous step's impulse, re-projected, tangential
+// part included.
 TEST(Orthotropic3, WarmStartKeepsFrictionWhenOnlyMuBIsSet) {
   Pile3dParams q;
   q.n_spheres = 100;
@@ -662,7 +662,7 @@ TEST(Periodic3, SpherePlacedOutsideIsBroughtIn) {
   EXPECT_NEAR(w.cell().le_offset, 0.03 + 0.7 * p.dt, 1e-16);
 }
 
-// WorldParams3 is constant during a run (issue 27): what a Lees-Edwards
+// WorldParams3 is constant during a run: what a Lees-Edwards
 // cell with L_y at imposed stress changes (lengths, rates, offset, strain,
 // the images' velocity) is the world's state, World3::cell(). One sphere,
 // no contact: L_y falls under the load p L_x L_z of mass M (a = p A / M =
