@@ -1,4 +1,4 @@
-// cdanalysis on 3D runs (issue 13 item 5; docs/analysis.md, "3D runs"):
+// cdanalysis on 3D runs (docs/analysis.md, "3D runs"):
 // - the contact stress of a 3D snapshot against an exact sum (a cubic
 //   lattice through its periodic images, read back from a VTK file), and
 //   against the stress columns cdsim writes for the same step of a real
@@ -9,7 +9,7 @@
 //   independent batches of the sample), the scalars within 0.01;
 // - the stress-fabric relation q/p ~ (2/5)(a_c + a_n + a_t), q = (s1 - s3)/3,
 //   on contacts built from the definitions: exact to second order within
-//   sampling error, and the first-order form within 15 % (the issue's
+//   sampling error, and the first-order form within 15 % (the acceptance
 //   criterion) at steady-shear-like anisotropies and within 2 % at small ones;
 // - fit cohesion on 3D runs: c/p = mu - mu0(I) against a known model;
 // - dimension detection and the refusals.

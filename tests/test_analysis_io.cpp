@@ -360,7 +360,7 @@ TEST(AnalysisIo, CommandLineExitsNonZeroNamingTheFile) {
   EXPECT_EQ(rc, 0) << msg;
 }
 
-// ---- Bad input to the command line (issue 28: items 2, 5, 10, 11, 16) ----
+// ---- Bad input to the command line ------------------------------------------
 
 namespace {
 
@@ -501,7 +501,7 @@ TEST(AnalysisIo, SeriesRowsMustBeWholeAndGoForward) {
   expect_refused("backwards", good + "500,4.8,0.5,0.3\n", "line 52: time 4.8 is before the previous row's 4.9");
 }
 
-// Analyses never dead-end (issue 29, item 1): over a campaign with a run that
+// Analyses never dead-end: over a campaign with a run that
 // has no steady window and one whose series is damaged, the report is
 // written with both listed and exits 5 (kExitPartial: written with
 // reservations), fit mu-i leaves them out by name and fits the others

@@ -1,4 +1,4 @@
-// Bad input never runs, and a run that goes bad stops (issue 15): derived
+// Bad input never runs, and a run that goes bad stops: derived
 // quantities (steps, time step, pull-off force) are checked before anything
 // is written; start samples are checked against the scene; the watchdog
 // stops a run whose state turns non-finite with exit 3 and a message naming
@@ -83,7 +83,7 @@ void expect_refused(const std::string& sets, const std::vector<std::string>& wor
 }  // namespace
 
 TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
-  // The issue's cases, each once exit 0 with nothing simulated.
+  // Cases that would otherwise exit 0 with nothing simulated.
   expect_refused("--set time.duration=1e90", {"1e+09", "time.duration"});
   expect_refused("--set time.dt=1", {"less than one step", "time.dt"});
   expect_refused("--set time.duration=0", {"less than one step", "time.duration"});
@@ -179,8 +179,8 @@ TEST(Watchdog, NonFiniteStateStopsTheRunWithExitThree) {
 // timeout sends it, to the run and then to its whole process group (it
 // arrives twice within microseconds, one request), once series.csv has a
 // row at step 2000 of the 4000, seen by polling: mid-run whatever the
-// machine's speed and load (it used to be sent after half the wall time of
-// a first run, which could land anywhere or after the end).
+// machine's speed and load (half the wall time of a first run could land
+// anywhere, or after the end).
 TEST(Signals, TermStopsAtAStepBoundaryWithACheckpointTheRunResumesFrom) {
   const fs::path dir = cdtest::scratch_dir("bad_input", "signal");
   const std::string scene =
@@ -353,7 +353,7 @@ TEST(BadInput, CdproblemRefusesBadOptionsAndTrailingText) {
   }
 }
 
-// The .cdp reader (issue 28 item 4) refuses what no step can hold: a
+// The .cdp reader refuses what no step can hold: a
 // negative mu, adhesion or inverse mass, a contact of a body with itself, a
 // tolerance outside (0, 1], a residual tolerance <= 0, and counts the rest
 // of the file cannot hold (refused before anything is allocated); each
@@ -454,7 +454,7 @@ TEST(BadInput, NanAndOutOfRangeOptionsAreRefusedByName) {
   EXPECT_EQ(cdsim((dir / "t" / "scene.toml").string() + " -q --out " + (dir / "t2").string()).code, 0);
 }
 
-// Finite but absurd values (issue 28 items 8, 9, 12, 16): every scene
+// Finite but absurd values: every scene
 // number is 0 or between 1e-100 and 1e100 in magnitude (docs/errors.md
 // says why); a grain whose mass or inertia under- or overflows is refused
 // in 2D as in 3D; a body outside the box, which would fall for ever, is
@@ -489,7 +489,7 @@ TEST(BadInput, AbsurdValuesAndBodiesOutsideTheBoxAreRefused) {
   EXPECT_NE(r.out.find("room for 729 disks"), std::string::npos) << r.out;
 }
 
-// A 3D contact.axis_a whose norm under- or overflows (issue 28 item 7):
+// A 3D contact.axis_a whose norm under- or overflows:
 // [1e-300, 0, 0] and [1e308, 1e308, 0] are refused by name (a plain norm
 // dropped the orthotropic cone silently); at the ends of the range a scene
 // may give, [1e-100, 0, 0] runs as [1, 0, 0] and [1e100, 1e100, 0] as
@@ -521,7 +521,7 @@ TEST(BadInput, AxisAOfExtremeLengthIsItsDirection) {
   }
 }
 
-// Continuation (issue 19): a run may start from a sheared run's checkpoint.
+// Continuation: a run may start from a sheared run's checkpoint.
 // The Lees-Edwards offset and the cell rates are carried, the mean flow is
 // replaced by the new rate's profile, and the first rows overlap no more than
 // the old run did (resetting the offset, as before, overlapped grains across

@@ -1,4 +1,4 @@
-// Campaigns know their parameters (issue 29 item 2): make writes a manifest
+// Campaigns know their parameters: make writes a manifest
 // of what made a campaign folder, refuses, naming the difference, to add
 // runs made with another N or STRAIN to it (also under make -n, writing
 // nothing), accepts more values of I, and `make campaign-status` tells each

@@ -120,7 +120,7 @@ TEST(CdsimCli, MalformedSceneAndBadOverride) {
 }
 
 // A folder or a binary file given as the scene is named as such; the
-// binary's bytes are not echoed to the terminal (issue 28 item 16).
+// binary's bytes are not echoed to the terminal.
 TEST(CdsimCli, FolderOrBinaryGivenAsTheSceneIsNamed) {
   const fs::path d = temp_dir("binary");
   Result r = run(d.string() + " --out " + (d / "out").string());

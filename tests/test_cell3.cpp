@@ -1,4 +1,4 @@
-// The tri-periodic 3D cell (issue 13). Item 1, the observables: the contact
+// The tri-periodic 3D cell. First the observables: the contact
 // stress sum f (x) l / V with branch vectors through periodic and
 // Lees-Edwards images, its invariants, the kinetic stress about the mean
 // shear flow, and the series columns built from them (run3.hpp:
@@ -8,7 +8,8 @@
 // step's force on each contact is P/dt along n exactly. The branch vector
 // is the one of the step's contact, at the midpoint configuration (method.md
 // section 6): the centres have closed by dt/2 times their approach speed.
-// Item 2: the scene of a cell (placement, refusals, a run's columns); and a 3D checkpoint carrying the cell.
+// Then the scene of a cell (placement, refusals, a run's columns); and a 3D
+// checkpoint carrying the cell.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,5 +1,5 @@
-// The pressure control of a periodic cell at high inertial number (issue
-// 13 item 2; docs/shear.md, "The pressure control at high I"). A length at
+// The pressure control of a periodic cell at high inertial number
+// (docs/shear.md, "The pressure control at high I"). A length at
 // imposed stress is loaded by (p - K_aa) times its face, K the kinetic
 // stress, which must not count the grains' own dilation flow (closed-form
 // tests, no contacts). Then simple shear

@@ -693,7 +693,7 @@ TEST(CdsimRestart, ZeroIntervalWritesNoCheckpoint) {
 
 }  // namespace
 
-// ---- signals, one writer, write failures (issue 28) ----------------------------
+// ---- signals, one writer, write failures ------------------------------------
 
 // What summary.toml says of the run's physics (not of its sessions' cost).
 std::map<std::string, std::string> summary_physics(const fs::path& run) {

@@ -1,4 +1,4 @@
-// Cohesion in 3D (issue 13 item 3, docs/3d.md "Cohesion in 3D shear"): the
+// Cohesion in 3D (docs/3d.md "Cohesion in 3D shear"): the
 // cohesion number's pull-off force f_a = eta p d^2 in a tri-periodic run,
 // its refusals, the tensile strength of cohesive sphere blocks against the
 // time step (the quick version of `make tensile`'s 3D study,

@@ -1,4 +1,4 @@
-// Energy step by step in dissipative 3D scenes (issue 31 item 3): e = 0,
+// Energy step by step in dissipative 3D scenes: e = 0,
 // friction, cohesion. The 2D scenes are checked by tests/world_util.hpp's
 // run_watched (test_pile, test_polygon, test_cohesion), which derives the
 // balance and the solver's bound; this is its 3D sibling on World3's rows:

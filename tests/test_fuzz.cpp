@@ -1,4 +1,4 @@
-// Fuzzing the three tools' inputs (issue 15): seeded, reproducible random
+// Fuzzing the three tools' inputs: seeded, reproducible random
 // mutations of valid inputs, each run as a user would run it. The contract:
 //   cdsim:      exit 0 with every series value finite, or exit 2 (bad input)
 //               or 3 (diverged) with a message, and no output folder written
@@ -462,7 +462,7 @@ void corrupt_systematically(const std::string& label, const std::string& cmd, co
 }  // namespace
 
 // A checkpoint whose checksum matches is still input: every array length,
-// every number, every tag is checked before the state is used (issue 28).
+// every number, every tag is checked before the state is used.
 TEST(Fuzz, CheckpointsWithAValidChecksumAreStillValidated2D) {
   const fs::path dir = cdtest::scratch_dir("fuzz", "systematic2d");
   SceneLines pile = bases()[0];

@@ -1,4 +1,4 @@
-// The messages a newcomer meets first (issue 29 item 6): a misspelt scene key
+// The messages a newcomer meets first: a misspelt scene key
 // or command-line option gets the closest valid one, every message line
 // starts with the program's name, a shear scene run before its preparation
 // names the scene that makes the sample, and --help-scene reads in a

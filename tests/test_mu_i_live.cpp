@@ -1,4 +1,4 @@
-// A live check of the rheology (issue 31 item 2): the current simulator
+// A live check of the rheology: the current simulator
 // compacts a small sample and shears it at one inertial number, and its
 // steady friction and packing fraction must match the reference campaigns
 // of `make regress` (tests/data/regress*: the same scene settings, 100 disks

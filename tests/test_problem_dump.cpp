@@ -1,4 +1,4 @@
-// A step's contact problem taken out of the run and solved again (issue 11):
+// A step's contact problem taken out of the run and solved again:
 // the problem a World hands its solver is plain data; written in cdlab's
 // own format (.cdp) and read back, the production solver gives the same
 // impulses to the bit; in Siconos' matrix form (.dat, boundary dofs

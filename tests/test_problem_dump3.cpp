@@ -1,4 +1,4 @@
-// A 3D step's contact problem taken out of the run (issue 27): `cdsim
+// A 3D step's contact problem taken out of the run: `cdsim
 // --dump-problem STEP` on a 3D shear writes problem_STEP.cdp3 (cdlab's
 // exact text form), problem_STEP.hdf5 (FCLib's local form) and the step's
 // impulses; `cdproblem solve` replays the .cdp3 to the same impulses bit for

@@ -1,4 +1,4 @@
-// Identical runs give identical files (issue 27, item 6): the same scene run
+// Identical runs give identical files: the same scene run
 // twice, each into its own folder, gives byte-identical series.csv and VTK
 // snapshots, and a summary.toml that differs only in its cost record (wall
 // and CPU time, load average). Wall-clock stage timings, which differ from

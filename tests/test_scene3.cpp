@@ -1,4 +1,4 @@
-// `dimension = 3` scenes run by cdsim (issue 12, item 6): the scene -> World3
+// `dimension = 3` scenes run by cdsim: the scene -> World3
 // mapping (cd/src/3d/setup3), contacts in VTK (output3), 3D checkpoints
 // (checkpoint3) and the shared run loop (core/run_loop) driving World3:
 // resume bit-identical, 1 and 2 threads identical, the other dimension's

@@ -1,4 +1,4 @@
-// Shipped scenes run clean (issue 29 item 4): every configs/*.toml runs,
+// Shipped scenes run clean: every configs/*.toml runs,
 // briefly, without a warning that the scene does not explain. A scene
 // explains a warning it is known to give, at its own settings, by a comment
 // line
@@ -52,9 +52,9 @@ const std::map<std::string, std::string> kShort = {
 // The preparations first: the shear scenes start from them.
 const std::vector<std::string> kFirst = {"shear-prep", "shear3-prep"};
 
-// Warnings explained by the test, not by the scene: configs/shear3-prep.toml
-// is being reworked (made cheaper) by its owner this session; its note
-// belongs in the scene once that lands. Empty while its short run is clean.
+// Warnings explained by the test, not by the scene, for a scene that cannot
+// carry its own note yet (a note belongs in the scene). Empty: every scene
+// explains its own warnings.
 const std::map<std::string, std::vector<std::string>> kExplainedHere = {};
 
 // The quoted words of the scene's `# expected warning "...": why` lines.

@@ -1,4 +1,4 @@
-// The 3D tri-periodic protocol (issue 13 items 1-2, docs/3d.md "Tri-periodic
+// The 3D tri-periodic protocol (docs/3d.md "Tri-periodic
 // protocol"): the cell's lengths as boundary dofs at imposed pressure
 // (isotropic compaction: L_x, L_y, L_z at sigma_aa = p; shear: L_y at
 // sigma_yy = p), Lees-Edwards shear at imposed inertial number, shear.start

@@ -1,4 +1,4 @@
-// Size laws and the overlap users read (issue 18): explicit diameters (a
+// Size laws and the overlap users read: explicit diameters (a
 // list or a file), a periodic cell sized from the actual size law (so a
 // campaign at size ratio 4 needs no hand-made cell), and the largest overlap
 // relative to the smaller grain of the pair.

@@ -1,4 +1,4 @@
-// Friction between two spheres in 3D against closed forms (issue 31 item 1).
+// Friction between two spheres in 3D against closed forms.
 // Every other 3D friction test has a plane as body 1 (mu_wall); these put
 // the Coulomb law on sphere-sphere rows (mu, mu_b), so that a bug in those
 // rows alone (a halved mu, a wrong sign) changes an asserted number.

@@ -1,4 +1,4 @@
-// State hashes across refactors of the step (issue 11): each scene below is
+// State hashes across refactors of the step: each scene below is
 // run for a fixed number of steps and the raw bytes of its state (positions,
 // angles, velocities, cell, and the last step's impulses) are hashed. The
 // expected hashes were recorded on the code before the contact-problem seam
@@ -62,7 +62,7 @@ std::uint64_t run_case(const Case& c, int* contacts) {
 }
 
 // The piles as their scenes were when the hashes were taken: a sweep cap of
-// 500 (the scenes now set 2000 so that the impact converges: issue 29).
+// 500 (the scenes set 2000 so that the impact converges).
 const std::vector<std::string> kSmallPile = {"particles.n=120", "box.width=0.012",
                                              "box.height=0.03", "time.dt=5e-4", "solver.max_iter=500"};
 
@@ -81,7 +81,8 @@ const std::vector<Case>& cases() {
        with(kSmallPile, {"contact.e_n=0.5", "contact.e_t=0.2"}), 150, 0x12bde6b883f03700ull},
       {"cohesion", "default.toml",
        with(kSmallPile, {"contact.adhesion=2e-4", "contact.debond=0.02"}), 150, 0x3ab28c3c445bc922ull},
-      // (hexagons.toml now opens corner overlaps: contact.overlap_projection)
+      // (hexagons.toml opens corner overlaps, contact.overlap_projection: off
+      // here, as when the hash was taken)
       {"hexagons", "hexagons.toml", with(kSmallPile, {"contact.overlap_projection=0"}), 150, 0x8cf1cfeb9dcbc25dull},
       {"mixture", "mixture.toml", kSmallPile, 150, 0x992ed57c1a8cdd34ull},
       // The compaction under p with no rate bound and no projection, as
@@ -91,7 +92,7 @@ const std::vector<Case>& cases() {
                                          "shear.height=0.0185", "solver.tol=1e-3",
                                          "shear.compaction_rate=0", "contact.overlap_projection=0"},
        // Changed with the kinetic stress about the grains' own profile along a
-       // controlled length (the control's load, issue 13 item 2); before it
+       // controlled length (the control's load); before it
        // 0x7803c4d049119bf6 (241 rows), a free collapse: changed with the
        // approach floor holding at compaction_rate = 0 too (a length shrinks
        // by at most a quarter of the alert distance a step, core/cell_dof.hpp;
@@ -117,7 +118,8 @@ const std::vector<Case>& cases() {
       // body 1 of its contacts: the glued grains' contacts are reversed,
       // the same physics in other round-off). Before it: 0xfaf171a2af56d23f
       // for both, mu_wall being ignored in walls mode.
-      // (solver.tol: the scene's until issue 29 set 1e-3)
+      // (solver.tol 1e-4: the scene's when the hashes were taken; the scene
+      // solves to 1e-3)
       // Changed with the bound on the top wall's fall (a quarter of the alert
       // distance a step; before it 0x13ff1960545c8bb9 and 0x04e21232d635fd64
       // from the scene's height 0.03, from which the wall, now slower, meets

@@ -1,5 +1,5 @@
 // Anderson acceleration of the NLGS sweep (solver.anderson, core/sweep.hpp;
-// issue 30, docs/accuracy.md) and its subspace correction (solver.subspace,
+// docs/accuracy.md) and its subspace correction (solver.subspace,
 // the SweepSubspace tests at the end) on a frozen 3D dense-shear step: 150 spheres
 // compacted at p, sheared at I = 0.01 (dt = 0.05 t_p) for 100 steps, and one
 // step of that state solved again from the same warm start.

@@ -1,7 +1,8 @@
-// Wall friction and body order (issue 11): contact.mu_wall applies to every
-// contact with a driven body (a segment wall or a grain glued to a rough
-// wall), whichever body the pair lists first; before the fix a glued grain
-// came out as body 2 of its contacts and mu_wall was ignored in walls mode.
+// Wall friction and body order: contact.mu_wall applies to every contact
+// with a driven body (a segment wall or a grain glued to a rough wall),
+// whichever body the pair lists first. A driven body is body 1 of its
+// contacts; were a glued grain body 2, mu_wall would be ignored in walls
+// mode.
 #include <gtest/gtest.h>
 
 #include <cmath>

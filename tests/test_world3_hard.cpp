@@ -1,4 +1,4 @@
-// Hard cases for the 3D step (issue 12 item 7), each against a closed form:
+// Hard cases for the 3D step, each against a closed form:
 // a tetrahedral pyramid at rest (every contact force from statics) at mass
 // ratio 1 (time steps 1 and 50 ms) and 10^4, a dense periodic stack, a tall column of
 // alternating densities, and cohesion just above and just below the weight.
