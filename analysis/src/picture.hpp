@@ -1,4 +1,4 @@
-// A picture of one snapshot of a run without ParaView (issue 29): the
+// A picture of one snapshot of a run without ParaView: the
 // grains with their true outlines (disks as circles, polygons with their
 // sides at their orientation) and the force chains, every force-bearing
 // contact a bar between the two centres (to the touched periodic image, or
