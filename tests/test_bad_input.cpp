@@ -524,8 +524,9 @@ TEST(BadInput, AxisAOfExtremeLengthIsItsDirection) {
 // Continuation: a run may start from a sheared run's checkpoint.
 // The Lees-Edwards offset and the cell rates are carried, the mean flow is
 // replaced by the new rate's profile, and the first rows overlap no more than
-// the old run did (resetting the offset, as before, overlapped grains across
-// the sheared boundary by up to a diameter, now refused at 0.05 d).
+// the old run did (resetting the offset would overlap grains across the
+// sheared boundary by up to a diameter; a start overlapping by more than
+// 0.05 d is refused).
 TEST(Continuation, AShearRunStartsFromAnotherAtANewRate) {
   const fs::path dir = cdtest::scratch_dir("bad_input", "continuation");
   const std::string common =

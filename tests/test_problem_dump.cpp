@@ -162,12 +162,11 @@ TEST(ProblemDump, CdsimDumpsAndCdproblemReplaysTheSameImpulses) {
 }
 
 // A dump that cannot be written is a write failure (exit 4, "could not
-// write" naming the option and the file), not a divergence: the .cdp is
-// written inside the step, before its solve, whose errors the run loop
-// reports as a diverged run (exit 3), as it did this one; the .impulses,
-// after the step, was already exit 4, and now names the option too. A
-// folder in the dump's place makes the write fail, as root too
-// (permissions would not); the run resumes from its checkpoint once the
+// write" naming the option and the file), not a divergence, although the
+// .cdp is written inside the step, before its solve, whose errors the run
+// loop reports as a diverged run (exit 3); the .impulses, written after the
+// step, likewise. A folder in the dump's place makes the write fail, as root
+// too (permissions would not); the run resumes from its checkpoint once the
 // place is free.
 TEST(ProblemDump, ADumpThatCannotBeWrittenIsAWriteFailure) {
   const auto dir = cdtest::scratch_dir("problem_dump", "unwritable");

@@ -188,13 +188,13 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
 }
 
 // A dump that cannot be written is a write failure (exit 4, "could not
-// write" naming the option and the file): the .cdp3, written inside the
-// step, was reported as a diverged run (exit 3); the FCLib file, after it,
-// whose rename into place fails here, was already exit 4 and now names the
-// option too. A folder in the file's place makes the write fail, as root
-// too; the run resumes from its checkpoint once it is free. (FCLib failing
-// to write its temporary file, now a write failure too, was bad input, exit
-// 2; no test makes HDF5 fail short of filling the disk.)
+// write" naming the option and the file), not a divergence (exit 3),
+// although the .cdp3 is written inside the step; the FCLib file after it,
+// whose rename into place fails here, likewise. A folder in the file's place
+// makes the write fail, as root too; the run resumes from its checkpoint
+// once it is free. (FCLib failing to write its temporary file is a write
+// failure too, not bad input, exit 2; no test makes HDF5 fail short of
+// filling the disk.)
 TEST(ProblemDump3, ADumpThatCannotBeWrittenIsAWriteFailure) {
   const fs::path dir = cdtest::scratch_dir("problem_dump3", "unwritable");
   const std::string cdsim = kCdsim + " " + kConfigs + "pile3d.toml --set particles.n=64 --set time.duration=0.04 "

@@ -398,9 +398,10 @@ TEST(PressureControl, CompactionThenShearAtImposedInertialNumber) {
     EXPECT_NEAR(mxx, kP, 0.01 * kP);
     EXPECT_NEAR(myy, kP, 0.01 * kP);
     // At rest, with no drift: the contacts and the cell conserve the sample's
-    // momentum (measured 2e-16; before the fix in World::wrap_into_cell the
-    // sample drifted up at 4.3 m/s = 0.69 sqrt(p/rho), KE / (M p/rho) 0.24;
-    // now 1.7e-5).
+    // momentum (measured 2e-16; without the removal of the crossings'
+    // momentum when bodies come back into the cell, 2d/boundary.cpp, the
+    // sample drifted up at 4.3 m/s = 0.69 sqrt(p/rho), KE / (M p/rho) 0.24
+    // instead of 1.7e-5).
     EXPECT_LT(ke, 1e-3);
     EXPECT_LT(drift, 1e-9);
     // Unbounded, the collapse reached dH/dt ~ 16 m/s, 0.13 d a step, more

@@ -111,10 +111,10 @@ const std::vector<Case>& cases() {
        // changed with the kinetic stress about the grains' own profile (as
        // above), then with the approach floor at compaction_rate = 0 (as
        // above): before it 0x5f18b3d49377be18 after 120 steps of the free
-       // collapse; the height now falls at most 0.025 d a step, so 300 steps
+       // collapse; the height falls at most 0.025 d a step, so 300 steps
        // (111 rows; 8 after 120)
        300, 0xe3cf011a8bc7b42dull},
-      // The walls scenes changed with the mu_wall fix (a driven body is now
+      // The walls scenes changed with the mu_wall fix (a driven body is
       // body 1 of its contacts: the glued grains' contacts are reversed,
       // the same physics in other round-off). Before it: 0xfaf171a2af56d23f
       // for both, mu_wall being ignored in walls mode.
@@ -122,9 +122,9 @@ const std::vector<Case>& cases() {
       // solves to 1e-3)
       // Changed with the bound on the top wall's fall (a quarter of the alert
       // distance a step; before it 0x13ff1960545c8bb9 and 0x04e21232d635fd64
-      // from the scene's height 0.03, from which the wall, now slower, meets
-      // no grain in 120 steps): from a height of 0.0135, the wall just above
-      // the grains' lattice.
+      // from the scene's height 0.03, from which the wall, slower with the
+      // bound, meets no grain in 120 steps): from a height of 0.0135, the
+      // wall just above the grains' lattice.
       {"walls", "shear-walls.toml", {"particles.n=80", "shear.width=0.012", "shear.height=0.0135", "solver.tol=1e-4"}, 120,
        0xdb2cd4f61fc1a577ull},
       {"walls_mu_wall", "shear-walls.toml",
