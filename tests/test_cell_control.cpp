@@ -37,9 +37,9 @@ namespace {
 // midpoint rule is exact for a constant force), until a grain crosses a
 // face (none does here). The grains keep their velocities; their flow stays
 // linear in y (v_y = eps y0 at y = y0 (1 + eps t)), so its kinetic stress is
-// 0 to round-off. Counting the flow as kinetic stress (the control before
-// the fix) took K_yy = sum m (eps y - <eps y>)^2 / V off the load: the height
-// decelerated by that much less (here 3e-5 of eps H0 over the run, against a
+// 0 to round-off. A control that counted the flow as kinetic stress would
+// take K_yy = sum m (eps y - <eps y>)^2 / V off the load: the height would
+// decelerate by that much less (here 3e-5 of eps H0 over the run, against a
 // round-off tolerance of 1e-12).
 TEST(CellControl, DilationWithTheGrainsIsNotKineticStress2D) {
   const double W = 6.0, H = 5.0, eps = 0.2, P = 1.0, M = 6.0, dt = 1e-3, r = 0.2;

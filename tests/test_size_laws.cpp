@@ -41,8 +41,8 @@ TEST(SizeLaws, ExplicitDiametersAreThoseOfTheParticles) {
 
 // shear.width = shear.height = 0: the cell holds the particles on the
 // generator's loose lattice whatever the size law. At size ratio 4 (uniform
-// by area, the seeds' choice) the Makefile's old ratio-2 cell was too small;
-// the computed one fits, and is the smallest square that does (one lattice
+// by area, the seeds' choice) a cell sized for ratio 2 is too small; the
+// computed one fits, and is the smallest square that does (one lattice
 // pitch less would not).
 TEST(SizeLaws, PeriodicCellIsSizedFromTheActualSizeLaw) {
   for (const double ratio : {1.0, 2.0, 4.0, 5.0}) {
