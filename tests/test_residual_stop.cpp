@@ -1,4 +1,4 @@
-// solver.residual_tol (issue 14): the optional second stopping test on the
+// solver.residual_tol: the optional second stopping test on the
 // law residual itself. On a frozen dense-shear step (disks, I = 1e-3, from
 // tests/data/frozen-shear) the rms |dp| test at tol = 1e-4 runs into the
 // 2000-sweep cap although the laws are met to ~1.5e-3 long before; with

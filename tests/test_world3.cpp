@@ -264,7 +264,7 @@ TEST(World3, ColumnOfFiveAtRest) {
 
 namespace {
 
-// The pile3d scene of issue 12 (pile3d.hpp), small: n^2 layers spheres on
+// The pile3d deposition scene (pile3d.hpp), small: n^2 layers spheres on
 // an n x n lattice.
 World3 make_pile(int n, int layers, const SolverParams& sp) {
   Pile3dParams q;
