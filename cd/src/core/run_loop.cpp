@@ -20,6 +20,7 @@
 
 #include "files.hpp"
 #include "load.hpp"
+#include "run_session_parts.hpp"
 #include "version.hpp"
 
 namespace cd {
@@ -73,24 +74,6 @@ extern "C" void on_stop(int sig) {
   }
   g_stop_ns.store(monotonic_ns());
   g_stop = sig;
-}
-
-// Removes the files an earlier run wrote in the folder, so that a shorter
-// run does not leave stale snapshots behind.
-void clear_previous(const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  if (!fs::is_directory(dir)) return;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string f = e.path().filename().string();
-    const bool ours = f == "series.csv" || f == "timings.csv" || f == "scene.toml" || f == "view.py" || e.path().extension() == ".pvd" ||
-                      f.starts_with("checkpoint.bin") || f.starts_with("problem_") ||
-                    f.starts_with("summary.toml") ||
-                      (e.path().extension() == ".vtp" &&
-                       (f.starts_with("particles_") || f.starts_with("contacts_") ||
-                        f.starts_with("walls_") || f.starts_with("shapes_") ||
-                        f.starts_with("spheres_")));
-    if (ours) fs::remove(e.path());
-  }
 }
 
 // Accumulates step statistics over one series interval.
@@ -174,14 +157,6 @@ void install_stop_handlers() {
 
 
 RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
-  namespace fs = std::filesystem;
-  const fs::path dir(opt.out);
-  const std::string ckpt = (dir / "checkpoint.bin").string();
-  const std::string series_path = (dir / "series.csv").string();
-  // The stage timings, wall-clock seconds, apart from the physics so that
-  // identical runs give byte-identical series (timings.csv: same rows).
-  const std::string timings_path = (dir / "timings.csv").string();
-  const double dt = plan.dt;
   const std::int64_t nsteps = plan.nsteps;
   const std::int64_t every_row = plan.every_row, every_snap = plan.every_snap;
   const std::int64_t every_ckpt = plan.every_ckpt, every_ckpt_strain = plan.every_ckpt_strain;
@@ -189,48 +164,21 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const bool checkpoints = plan.checkpoints();
   const bool progress = !opt.quiet && isatty(STDERR_FILENO);
 
-  // Resume from a checkpoint of this scene; checked before anything is written.
   const std::uint64_t key = plan.key;
   // A dump the run never reaches would be silently missing.
   for (const std::int64_t k : opt.dump_steps)
     if (k > nsteps)
       throw std::invalid_argument(fmt::format("--dump-problem {}: the run's last step is {}", k, nsteps));
-  // One writer per folder: locked before the checkpoint is read (an existing
-  // folder) or as soon as the folder is made.
-  std::optional<FolderLock> lock;
-  if (fs::is_directory(dir)) lock.emplace(opt.out);
-  // Before every write: the folder must still be the one locked. A stopping
-  // run whose folder was removed and made again by a new run (of the same
-  // --out) would otherwise reopen the new series.csv by its path and append
-  // its last row ahead of the new header; it writes nothing instead
-  // (FolderGone). Each check is one stat, at most a few per series row.
-  const auto still_ours = [&] {
-    if (lock) lock->check_unchanged();
-  };
-  const bool resume = !opt.fresh && fs::exists(ckpt);
-  std::vector<std::string> columns;  // of series.csv, cut back to the checkpoint
-  std::vector<std::string> timing_columns;  // of timings.csv, likewise
-  bool legacy = false;                      // timings in series.csv (a run begun before timings.csv)
-  RunTotals tot;                     // the run's cost so far (summary.toml)
-  if (resume) {
-    try {
-      const std::uint64_t stored = w.load(ckpt, &tot);
-      if ((stored != key && !folder_scene_is((dir / "scene.toml").string(), key)) || w.steps() > nsteps)
-        throw CheckpointError(fmt::format("checkpoint '{}' was written by a different scene "
-                                          "(compare with {})", ckpt, (dir / "scene.toml").string()));
-      still_ours();
-      columns = truncate_series(series_path, w.steps());
-      // A run begun before timings.csv existed has the timings in its
-      // series: it goes on so, to its end.
-      legacy = !fs::exists(timings_path) &&
-               std::any_of(columns.begin(), columns.end(), [](const std::string& c) { return c.starts_with("t_"); });
-      if (!legacy) timing_columns = truncate_series(timings_path, w.steps());
-    } catch (const CheckpointError& e) {
-      throw CheckpointError(std::string(e.what()) +
-                            "; run with --fresh to discard the checkpoint and start over");
-    }
-  }
-  const std::int64_t k0 = resume ? w.steps() : 0;
+  RunFolder folder(opt.out);
+  folder.lock_if_present();
+  const auto still_ours = [&] { folder.check(); };
+  ResumePoint from = resume_from_checkpoint(w, plan, folder, opt.fresh);
+  const bool resume = from.resumed;
+  const bool legacy = from.legacy_timings;
+  RunTotals tot = from.totals;
+  const std::string ckpt = folder.checkpoint();
+  const std::string series_path = folder.series(), timings_path = folder.timings();
+  const std::int64_t k0 = from.step;
   // The compaction's stop rule; a resumed run reads its rows back, and one
   // that had settled at its checkpoint takes no more steps.
   SettleRule settle = plan.settle;
@@ -250,19 +198,14 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   warn_long(every_ckpt, fmt::format("output.checkpoint_interval = {} s", plan.checkpoint_interval));
   warn_long(every_ckpt_strain, fmt::format("output.checkpoint_strain = {}", plan.checkpoint_strain));
 
-  fs::create_directories(opt.out);
-  if (!lock) lock.emplace(opt.out);
-  still_ours();  // not removed (and made again above) since it was locked
+  folder.make();
   if (!resume) clear_previous(opt.out);
-  write_file_atomic((dir / "scene.toml").string(), opt.scene_toml);
-  // On resume, the snapshots up to the checkpoint are known by their steps
-  // (the time is computed as the step does, steps * dt).
-  Frames frames;
-  for (std::int64_t j = 0; resume && every_snap && j * every_snap <= k0; ++j)
-    frames.emplace_back(static_cast<double>(j * every_snap) * dt, fmt::format("{:05d}", j));
-  Series series = resume ? Series(series_path, std::move(columns)) : Series(series_path);
+  write_file_atomic(folder.file("scene.toml"), opt.scene_toml);
+  Frames frames = resume ? snapshots_up_to(plan, k0) : Frames{};
+  Series series = resume ? Series(series_path, std::move(from.series_columns)) : Series(series_path);
   std::optional<Series> timings;
-  if (!legacy) timings.emplace(resume ? Series(timings_path, std::move(timing_columns)) : Series(timings_path));
+  if (!legacy)
+    timings.emplace(resume ? Series(timings_path, std::move(from.timing_columns)) : Series(timings_path));
   if (every_snap) w.open_snapshots(opt.out, std::move(frames));
 
   RunSummary sum;
@@ -290,7 +233,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     sum.threads = omp_get_max_threads();
     sum.load_end = load_average();
     still_ours();
-    write_file_atomic((dir / "summary.toml").string(), summary_toml(sum));
+    write_file_atomic(folder.file("summary.toml"), summary_toml(sum));
   };
   // A diverged run still says what it cost, up to `last`, the last step
   // counted; a failure to write that does not hide the divergence.

@@ -1,0 +1,78 @@
+// The parts of a run session (run_loop.hpp), each one concern that can be
+// read and tested alone: the output folder and its lock, the resume from a
+// checkpoint.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "checkpoint_io.hpp"
+#include "files.hpp"
+#include "run_loop.hpp"
+#include "run_plan.hpp"
+
+namespace cd {
+
+// The output folder of a run: the paths of its files and its one-writer
+// lock, taken before the checkpoint is read (an existing folder) or as soon
+// as the folder is made.
+class RunFolder {
+ public:
+  explicit RunFolder(const std::string& out) : out_(out), dir_(out) {}
+  const std::string& out() const { return out_; }
+  // DIR/name.
+  std::string file(const char* name) const { return (dir_ / name).string(); }
+  std::string checkpoint() const { return file("checkpoint.bin"); }
+  std::string series() const { return file("series.csv"); }
+  // The stage timings, wall-clock seconds, apart from the physics so that
+  // identical runs give byte-identical series (timings.csv: same rows).
+  std::string timings() const { return file("timings.csv"); }
+
+  // Locks the folder if it exists already: before its checkpoint is read.
+  void lock_if_present();
+  // Makes the folder and locks it (if not yet locked), then checks that it
+  // was not removed and made again since it was locked.
+  void make();
+  // Before every write: the folder must still be the one locked. A stopping
+  // run whose folder was removed and made again by a new run (of the same
+  // --out) would otherwise reopen the new series.csv by its path and append
+  // its last row ahead of the new header; it writes nothing instead
+  // (FolderGone). Each check is one stat, at most a few per series row.
+  void check() const {
+    if (lock_) lock_->check_unchanged();
+  }
+
+ private:
+  std::string out_;
+  std::filesystem::path dir_;
+  std::optional<FolderLock> lock_;
+};
+
+// Removes the files an earlier run wrote in the folder, so that a shorter
+// run does not leave stale snapshots behind.
+void clear_previous(const std::filesystem::path& dir);
+
+// Where a run starts: step 0, or the checkpoint it resumes from.
+struct ResumePoint {
+  bool resumed = false;
+  std::int64_t step = 0;                    // the checkpoint's step; 0 for a fresh run
+  std::vector<std::string> series_columns;  // of series.csv, cut back to the checkpoint
+  std::vector<std::string> timing_columns;  // of timings.csv, likewise
+  bool legacy_timings = false;              // timings in series.csv (a run begun before timings.csv)
+  RunTotals totals;                         // the run's cost so far (summary.toml)
+};
+
+// Resumes from the folder's checkpoint unless `fresh` or there is none: the
+// engine's state replaced by it, series.csv and timings.csv cut back to its
+// step. A checkpoint of another scene (or dimension), or an unreadable
+// one, throws CheckpointError saying how to start over, before anything is
+// written.
+ResumePoint resume_from_checkpoint(RunEngine& e, const RunPlan& plan, const RunFolder& folder, bool fresh);
+
+// The snapshots a resumed run wrote up to its checkpoint at step k0, known
+// by their steps (the time is computed as the step does, steps * dt).
+Frames snapshots_up_to(const RunPlan& plan, std::int64_t k0);
+
+}  // namespace cd
