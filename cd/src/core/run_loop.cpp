@@ -158,9 +158,7 @@ void install_stop_handlers() {
 
 RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const std::int64_t nsteps = plan.nsteps;
-  const std::int64_t every_row = plan.every_row, every_snap = plan.every_snap;
-  const std::int64_t every_ckpt = plan.every_ckpt, every_ckpt_strain = plan.every_ckpt_strain;
-  const double ckpt_wall = plan.ckpt_wall;
+  const std::int64_t every_snap = plan.every_snap;
   const bool checkpoints = plan.checkpoints();
   const bool progress = !opt.quiet && isatty(STDERR_FILENO);
 
@@ -186,17 +184,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const std::int64_t k_last = resume && settle.settled() ? k0 : nsteps;
   w.start();
 
-  // An interval as long as the run writes no checkpoint before the end.
-  const auto warn_long = [&](std::int64_t every, const std::string& what) {
-    if (every && every >= nsteps)
-      std::fprintf(stderr, "cdsim: warning: %s is %lld steps (rounded up to whole series rows), "
-                   "not shorter than the run's %lld: it writes no checkpoint before the end%s\n",
-                   what.c_str(), static_cast<long long>(every), static_cast<long long>(nsteps),
-                   ckpt_wall > 0 ? " (output.checkpoint_wall still does)"
-                                 : ", so a kill loses the whole run");
-  };
-  warn_long(every_ckpt, fmt::format("output.checkpoint_interval = {} s", plan.checkpoint_interval));
-  warn_long(every_ckpt_strain, fmt::format("output.checkpoint_strain = {}", plan.checkpoint_strain));
+  std::fputs(long_interval_warnings(plan).c_str(), stderr);
 
   folder.make();
   if (!resume) clear_previous(opt.out);
@@ -214,7 +202,9 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const auto start = Clock::now();
   const double cpu0 = cpu_seconds();
   sum.load_start = load_average();
-  auto last_print = start, last_ckpt = start, last_line = start;
+  auto last_print = start, last_line = start;
+  OutputCadence cadence(plan, resume);
+  cadence.start(start);
   long iter_total = 0;
   if (k0 < k_last) tot.sessions += 1;
   // The totals as they stand now: the wall and CPU time of this session added.
@@ -301,13 +291,13 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
                                           "rows before it", k, w.time(), name, x));
     // A signal's stop waits for the next series row: rows are whole
     // intervals, and a checkpoint there resumes to the same series.
-    const bool row_due = k % every_row == 0 || k == nsteps;
+    const bool row_due = cadence.row_due(k);
     if (g_stop != 0 && !stop_seen) {
       stop_seen = true;
       if (!row_due)
         std::fprintf(stderr, "%scdsim: signal %d: stopping at the next series row (step %lld); a second "
                      "signal stops at once\n", progress ? "\n" : "", int(g_stop),
-                     static_cast<long long>(std::min(nsteps, (k / every_row + 1) * every_row)));
+                     static_cast<long long>(cadence.next_row(k)));
     }
     // --max-steps stops after exactly N steps (to try a scene), with a row
     // for the partial interval there.
@@ -388,21 +378,17 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
         k_end = k;
       }
     }
-    if (every_snap && k % every_snap == 0) timed_output([&] {
+    if (cadence.snapshot_due(k)) timed_output([&] {
       still_ours();
       w.write_snapshot();
     });
-    // After this step's outputs, so that a restart has them all. A resumed
-    // run keeps its checkpoint current even with checkpoints off.
-    const bool wall_due = ckpt_wall > 0 && k % every_row == 0 &&
-                          std::chrono::duration<double>(Clock::now() - last_ckpt).count() >= ckpt_wall;
-    if ((every_ckpt && k % every_ckpt == 0) || (every_ckpt_strain && k % every_ckpt_strain == 0) ||
-        wall_due || ((k == nsteps || stopping || settled) && (checkpoints || resume))) {
+    // After this step's outputs, so that a restart has them all.
+    if (cadence.checkpoint_due(k, k == nsteps || stopping || settled, Clock::now())) {
       timed_output([&] {
         still_ours();
         w.save(ckpt, key, totals_now());
       });
-      last_ckpt = Clock::now();
+      cadence.checkpoint_written(Clock::now());
     }
     if (stopping) {
       sum.stop_signal = g_stop;

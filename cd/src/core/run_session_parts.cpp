@@ -67,4 +67,23 @@ Frames snapshots_up_to(const RunPlan& plan, std::int64_t k0) {
   return frames;
 }
 
+namespace {
+
+std::string long_interval_warning(const RunPlan& plan, std::int64_t every, const std::string& what) {
+  if (!every || every < plan.nsteps) return "";
+  return fmt::format("cdsim: warning: {} is {} steps (rounded up to whole series rows), not shorter than the "
+                     "run's {}: it writes no checkpoint before the end{}\n",
+                     what, every, plan.nsteps,
+                     plan.ckpt_wall > 0 ? " (output.checkpoint_wall still does)" : ", so a kill loses the whole run");
+}
+
+}  // namespace
+
+std::string long_interval_warnings(const RunPlan& plan) {
+  return long_interval_warning(plan, plan.every_ckpt,
+                               fmt::format("output.checkpoint_interval = {} s", plan.checkpoint_interval)) +
+         long_interval_warning(plan, plan.every_ckpt_strain,
+                               fmt::format("output.checkpoint_strain = {}", plan.checkpoint_strain));
+}
+
 }  // namespace cd

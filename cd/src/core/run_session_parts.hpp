@@ -1,7 +1,9 @@
 // The parts of a run session (run_loop.hpp), each one concern that can be
 // read and tested alone: the output folder and its lock, the resume from a
-// checkpoint.
+// checkpoint, when outputs fall.
 #pragma once
+#include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -14,6 +16,8 @@
 #include "run_plan.hpp"
 
 namespace cd {
+
+using RunClock = std::chrono::steady_clock;
 
 // The output folder of a run: the paths of its files and its one-writer
 // lock, taken before the checkpoint is read (an existing folder) or as soon
@@ -74,5 +78,47 @@ ResumePoint resume_from_checkpoint(RunEngine& e, const RunPlan& plan, const RunF
 // The snapshots a resumed run wrote up to its checkpoint at step k0, known
 // by their steps (the time is computed as the step does, steps * dt).
 Frames snapshots_up_to(const RunPlan& plan, std::int64_t k0);
+
+// When a step's outputs fall (RunPlan's intervals, in steps): a series row
+// every every_row steps and at the scene's last step; a snapshot every
+// every_snap; a checkpoint by simulated time or strain (on rows: the plan
+// rounds them up to whole rows), on the first row after ckpt_wall seconds
+// of wall clock since the last one (or since start), and at the session's
+// end when checkpoints are on. A resumed run keeps its checkpoint current
+// even with checkpoints off.
+class OutputCadence {
+ public:
+  OutputCadence(const RunPlan& plan, bool resumed)
+      : nsteps_(plan.nsteps), every_row_(plan.every_row), every_snap_(plan.every_snap),
+        every_ckpt_(plan.every_ckpt), every_ckpt_strain_(plan.every_ckpt_strain), ckpt_wall_(plan.ckpt_wall),
+        checkpoint_at_end_(plan.checkpoints() || resumed) {}
+
+  bool row_due(std::int64_t k) const { return k % every_row_ == 0 || k == nsteps_; }
+  // The series row a stop asked at step k waits for.
+  std::int64_t next_row(std::int64_t k) const { return std::min(nsteps_, (k / every_row_ + 1) * every_row_); }
+  bool snapshot_due(std::int64_t k) const { return every_snap_ && k % every_snap_ == 0; }
+  // `ending`: the session ends at step k (the scene's last step, a stop,
+  // or a settled compaction).
+  bool checkpoint_due(std::int64_t k, bool ending, RunClock::time_point now) const {
+    const bool wall_due = ckpt_wall_ > 0 && k % every_row_ == 0 &&
+                          std::chrono::duration<double>(now - last_checkpoint_).count() >= ckpt_wall_;
+    return (every_ckpt_ && k % every_ckpt_ == 0) || (every_ckpt_strain_ && k % every_ckpt_strain_ == 0) ||
+           wall_due || (ending && checkpoint_at_end_);
+  }
+  // The wall clock counts from the session's start, then from each checkpoint.
+  void start(RunClock::time_point t) { last_checkpoint_ = t; }
+  void checkpoint_written(RunClock::time_point t) { last_checkpoint_ = t; }
+
+ private:
+  std::int64_t nsteps_, every_row_, every_snap_, every_ckpt_, every_ckpt_strain_;
+  double ckpt_wall_;
+  bool checkpoint_at_end_;
+  RunClock::time_point last_checkpoint_{};
+};
+
+// The warnings (whole lines, "" if none) for a checkpoint interval, by
+// simulated time or by strain, not shorter than the run: it writes no
+// checkpoint before the end.
+std::string long_interval_warnings(const RunPlan& plan);
 
 }  // namespace cd
