@@ -46,36 +46,6 @@ std::string toml_float(double x) {
   return t;
 }
 
-// The first SIGINT, SIGTERM or SIGHUP asks the run to stop at its next series
-// row, where a checkpoint falls as it always does, so that the resumed run is
-// the one never stopped; a second one of them, a second or more later, ends
-// the process at once, as a kill would (the resume then starts from the last
-// checkpoint). One within that second is the same request delivered twice:
-// `timeout` signals the command and then its whole process group, and a
-// shell's job control may do the same, so a single stop asked that way
-// arrives twice within microseconds; before this rule it killed the run.
-volatile std::sig_atomic_t g_stop = 0;
-std::atomic<std::int64_t> g_stop_ns{0};  // CLOCK_MONOTONIC of the first signal
-static_assert(std::atomic<std::int64_t>::is_always_lock_free);  // safe in a handler
-constexpr std::int64_t kRepeatNs = 1'000'000'000;
-
-std::int64_t monotonic_ns() {  // clock_gettime is async-signal-safe (POSIX)
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
-}
-
-extern "C" void on_stop(int sig) {
-  if (g_stop != 0) {
-    if (monotonic_ns() - g_stop_ns.load() < kRepeatNs) return;  // the same request
-    std::signal(sig, SIG_DFL);
-    std::raise(sig);
-    return;
-  }
-  g_stop_ns.store(monotonic_ns());
-  g_stop = sig;
-}
-
 // Accumulates step statistics over one series interval.
 struct Interval {
   int steps = 0;
@@ -149,12 +119,6 @@ std::string summary_toml(const RunSummary& s) {
   return o;
 }
 
-void install_stop_handlers() {
-  std::signal(SIGINT, on_stop);
-  std::signal(SIGTERM, on_stop);
-  std::signal(SIGHUP, on_stop);
-}
-
 
 RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const std::int64_t nsteps = plan.nsteps;
@@ -163,10 +127,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const bool progress = !opt.quiet && isatty(STDERR_FILENO);
 
   const std::uint64_t key = plan.key;
-  // A dump the run never reaches would be silently missing.
-  for (const std::int64_t k : opt.dump_steps)
-    if (k > nsteps)
-      throw std::invalid_argument(fmt::format("--dump-problem {}: the run's last step is {}", k, nsteps));
+  const ProblemDumps dumps(opt.dump_steps, nsteps);
   RunFolder folder(opt.out);
   folder.lock_if_present();
   const auto still_ours = [&] { folder.check(); };
@@ -235,13 +196,6 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     return RunDiverged(msg);
   };
 
-  // A --dump-problem file that could not be written (a WriteError from the
-  // engine's step or after_step): that failure, naming the option and the
-  // step (cdsim exits 4).
-  const auto dump_failed = [&](std::int64_t k, const WriteError& e) {
-    return WriteError(fmt::format("--dump-problem {}: {}", k, e.what()));
-  };
-
   auto timed_output = [&](auto&& f) {
     const auto t = Clock::now();
     f();
@@ -251,15 +205,12 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     still_ours();
     w.write_snapshot();
   });
-  const auto dumped = [&](std::int64_t k) {
-    return std::find(opt.dump_steps.begin(), opt.dump_steps.end(), k) != opt.dump_steps.end();
-  };
 
   std::int64_t k_end = k_last;  // the last step taken (earlier if stopped by a signal or settled)
-  bool stop_seen = false;       // a signal's stop was announced
+  StopNotice stop_notice;
   bool settled = k_last < nsteps;
   for (std::int64_t k = k0 + 1; k <= k_last; ++k) {
-    if (dumped(k)) still_ours();  // the step writes its problem before its solve
+    if (dumps.at(k)) still_ours();  // the step writes its problem before its solve
     try {
       w.step();
     } catch (const FolderGone&) {
@@ -267,7 +218,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     } catch (const WriteError& e) {
       // Inside a step, only --dump-problem writes (its hook, before the
       // solve): a write that failed, not a state that went bad.
-      throw dump_failed(k, e);
+      throw ProblemDumps::failed(k, e);
     } catch (const std::runtime_error& e) {
       // A step that cannot go on (e.g. a periodic cell shrunk below what
       // detection needs): the run stops as a diverged one, its outputs kept.
@@ -292,25 +243,20 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     // A signal's stop waits for the next series row: rows are whole
     // intervals, and a checkpoint there resumes to the same series.
     const bool row_due = cadence.row_due(k);
-    if (g_stop != 0 && !stop_seen) {
-      stop_seen = true;
-      if (!row_due)
-        std::fprintf(stderr, "%scdsim: signal %d: stopping at the next series row (step %lld); a second "
-                     "signal stops at once\n", progress ? "\n" : "", int(g_stop),
-                     static_cast<long long>(cadence.next_row(k)));
-    }
+    if (const int sig = stop_signal(); sig != 0)
+      std::fputs(stop_notice.seen(sig, row_due, cadence.next_row(k), progress).c_str(), stderr);
     // --max-steps stops after exactly N steps (to try a scene), with a row
     // for the partial interval there.
     const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps;
-    const bool stopping = (g_stop != 0 && row_due && k < nsteps) || at_limit;
+    const bool stopping = (stop_signal() != 0 && row_due && k < nsteps) || at_limit;
     if (stopping) k_end = k;
-    if (dumped(k)) still_ours();
+    if (dumps.at(k)) still_ours();
     try {
       w.after_step(k);  // writes the rest of a --dump-problem step
     } catch (const FolderGone&) {
       throw;
     } catch (const WriteError& e) {
-      throw dump_failed(k, e);
+      throw ProblemDumps::failed(k, e);
     }
     iv.add(st);
     iter_total += st.solve.iterations;
@@ -391,8 +337,8 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       cadence.checkpoint_written(Clock::now());
     }
     if (stopping) {
-      sum.stop_signal = g_stop;
-      sum.stopped_at_max_steps = at_limit && !g_stop;
+      sum.stop_signal = stop_signal();
+      sum.stopped_at_max_steps = at_limit && !stop_signal();
       break;
     }
     if (settled) break;

@@ -1,7 +1,11 @@
 #include "run_session_parts.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <ctime>
 #include <filesystem>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -69,6 +73,36 @@ Frames snapshots_up_to(const RunPlan& plan, std::int64_t k0) {
 
 namespace {
 
+// The first SIGINT, SIGTERM or SIGHUP asks the run to stop at its next series
+// row, where a checkpoint falls as it always does, so that the resumed run is
+// the one never stopped; a second one of them, a second or more later, ends
+// the process at once, as a kill would (the resume then starts from the last
+// checkpoint). One within that second is the same request delivered twice:
+// `timeout` signals the command and then its whole process group, and a
+// shell's job control may do the same, so a single stop asked that way
+// arrives twice within microseconds; before this rule it killed the run.
+volatile std::sig_atomic_t g_stop = 0;
+std::atomic<std::int64_t> g_stop_ns{0};  // CLOCK_MONOTONIC of the first signal
+static_assert(std::atomic<std::int64_t>::is_always_lock_free);  // safe in a handler
+constexpr std::int64_t kRepeatNs = 1'000'000'000;
+
+std::int64_t monotonic_ns() {  // clock_gettime is async-signal-safe (POSIX)
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+extern "C" void on_stop(int sig) {
+  if (g_stop != 0) {
+    if (monotonic_ns() - g_stop_ns.load() < kRepeatNs) return;  // the same request
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+    return;
+  }
+  g_stop_ns.store(monotonic_ns());
+  g_stop = sig;
+}
+
 std::string long_interval_warning(const RunPlan& plan, std::int64_t every, const std::string& what) {
   if (!every || every < plan.nsteps) return "";
   return fmt::format("cdsim: warning: {} is {} steps (rounded up to whole series rows), not shorter than the "
@@ -84,6 +118,32 @@ std::string long_interval_warnings(const RunPlan& plan) {
                                fmt::format("output.checkpoint_interval = {} s", plan.checkpoint_interval)) +
          long_interval_warning(plan, plan.every_ckpt_strain,
                                fmt::format("output.checkpoint_strain = {}", plan.checkpoint_strain));
+}
+
+void install_stop_handlers() {
+  std::signal(SIGINT, on_stop);
+  std::signal(SIGTERM, on_stop);
+  std::signal(SIGHUP, on_stop);
+}
+
+int stop_signal() { return g_stop; }
+
+std::string StopNotice::seen(int signal, bool row_due, std::int64_t row, bool after_progress) {
+  if (announced_) return "";
+  announced_ = true;
+  if (row_due) return "";
+  return fmt::format("{}cdsim: signal {}: stopping at the next series row (step {}); a second signal stops at once\n",
+                     after_progress ? "\n" : "", signal, row);
+}
+
+ProblemDumps::ProblemDumps(const std::vector<std::int64_t>& steps, std::int64_t nsteps) : steps_(steps) {
+  for (const std::int64_t k : steps_)
+    if (k > nsteps)
+      throw std::invalid_argument(fmt::format("--dump-problem {}: the run's last step is {}", k, nsteps));
+}
+
+WriteError ProblemDumps::failed(std::int64_t k, const WriteError& e) {
+  return WriteError(fmt::format("--dump-problem {}: {}", k, e.what()));
 }
 
 }  // namespace cd

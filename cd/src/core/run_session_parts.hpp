@@ -1,6 +1,7 @@
 // The parts of a run session (run_loop.hpp), each one concern that can be
 // read and tested alone: the output folder and its lock, the resume from a
-// checkpoint, when outputs fall.
+// checkpoint, when outputs fall, a stop asked by a signal, the
+// --dump-problem steps.
 #pragma once
 #include <algorithm>
 #include <chrono>
@@ -120,5 +121,40 @@ class OutputCadence {
 // simulated time or by strain, not shorter than the run: it writes no
 // checkpoint before the end.
 std::string long_interval_warnings(const RunPlan& plan);
+
+// The signal that asked the run to stop (SIGINT, SIGTERM or SIGHUP, caught
+// since install_stop_handlers), 0 if none: set once, by the first of them.
+int stop_signal();
+
+// What the run says when it first sees a signal's stop: that the stop waits
+// for the next series row (rows are whole intervals, and a checkpoint there
+// resumes to the same series), unless one falls at this very step.
+class StopNotice {
+ public:
+  // The line to print ("" if none) at a step where `signal` is set; `row`
+  // is the row the stop waits for, `after_progress` whether a progress line
+  // is on the terminal (the notice then starts a line of its own).
+  std::string seen(int signal, bool row_due, std::int64_t row, bool after_progress);
+
+ private:
+  bool announced_ = false;
+};
+
+// The --dump-problem steps: each step's contact problem is written into the
+// folder by the engine (before its solve, and after it its impulses).
+class ProblemDumps {
+ public:
+  // Throws std::invalid_argument for a step past the run's last, nsteps: a
+  // dump the run never reaches would be silently missing.
+  ProblemDumps(const std::vector<std::int64_t>& steps, std::int64_t nsteps);
+  bool at(std::int64_t k) const { return std::find(steps_.begin(), steps_.end(), k) != steps_.end(); }
+  // A dump file that could not be written (a WriteError from the engine's
+  // step or after_step): that failure, naming the option and the step
+  // (cdsim exits 4).
+  static WriteError failed(std::int64_t k, const WriteError& e);
+
+ private:
+  std::vector<std::int64_t> steps_;
+};
 
 }  // namespace cd
