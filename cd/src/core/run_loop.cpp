@@ -29,14 +29,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// CPU time of the process, user + system (s): every thread's.
-double cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
 // A TOML float: shortest text that reads back exactly, with a '.' or exponent.
 std::string toml_float(double x) {
   if (std::isnan(x)) return "nan";
@@ -45,31 +37,6 @@ std::string toml_float(double x) {
   if (t.find_first_of(".e") == std::string::npos) t += ".0";
   return t;
 }
-
-// Accumulates step statistics over one series interval.
-struct Interval {
-  int steps = 0;
-  long iter_sum = 0;
-  int iter_max = 0;
-  int cap_hits = 0;
-  double res_max = 0, res_mean_sum = 0;
-  double ov_max = 0, ov_small = 0;
-  double corr_work = 0, proj_work = 0;
-  StageTimes t0;
-
-  void add(const StepStats& s) {
-    ++steps;
-    iter_sum += s.solve.iterations;
-    iter_max = std::max(iter_max, s.solve.iterations);
-    cap_hits += s.solve.cap_hit;
-    res_max = std::max(res_max, s.solve.residual_max);
-    res_mean_sum += s.solve.residual_mean;
-    ov_max = std::max(ov_max, s.max_overlap);
-    ov_small = std::max(ov_small, s.max_overlap_small);
-    corr_work += s.correction_work;
-    proj_work += s.projection_work;
-  }
-};
 
 }  // namespace
 
@@ -124,7 +91,6 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   const std::int64_t nsteps = plan.nsteps;
   const std::int64_t every_snap = plan.every_snap;
   const bool checkpoints = plan.checkpoints();
-  const bool progress = !opt.quiet && isatty(STDERR_FILENO);
 
   const std::uint64_t key = plan.key;
   const ProblemDumps dumps(opt.dump_steps, nsteps);
@@ -134,7 +100,6 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
   ResumePoint from = resume_from_checkpoint(w, plan, folder, opt.fresh);
   const bool resume = from.resumed;
   const bool legacy = from.legacy_timings;
-  RunTotals tot = from.totals;
   const std::string ckpt = folder.checkpoint();
   const std::string series_path = folder.series(), timings_path = folder.timings();
   const std::int64_t k0 = from.step;
@@ -157,34 +122,17 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     timings.emplace(resume ? Series(timings_path, std::move(from.timing_columns)) : Series(timings_path));
   if (every_snap) w.open_snapshots(opt.out, std::move(frames));
 
-  RunSummary sum;
-  Interval iv;
+  SeriesInterval iv;
   iv.t0 = w.times();  // restored on resume
   const auto start = Clock::now();
-  const double cpu0 = cpu_seconds();
-  sum.load_start = load_average();
-  auto last_print = start, last_line = start;
+  CostRecord cost(from.totals, start);
+  RunSummary& sum = cost.summary();
+  ProgressLines progress(opt, nsteps, k0, start);
   OutputCadence cadence(plan, resume);
   cadence.start(start);
-  long iter_total = 0;
-  if (k0 < k_last) tot.sessions += 1;
-  // The totals as they stand now: the wall and CPU time of this session added.
-  const auto totals_now = [&] {
-    RunTotals t = tot;
-    t.wall += std::chrono::duration<double>(Clock::now() - start).count();
-    t.cpu += cpu_seconds() - cpu0;
-    return t;
-  };
-  // summary.toml: at the end of the session, however it ends.
+  if (k0 < k_last) cost.count_session();
   const auto write_summary = [&](const char* status, std::int64_t last) {
-    sum.status = status;
-    sum.last_step = last;
-    sum.total_steps = nsteps;
-    sum.totals = totals_now();
-    sum.threads = omp_get_max_threads();
-    sum.load_end = load_average();
-    still_ours();
-    write_file_atomic(folder.file("summary.toml"), summary_toml(sum));
+    cost.write_summary(status, last, nsteps, folder);
   };
   // A diverged run still says what it cost, up to `last`, the last step
   // counted; a failure to write that does not hide the divergence.
@@ -244,7 +192,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     // intervals, and a checkpoint there resumes to the same series.
     const bool row_due = cadence.row_due(k);
     if (const int sig = stop_signal(); sig != 0)
-      std::fputs(stop_notice.seen(sig, row_due, cadence.next_row(k), progress).c_str(), stderr);
+      std::fputs(stop_notice.seen(sig, row_due, cadence.next_row(k), progress.on_terminal()).c_str(), stderr);
     // --max-steps stops after exactly N steps (to try a scene), with a row
     // for the partial interval there.
     const bool at_limit = opt.max_steps > 0 && k - k0 >= opt.max_steps && k < nsteps;
@@ -259,26 +207,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
       throw ProblemDumps::failed(k, e);
     }
     iv.add(st);
-    iter_total += st.solve.iterations;
-    sum.max_iterations = std::max(sum.max_iterations, st.solve.iterations);
-    sum.cap_hits += st.solve.cap_hit;
-    sum.anderson_off += st.solve.anderson_off > 0;
-    sum.subspace_off += st.solve.subspace_off > 0;
-    sum.subspace_iterations += st.solve.subspace_iterations;
-    sum.floor_steps += st.floor_held;
-    sum.max_residual = std::max(sum.max_residual, st.solve.residual_max);
-    sum.max_overlap = std::max(sum.max_overlap, st.max_overlap);
-    sum.max_overlap_small = std::max(sum.max_overlap_small, st.max_overlap_small);
-    tot.sweeps += st.solve.iterations;
-    tot.sweeps_max = std::max(tot.sweeps_max, double(st.solve.iterations));
-    tot.cap_steps += st.solve.cap_hit;
-    tot.residual_max = std::max(tot.residual_max, st.solve.residual_max);
-    tot.residual_last = st.solve.residual_max;
-    tot.overlap_max = std::max(tot.overlap_max, st.max_overlap);
-    tot.cg_iterations += st.solve.subspace_iterations;
-    tot.anderson_off_steps += st.solve.anderson_off > 0;
-    tot.subspace_off_steps += st.solve.subspace_off > 0;
-    tot.floor_steps += st.floor_held;
+    cost.add(st);
 
     if (row_due || stopping) {
       timed_output([&] {
@@ -317,7 +246,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
           timings->flush();
         }
       });
-      iv = Interval{};
+      iv = SeriesInterval{};
       iv.t0 = w.times();
       if (settle.settled() && k < nsteps) {
         settled = true;
@@ -332,7 +261,7 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     if (cadence.checkpoint_due(k, k == nsteps || stopping || settled, Clock::now())) {
       timed_output([&] {
         still_ours();
-        w.save(ckpt, key, totals_now());
+        w.save(ckpt, key, cost.totals_now());
       });
       cadence.checkpoint_written(Clock::now());
     }
@@ -343,36 +272,10 @@ RunSummary run_loop(RunEngine& w, const RunPlan& plan, const RunOptions& opt) {
     }
     if (settled) break;
 
-    if (opt.progress_every > 0 && k < nsteps) {
-      const auto now = Clock::now();
-      if (now - last_line >= std::chrono::duration<double>(opt.progress_every)) {
-        last_line = now;
-        const double el = std::chrono::duration<double>(now - start).count();
-        std::printf("cdsim: %s: %.1f %% (step %lld of %lld), %.0f s in this session, ETA %.0f s\n",
-                    opt.out.c_str(), 100.0 * double(k) / double(nsteps), static_cast<long long>(k),
-                    static_cast<long long>(nsteps), el, el / double(k - k0) * double(nsteps - k));
-        std::fflush(stdout);
-      }
-    }
-    if (progress) {
-      const auto now = Clock::now();
-      if (now - last_print > std::chrono::milliseconds(500) || k == nsteps) {
-        last_print = now;
-        const double el = std::chrono::duration<double>(now - start).count();
-        const double eta = el / (k - k0) * (nsteps - k);
-        std::fprintf(stderr, "\r%5.1f%%  ETA %6.1fs  step %lld/%lld  contacts %d  iterations %d   ",
-                     100.0 * k / nsteps, eta, static_cast<long long>(k),
-                     static_cast<long long>(nsteps), st.contacts, st.solve.iterations);
-        std::fflush(stderr);
-      }
-    }
+    progress.after_step(k, st);
   }
-  if (progress) std::fprintf(stderr, "\n");
-  sum.first_step = k0;
-  sum.steps = k_end - k0;
-  sum.total_steps = nsteps;
-  sum.mean_iterations = sum.steps ? double(iter_total) / sum.steps : 0.0;
-  sum.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
+  progress.end();
+  cost.end_session(k0, k_end, nsteps);
   sum.kinetic_energy = w.kinetic_energy();
   sum.settled = settled;
   sum.settle_on = settle.on();

@@ -1,13 +1,20 @@
 #include "run_session_parts.hpp"
 
+#include <omp.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <stdexcept>
 
 #include <fmt/format.h>
+
+#include "load.hpp"
 
 namespace cd {
 
@@ -72,6 +79,14 @@ Frames snapshots_up_to(const RunPlan& plan, std::int64_t k0) {
 }
 
 namespace {
+
+// CPU time of the process, user + system (s): every thread's.
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 // The first SIGINT, SIGTERM or SIGHUP asks the run to stop at its next series
 // row, where a checkpoint falls as it always does, so that the resumed run is
@@ -144,6 +159,107 @@ ProblemDumps::ProblemDumps(const std::vector<std::int64_t>& steps, std::int64_t 
 
 WriteError ProblemDumps::failed(std::int64_t k, const WriteError& e) {
   return WriteError(fmt::format("--dump-problem {}: {}", k, e.what()));
+}
+
+void SeriesInterval::add(const StepStats& s) {
+  ++steps;
+  iter_sum += s.solve.iterations;
+  iter_max = std::max(iter_max, s.solve.iterations);
+  cap_hits += s.solve.cap_hit;
+  res_max = std::max(res_max, s.solve.residual_max);
+  res_mean_sum += s.solve.residual_mean;
+  ov_max = std::max(ov_max, s.max_overlap);
+  ov_small = std::max(ov_small, s.max_overlap_small);
+  corr_work += s.correction_work;
+  proj_work += s.projection_work;
+}
+
+CostRecord::CostRecord(const RunTotals& so_far, RunClock::time_point start)
+    : totals_(so_far), start_(start), cpu0_(cpu_seconds()) {
+  sum_.load_start = load_average();
+}
+
+void CostRecord::add(const StepStats& st) {
+  iterations_ += st.solve.iterations;
+  sum_.max_iterations = std::max(sum_.max_iterations, st.solve.iterations);
+  sum_.cap_hits += st.solve.cap_hit;
+  sum_.anderson_off += st.solve.anderson_off > 0;
+  sum_.subspace_off += st.solve.subspace_off > 0;
+  sum_.subspace_iterations += st.solve.subspace_iterations;
+  sum_.floor_steps += st.floor_held;
+  sum_.max_residual = std::max(sum_.max_residual, st.solve.residual_max);
+  sum_.max_overlap = std::max(sum_.max_overlap, st.max_overlap);
+  sum_.max_overlap_small = std::max(sum_.max_overlap_small, st.max_overlap_small);
+  totals_.sweeps += st.solve.iterations;
+  totals_.sweeps_max = std::max(totals_.sweeps_max, double(st.solve.iterations));
+  totals_.cap_steps += st.solve.cap_hit;
+  totals_.residual_max = std::max(totals_.residual_max, st.solve.residual_max);
+  totals_.residual_last = st.solve.residual_max;
+  totals_.overlap_max = std::max(totals_.overlap_max, st.max_overlap);
+  totals_.cg_iterations += st.solve.subspace_iterations;
+  totals_.anderson_off_steps += st.solve.anderson_off > 0;
+  totals_.subspace_off_steps += st.solve.subspace_off > 0;
+  totals_.floor_steps += st.floor_held;
+}
+
+RunTotals CostRecord::totals_now() const {
+  RunTotals t = totals_;
+  t.wall += std::chrono::duration<double>(RunClock::now() - start_).count();
+  t.cpu += cpu_seconds() - cpu0_;
+  return t;
+}
+
+void CostRecord::end_session(std::int64_t k0, std::int64_t k_end, std::int64_t nsteps) {
+  sum_.first_step = k0;
+  sum_.steps = k_end - k0;
+  sum_.total_steps = nsteps;
+  sum_.mean_iterations = sum_.steps ? double(iterations_) / sum_.steps : 0.0;
+  sum_.wall_time = std::chrono::duration<double>(RunClock::now() - start_).count();
+}
+
+void CostRecord::write_summary(const char* status, std::int64_t last, std::int64_t nsteps, const RunFolder& folder) {
+  sum_.status = status;
+  sum_.last_step = last;
+  sum_.total_steps = nsteps;
+  sum_.totals = totals_now();
+  sum_.threads = omp_get_max_threads();
+  sum_.load_end = load_average();
+  folder.check();
+  write_file_atomic(folder.file("summary.toml"), summary_toml(sum_));
+}
+
+ProgressLines::ProgressLines(const RunOptions& opt, std::int64_t nsteps, std::int64_t k0, RunClock::time_point start)
+    : out_(opt.out), every_(opt.progress_every), terminal_(!opt.quiet && isatty(STDERR_FILENO)), nsteps_(nsteps),
+      k0_(k0), start_(start), last_terminal_(start), last_line_(start) {}
+
+void ProgressLines::after_step(std::int64_t k, const StepStats& st) {
+  if (every_ > 0 && k < nsteps_) {
+    const auto now = RunClock::now();
+    if (now - last_line_ >= std::chrono::duration<double>(every_)) {
+      last_line_ = now;
+      const double el = std::chrono::duration<double>(now - start_).count();
+      std::printf("cdsim: %s: %.1f %% (step %lld of %lld), %.0f s in this session, ETA %.0f s\n",
+                  out_.c_str(), 100.0 * double(k) / double(nsteps_), static_cast<long long>(k),
+                  static_cast<long long>(nsteps_), el, el / double(k - k0_) * double(nsteps_ - k));
+      std::fflush(stdout);
+    }
+  }
+  if (terminal_) {
+    const auto now = RunClock::now();
+    if (now - last_terminal_ > std::chrono::milliseconds(500) || k == nsteps_) {
+      last_terminal_ = now;
+      const double el = std::chrono::duration<double>(now - start_).count();
+      const double eta = el / (k - k0_) * (nsteps_ - k);
+      std::fprintf(stderr, "\r%5.1f%%  ETA %6.1fs  step %lld/%lld  contacts %d  iterations %d   ",
+                   100.0 * k / nsteps_, eta, static_cast<long long>(k), static_cast<long long>(nsteps_),
+                   st.contacts, st.solve.iterations);
+      std::fflush(stderr);
+    }
+  }
+}
+
+void ProgressLines::end() const {
+  if (terminal_) std::fprintf(stderr, "\n");
 }
 
 }  // namespace cd

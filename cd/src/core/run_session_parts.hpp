@@ -1,7 +1,8 @@
 // The parts of a run session (run_loop.hpp), each one concern that can be
 // read and tested alone: the output folder and its lock, the resume from a
 // checkpoint, when outputs fall, a stop asked by a signal, the
-// --dump-problem steps.
+// --dump-problem steps, the cost record (summary.toml) and the progress
+// lines.
 #pragma once
 #include <algorithm>
 #include <chrono>
@@ -15,6 +16,7 @@
 #include "files.hpp"
 #include "run_loop.hpp"
 #include "run_plan.hpp"
+#include "stages.hpp"
 
 namespace cd {
 
@@ -155,6 +157,70 @@ class ProblemDumps {
 
  private:
   std::vector<std::int64_t> steps_;
+};
+
+// Step statistics over one series interval (the row's solver, overlap and
+// work columns); t0: the stage timers at its start.
+struct SeriesInterval {
+  int steps = 0;
+  long iter_sum = 0;
+  int iter_max = 0;
+  int cap_hits = 0;
+  double res_max = 0, res_mean_sum = 0;
+  double ov_max = 0, ov_small = 0;
+  double corr_work = 0, proj_work = 0;
+  StageTimes t0;
+
+  void add(const StepStats& s);
+};
+
+// The cost record of a session: its statistics (RunSummary, cdsim's closing
+// lines) and the run's totals over every session (summary.toml), counted
+// step by step, with the session's wall and CPU time.
+class CostRecord {
+ public:
+  // The session starts at `start`: its CPU clock and the machine's load are
+  // read now. `so_far`: the run's totals at the checkpoint it resumes from
+  // (zero for a fresh run).
+  CostRecord(const RunTotals& so_far, RunClock::time_point start);
+  // A session that takes steps is one more of the run's.
+  void count_session() { totals_.sessions += 1; }
+  void add(const StepStats& st);
+  // The totals as they stand now: the wall and CPU time of this session added.
+  RunTotals totals_now() const;
+  // The session's closing figures: it took steps k0+1 .. k_end of nsteps.
+  void end_session(std::int64_t k0, std::int64_t k_end, std::int64_t nsteps);
+  RunSummary& summary() { return sum_; }
+  // summary.toml, at the end of the session however it ends; `last` is the
+  // last step taken (counted).
+  void write_summary(const char* status, std::int64_t last, std::int64_t nsteps, const RunFolder& folder);
+
+ private:
+  RunSummary sum_;
+  RunTotals totals_;
+  RunClock::time_point start_;
+  double cpu0_;
+  long iterations_ = 0;  // the session's sweeps, for its mean
+};
+
+// The progress of a session: on a terminal (unless quiet), a line on stderr
+// rewritten every half second; with --progress, a whole line on stdout
+// every so many seconds of wall clock, quiet or not, terminal or log.
+class ProgressLines {
+ public:
+  // The session runs steps k0+1 .. nsteps from `start`.
+  ProgressLines(const RunOptions& opt, std::int64_t nsteps, std::int64_t k0, RunClock::time_point start);
+  bool on_terminal() const { return terminal_; }
+  void after_step(std::int64_t k, const StepStats& st);
+  // Ends the terminal's line.
+  void end() const;
+
+ private:
+  std::string out_;
+  double every_;  // s between the stdout lines; 0: none
+  bool terminal_;
+  std::int64_t nsteps_, k0_;
+  RunClock::time_point start_, last_terminal_, last_line_;
 };
 
 }  // namespace cd
