@@ -14,7 +14,7 @@
 #include "cohesion.hpp"
 #include "cost.hpp"
 #include "plot.hpp"
-#include "scene_info.hpp"
+#include "report_scan.hpp"
 #include "trends.hpp"
 
 namespace fs = std::filesystem;
@@ -62,39 +62,6 @@ std::string or_na(double v, double err) {
                           : "n/a";
 }
 
-// One row of the report's table of points: physics and cost side by side.
-struct Point {
-  std::string name, status;
-  double I = std::nan(""), I_err = std::nan(""), mu = std::nan(""), mu_err = std::nan("");
-  double phi = std::nan(""), phi_err = std::nan(""), z = std::nan(""), z_err = std::nan("");
-  double p = std::nan(""), p_err = std::nan("");
-  std::optional<RunCost> cost;
-  // From scene.toml (nan / -1 when absent) and the particles snapshots.
-  std::string run;
-  double eta = std::nan(""), I_imposed = std::nan(""), pressure = std::nan("");
-  int nsides = -1;
-  bool steady = false;
-};
-
-// The shapes of a run: the nsides of its last particles snapshot when it
-// has one shape there, else scene.toml's; -1 unknown or mixed.
-int run_nsides(const std::string& run, const std::optional<SceneInfo>& scene) {
-  try {
-    const auto snaps = list_snapshots(run, "particles");
-    if (!snaps.empty()) {
-      int n = -2;
-      for (const auto& q : read_particles(snaps.back())) {
-        if (q.nsides < 0) break;
-        if (n == -2) n = q.nsides;
-        else if (n != q.nsides) return -1;
-      }
-      if (n >= 0) return n;
-    }
-  } catch (const AnalysisError&) {
-  }
-  return scene && scene->nsides ? *scene->nsides : -1;
-}
-
 // Distinct finite values.
 std::vector<double> distinct(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
@@ -110,16 +77,16 @@ std::string made_by(const std::string& report_cmd, const std::string& fit_cmd) {
 
 // Wall time and sweeps per step against the measured I (log-log), the
 // points of an inertial campaign: dir/cost_I.{png,svg}, data in cost_I.csv.
-bool plot_cost_I(const std::string& dir, const std::vector<Point>& points) {
+bool plot_cost_I(const std::string& dir, const ReportScan& scan) {
   // Every run with a cost: the runs left out of the fits (no steady window)
   // are often the most expensive, and leaving them out would make the cost
   // seem to fall steadily with I. Such a run is placed at its imposed I and
   // drawn apart (open symbols).
   Table t({"I", "wall_time", "sweeps_per_step", "cap_share", "steps", "steady"});
-  for (const Point& p : points) {
+  for (const ReportRun& p : scan.runs) {
     if (!p.cost) continue;
-    const bool measured = p.steady && std::isfinite(p.I) && p.I > 0;
-    const double I = measured ? p.I : p.I_imposed;
+    const bool measured = p.steady && std::isfinite(p.I.v) && p.I.v > 0;
+    const double I = measured ? p.I.v : p.I_imposed;
     if (std::isfinite(I) && I > 0)
       t.add_row({I, p.cost->wall_time, p.cost->sweeps_per_step, p.cost->cap_share, p.cost->steps, measured ? 1.0 : 0.0});
   }
@@ -137,6 +104,78 @@ bool plot_cost_I(const std::string& dir, const std::vector<Point>& points) {
       "     'cost_I.csv' every ::1 using 1:($6 > 0 ? 1/0 : $3) axes x1y2 with points pt 4 ps 1.5 lc rgb '#b03a2e' "
       "title 'sweeps per step, not steady'\n";
   return plot_both(dir, "cost_I", body);
+}
+
+
+// The shear profile's rate_min over the steady window, when measured.
+std::string shear_profile_html(const Val& rate_min) {
+  return fmt::format("<p>shear profile (5 layers): rate_min = {}{}</p>\n", or_na(rate_min.v, rate_min.err),
+                     is_banded(rate_min.v) ? " — <b>banded</b>: a layer moves nearly as a rigid plug; this run's I is "
+                                             "not the local one (cdanalysis profile)"
+                                           : "");
+}
+
+// 3D: the window's anisotropies beside q/p, and which snapshots made them.
+std::string fabric3_html(const ReportRun& r) {
+  const WindowFabric3& fw = *r.fabric3;
+  const Window w = r.main_stats ? r.main_stats->window : Window{};
+  const char* xs = r.x_column == "strain" ? "γ" : "t";
+  const double qp = fw.of("q_over_p").v;
+  const double rel = fw.check_rel, rel_err = fw.check_rel_err;
+  const std::string what =
+      fw.averaged ? fmt::format("mean ± sem over {} snapshots in the steady window {} = {:.4g}–{:.4g} ({} … {}; "
+                                "{:.0f} force-bearing contacts each on average)",
+                                fw.files.size(), xs, w.x_begin, w.x_end, html_escape(fw.files.front()),
+                                html_escape(fw.files.back()), fw.bearing)
+                  : fmt::format("last snapshot {} alone ({}; no error bars from one snapshot; {:.0f} "
+                                "force-bearing contacts)",
+                                html_escape(fw.files.front()), html_escape(fw.alone), fw.bearing);
+  return fmt::format(
+      "<p>fabric: {}: a_c = {}, a_n = {}, a_t = {}; q/p = {} (q = (σ1 − σ3)/3) against "
+      "(2/5)(a_c + a_n + a_t) = {}: relative deviation ((2/5)Σa − q/p)/(q/p) = {}; "
+      "μ = −σ_xy/σ_yy = {}; z = {}</p>\n",
+      what, or_na(fw.of("a_c").v, fw.of("a_c").err), or_na(fw.of("a_n").v, fw.of("a_n").err),
+      or_na(fw.of("a_t").v, fw.of("a_t").err), or_na(qp, fw.of("q_over_p").err),
+      or_na(fw.of("sum_2_5").v, fw.of("sum_2_5").err),
+      std::isfinite(rel) ? (std::isfinite(rel_err) ? fmt::format("{:+.1f} % ± {:.1f} %", 100 * rel, 100 * rel_err)
+                                                   : fmt::format("{:+.1f} %", 100 * rel))
+                         : std::string("n/a"),
+      or_na(fw.of("mu").v, fw.of("mu").err), or_na(fw.of("z").v, fw.of("z").err));
+}
+
+// 2D: the last snapshot's polar diagrams.
+std::string fabric2_html(const ReportRun& r) {
+  std::string s = fmt::format("<p>last snapshot {}</p>\n", html_escape(r.fabric2->file));
+  for (const char* q : {"P", "fn", "ft"}) s += fmt::format("<img src='{}_polar_{}.png' width=300>\n", r.stem(), q);
+  return s;
+}
+
+// A run's section under Runs: what failed, its shear profile, its series
+// plot and its fabric.
+std::string run_html(const ReportRun& r) {
+  std::string s = fmt::format("<h3>{} ({})</h3>\n", html_escape(r.name), r.stem());
+  if (!r.skipped_why.empty()) s += fmt::format("<p>{}</p>\n", html_escape(r.skipped_why));
+  if (r.measured && std::isfinite(r.rate_min.v)) s += shear_profile_html(r.rate_min);
+  if (!r.not_steady_why.empty()) s += fmt::format("<p>not steady: {}</p>\n", html_escape(r.not_steady_why));
+  if (r.curve) s += fmt::format("<img src='{}_series.png' width=600>\n", r.stem());
+  if (r.fabric3) s += fabric3_html(r);
+  if (r.fabric2) s += fabric2_html(r);
+  if (!r.fabric_why.empty()) s += fmt::format("<p>fabric: {}</p>\n", html_escape(r.fabric_why));
+  if (!r.unreadable_why.empty()) s += fmt::format("<p>{}</p>\n", html_escape(r.unreadable_why));
+  return s;
+}
+
+// Each run's series, its steady window shaded, and (2D) the polar diagrams
+// of its last contact snapshot. False when gnuplot failed on one of them.
+bool draw_run_plots(const ReportScan& scan, const std::string& out_dir) {
+  bool ok = true;
+  for (const ReportRun& r : scan.runs) {
+    if (r.curve)
+      ok = plot_series(out_dir, r.stem() + "_series", *r.curve, r.x_column, r.main_column,
+                       r.main_stats ? &*r.main_stats : nullptr) && ok;
+    if (r.fabric2) ok = plot_polar(out_dir, r.stem() + "_polar", *r.fabric2) && ok;
+  }
+  return ok;
 }
 
 }  // namespace
@@ -271,21 +310,11 @@ std::vector<std::string> campaign_runs(const std::string& campaign) {
 }
 
 ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins) {
-  const auto runs = campaign_runs(campaign);
+  const ReportScan scan = scan_campaign(campaign, bins);
   fs::create_directories(out_dir);
-  ReportSummary sum;
-  sum.runs = runs.size();
-  // The campaign's dimension: its first run whose scene.toml reads (2 when
-  // none does). A run of the other dimension is listed and skipped.
-  int dim = 2;
-  for (const auto& run : runs) {
-    try {
-      dim = run_dimension(run);
-      break;
-    } catch (const AnalysisError&) {
-    }
-  }
-  sum.dimension = dim;
+  ReportSummary sum = summarize(scan);
+  sum.plots_ok = draw_run_plots(scan, out_dir);
+  const int dim = scan.dimension;
   const std::string mu_col = mu_column(dim);
   const std::vector<std::string> quantities = {mu_col, "inertial_number", "packing_fraction", "z", "p"};
   std::vector<std::string> names = {"run"};
@@ -316,195 +345,57 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   std::string runs_csv = "run,folder,status";
   for (const auto& c : kCostColumns) runs_csv += "," + c;
   runs_csv += ",threads\n";
-  std::vector<Point> points;
   std::string html_runs;
-  std::vector<double> I, mu, mu_err;
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    const std::string& run = runs[k];
-    const std::string name = fs::path(run).filename().string();
-    std::string status = "ok";
-    std::string stem = fmt::format("run{:03d}", k);
-    html_runs += fmt::format("<h3>{} ({})</h3>\n", html_escape(name), stem);
-    Point pt;
-    pt.name = name;
-    pt.run = run;
-    {
-      std::optional<SceneInfo> scene;
-      try {
-        scene = read_scene_info(run);
-        if (scene->dimension != dim) {
-          status = "skipped";
-          const std::string why = fmt::format("{}: a {}D run in a {}D campaign (the first run's dimension): "
-                                              "skipped", run, scene->dimension, dim);
-          sum.problems.push_back(why);
-          html_runs += fmt::format("<p>{}</p>\n", html_escape(why));
-        } else {  // a skipped run says nothing of the campaign's kind
-          if (scene->cohesion_number) pt.eta = *scene->cohesion_number;
-          if (scene->inertial_number) pt.I_imposed = *scene->inertial_number;
-          if (scene->pressure) pt.pressure = *scene->pressure;
-        }
-      } catch (const AnalysisError&) {
+  for (const ReportRun& r : scan.runs) {
+    const std::vector<double> cost = cost_values(r.cost);
+    if (r.measured) {
+      // The steady means by column name, in the order of quantities.
+      std::map<std::string, double> row = {{"run", static_cast<double>(r.index)}};
+      const Val* mean[] = {&r.mu, &r.I, &r.phi, &r.z, &r.p};
+      for (std::size_t q = 0; q < quantities.size(); ++q) {
+        row[quantities[q]] = mean[q]->v;
+        row[quantities[q] + "_err"] = mean[q]->err;
       }
-      pt.nsides = run_nsides(run, scene);
+      row["window_begin"] = r.main_stats->window.x_begin;
+      row["window_end"] = r.main_stats->window.x_end;
+      row["tau_int"] = r.main_stats->acf.tau;
+      row["n_eff"] = r.main_stats->acf.n_eff;
+      row["rate_min"] = r.rate_min.v;
+      row["rate_min_err"] = r.rate_min.err;
+      for (std::size_t c = 0; c < kCostColumns.size(); ++c) row[kCostColumns[c]] = cost[c];
+      steady.add_named_row(row);
     }
-    try {
-      pt.cost = read_run_cost(run);
-    } catch (const AnalysisError& e) {
-      sum.problems.push_back(e.what());  // the cost columns say n/a
-    }
-    if (pt.cost) {
-      ++sum.costed;
-      sum.wall_time += pt.cost->wall_time;
-      sum.cpu_time += pt.cost->cpu_time;
-    }
-    const std::vector<double> cost = cost_values(pt.cost);
-    try {
-      const auto series = read_series(run);
-      const std::string xc = default_x_column(series);
-      if (status == "skipped") throw AnalysisError("");
-      const std::string main = series.has(mu_col) ? mu_col : "kinetic_energy";
-      Window w{};
-      bool have_window = false;
-      std::optional<SteadyStats> main_stats;
-      try {
-        const auto rs = run_steady(run, series, main, xc, std::nullopt);
-        w = rs.stats.window;
-        have_window = true;
-        main_stats = rs.stats;
-        // The steady means by column name: the table's row and the point read
-        // the same named values.
-        std::map<std::string, double> row = {{"run", static_cast<double>(k)}};
-        std::map<std::string, Val> mean;
-        for (const auto& q : quantities) {
-          Val m;  // nan when the series has no such column
-          if (q == "inertial_number" && series.has(q)) {
-            const auto st = measured_inertial_number(series, xc, w);  // from <sigma_yy>
-            m = {st.mean, st.err};
-          } else if (series.has(q)) {
-            const auto st = stats_over(series, q, xc, w);
-            m = {st.mean, st.error()};
-          }
-          mean[q] = m;
-          row[q] = m.v;
-          row[q + "_err"] = m.err;
-        }
-        row["window_begin"] = w.x_begin;
-        row["window_end"] = w.x_end;
-        row["tau_int"] = rs.stats.acf.tau;
-        row["n_eff"] = rs.stats.acf.n_eff;
-        // Is the shear homogeneous over the window? (run.hpp shear_profile;
-        // nan for a run without particle snapshots or not a periodic shear)
-        const Val rate_min = window_rate_min(run, series, xc, w);
-        if (std::isfinite(rate_min.v)) {
-          html_runs += fmt::format("<p>shear profile (5 layers): rate_min = {}{}</p>\n",
-                                   or_na(rate_min.v, rate_min.err),
-                                   is_banded(rate_min.v)
-                                       ? " — <b>banded</b>: a layer moves nearly as a rigid plug; this run's I is "
-                                         "not the local one (cdanalysis profile)"
-                                       : "");
-          if (is_banded(rate_min.v)) status = "banded";
-          if (is_banded(rate_min.v))
-            sum.problems.push_back(fmt::format("{}: banded shear (rate_min {:.2f} < {}; cdanalysis profile)", run,
-                                               rate_min.v, kBandedRateMin));
-        }
-        row["rate_min"] = rate_min.v;
-        row["rate_min_err"] = rate_min.err;
-        for (std::size_t c = 0; c < kCostColumns.size(); ++c) row[kCostColumns[c]] = cost[c];
-        steady.add_named_row(row);
-        pt.mu = mean[mu_col].v, pt.mu_err = mean[mu_col].err;
-        pt.I = mean["inertial_number"].v, pt.I_err = mean["inertial_number"].err;
-        pt.phi = mean["packing_fraction"].v, pt.phi_err = mean["packing_fraction"].err;
-        pt.z = mean["z"].v, pt.z_err = mean["z"].err;
-        pt.p = mean["p"].v, pt.p_err = mean["p"].err;
-        pt.steady = series.has(mu_col) || series.has("packing_fraction");
-        ++sum.steady;
-      } catch (const AnalysisError& e) {
-        status = "not steady";
-        sum.problems.push_back(fmt::format("{}: {}", run, e.what()));
-        html_runs += fmt::format("<p>not steady: {}</p>\n", html_escape(e.what()));
+    if (r.fabric3) {
+      const WindowFabric3& fw = *r.fabric3;
+      std::map<std::string, double> frow = {{"run", static_cast<double>(r.index)}};
+      for (const auto& c : kFabric3Columns) {
+        frow[c] = fw.of(c).v;
+        frow[c + "_err"] = fw.of(c).err;
       }
-      sum.plots_ok = plot_series(out_dir, stem + "_series", series, xc, main, main_stats ? &*main_stats : nullptr) && sum.plots_ok;
-      html_runs += fmt::format("<img src='{}_series.png' width=600>\n", stem);
-      if (dim == 3 && !list_snapshots(run, "contacts").empty()) {
-        try {
-          const auto fw = window_fabric3(run, series, xc, have_window ? &w : nullptr);
-          sum.problems.insert(sum.problems.end(), fw.problems.begin(), fw.problems.end());
-          const char* xs = xc == "strain" ? "γ" : "t";
-          std::map<std::string, double> frow = {{"run", static_cast<double>(k)}};
-          for (const auto& c : kFabric3Columns) {
-            frow[c] = fw.of(c).v;
-            frow[c + "_err"] = fw.of(c).err;
-          }
-          const double rel = fw.check_rel, rel_err = fw.check_rel_err;
-          frow["check_rel"] = rel;
-          frow["check_rel_err"] = rel_err;
-          frow["fabric_snapshots"] = static_cast<double>(fw.files.size());
-          for (std::size_t c = 0; c < kCostColumns.size(); ++c) frow[kCostColumns[c]] = cost[c];
-          fabric.add_named_row(frow);
-          ++sum.fabric;
-          const double qp = fw.of("q_over_p").v;
-          const std::string what =
-              fw.averaged ? fmt::format("mean ± sem over {} snapshots in the steady window {} = {:.4g}–{:.4g} ({} … {}; "
-                                        "{:.0f} force-bearing contacts each on average)",
-                                        fw.files.size(), xs, w.x_begin, w.x_end, html_escape(fw.files.front()),
-                                        html_escape(fw.files.back()), fw.bearing)
-                          : fmt::format("last snapshot {} alone ({}; no error bars from one snapshot; {:.0f} "
-                                        "force-bearing contacts)",
-                                        html_escape(fw.files.front()), html_escape(fw.alone), fw.bearing);
-          html_runs += fmt::format(
-              "<p>fabric: {}: a_c = {}, a_n = {}, a_t = {}; q/p = {} (q = (σ1 − σ3)/3) against "
-              "(2/5)(a_c + a_n + a_t) = {}: relative deviation ((2/5)Σa − q/p)/(q/p) = {}; "
-              "μ = −σ_xy/σ_yy = {}; z = {}</p>\n",
-              what, or_na(fw.of("a_c").v, fw.of("a_c").err), or_na(fw.of("a_n").v, fw.of("a_n").err),
-              or_na(fw.of("a_t").v, fw.of("a_t").err), or_na(qp, fw.of("q_over_p").err),
-              or_na(fw.of("sum_2_5").v, fw.of("sum_2_5").err),
-              std::isfinite(rel) ? (std::isfinite(rel_err)
-                                        ? fmt::format("{:+.1f} % ± {:.1f} %", 100 * rel, 100 * rel_err)
-                                        : fmt::format("{:+.1f} %", 100 * rel))
-                                 : std::string("n/a"),
-              or_na(fw.of("mu").v, fw.of("mu").err), or_na(fw.of("z").v, fw.of("z").err));
-        } catch (const AnalysisError& e) {
-          sum.problems.push_back(fmt::format("{}: {}", run, e.what()));
-          html_runs += fmt::format("<p>fabric: {}</p>\n", html_escape(e.what()));
-        }
-      } else if (!list_snapshots(run, "contacts").empty()) {
-        try {
-          const auto f = run_fabric(run, -1, bins, -1);
-          const auto& a = f.fft;
-          const auto& b = f.tensor;
-          std::map<std::string, double> frow = {
-              {"run", static_cast<double>(k)}, {"a_c", a.c.a()}, {"theta_c", a.c.theta()},
-              {"a_ln", a.ln.a()}, {"a_lt", a.lt.a()}, {"a_fn", a.fn.a()}, {"a_ft", a.ft.a()},
-              {"sum_half", a.sum_half()}, {"q_over_p", f.stress.q_over_p()}, {"a_c_tensor", b.c.a()},
-              {"a_ln_tensor", b.ln.a()}, {"a_lt_tensor", b.lt.a()}, {"a_fn_tensor", b.fn.a()},
-              {"a_ft_tensor", b.ft.a()}, {"sliding", f.sliding},
-              {"z", f.connectivity ? f.connectivity->z : std::nan("")},
-              {"non_floating", f.connectivity ? f.connectivity->non_floating : std::nan("")}};
-          for (std::size_t c = 0; c < kCostColumns.size(); ++c) frow[kCostColumns[c]] = cost[c];
-          fabric.add_named_row(frow);
-          ++sum.fabric;
-          sum.plots_ok = plot_polar(out_dir, stem + "_polar", f) && sum.plots_ok;
-          html_runs += fmt::format("<p>last snapshot {}</p>\n", html_escape(f.file));
-          for (const char* q : {"P", "fn", "ft"})
-            html_runs += fmt::format("<img src='{}_polar_{}.png' width=300>\n", stem, q);
-        } catch (const AnalysisError& e) {
-          sum.problems.push_back(fmt::format("{}: {}", run, e.what()));
-          html_runs += fmt::format("<p>fabric: {}</p>\n", html_escape(e.what()));
-        }
-      }
-    } catch (const AnalysisError& e) {
-      if (status != "skipped") {
-        status = "unreadable";
-        sum.problems.push_back(e.what());
-        html_runs += fmt::format("<p>{}</p>\n", html_escape(e.what()));
-      }
+      frow["check_rel"] = fw.check_rel;
+      frow["check_rel_err"] = fw.check_rel_err;
+      frow["fabric_snapshots"] = static_cast<double>(fw.files.size());
+      for (std::size_t c = 0; c < kCostColumns.size(); ++c) frow[kCostColumns[c]] = cost[c];
+      fabric.add_named_row(frow);
+    } else if (r.fabric2) {
+      const RunFabric& f = *r.fabric2;
+      const auto& a = f.fft;
+      const auto& b = f.tensor;
+      std::map<std::string, double> frow = {
+          {"run", static_cast<double>(r.index)}, {"a_c", a.c.a()}, {"theta_c", a.c.theta()},
+          {"a_ln", a.ln.a()}, {"a_lt", a.lt.a()}, {"a_fn", a.fn.a()}, {"a_ft", a.ft.a()},
+          {"sum_half", a.sum_half()}, {"q_over_p", f.stress.q_over_p()}, {"a_c_tensor", b.c.a()},
+          {"a_ln_tensor", b.ln.a()}, {"a_lt_tensor", b.lt.a()}, {"a_fn_tensor", b.fn.a()},
+          {"a_ft_tensor", b.ft.a()}, {"sliding", f.sliding},
+          {"z", f.connectivity ? f.connectivity->z : std::nan("")},
+          {"non_floating", f.connectivity ? f.connectivity->non_floating : std::nan("")}};
+      for (std::size_t c = 0; c < kCostColumns.size(); ++c) frow[kCostColumns[c]] = cost[c];
+      fabric.add_named_row(frow);
     }
-    runs_csv += fmt::format("{},\"{}\",{}", k, run, status);
+    runs_csv += fmt::format("{},\"{}\",{}", r.index, r.folder, r.status);
     for (const double v : cost) runs_csv += "," + or_na(v, "{}");  // shortest exact text
-    runs_csv += "," + (pt.cost ? fmt::format("{}", pt.cost->threads) : std::string("n/a")) + "\n";
-    pt.status = status;
-    if (status == "skipped" || status == "not steady" || status == "unreadable") ++sum.left_out;
-    points.push_back(pt);
+    runs_csv += "," + (r.cost ? fmt::format("{}", r.cost->threads) : std::string("n/a")) + "\n";
+    html_runs += run_html(r);
   }
   write_text((fs::path(out_dir) / "runs.csv").string(), runs_csv);
   steady.write_csv((fs::path(out_dir) / "steady.csv").string());
@@ -518,7 +409,7 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
 
   // The campaign's kind, from the runs: what their scenes (and shapes) vary.
   std::vector<double> etas, Is, ps, ns;
-  for (const Point& p : points) {
+  for (const ReportRun& p : scan.runs) {
     etas.push_back(p.eta);
     Is.push_back(p.I_imposed);
     ps.push_back(p.pressure);
@@ -529,8 +420,8 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   bool by_I = distinct(Is).size() >= 2;
   if (distinct(Is).empty()) {  // no scene says I: the measured I spanning a factor 1.5
     double lo = INFINITY, hi = 0;
-    for (const Point& p : points)
-      if (std::isfinite(p.I) && p.I > 0) lo = std::min(lo, p.I), hi = std::max(hi, p.I);
+    for (const ReportRun& p : scan.runs)
+      if (std::isfinite(p.I.v) && p.I.v > 0) lo = std::min(lo, p.I.v), hi = std::max(hi, p.I.v);
     by_I = hi >= 1.5 * lo;
   }
   std::vector<std::string> kinds;
@@ -564,19 +455,19 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     std::vector<double> I, mu, mu_err;
     std::vector<StatePoint> sp;
     const int shape0 = [&] {
-      for (const Point& p : points)
+      for (const ReportRun& p : scan.runs)
         if (p.steady) return p.nsides;
       return -1;
     }();
-    for (const Point& p : points) {
-      if (!p.steady || !std::isfinite(p.I) || (std::isfinite(p.eta) && p.eta != 0) || p.nsides != shape0)
+    for (const ReportRun& p : scan.runs) {
+      if (!p.steady || !std::isfinite(p.I.v) || (std::isfinite(p.eta) && p.eta != 0) || p.nsides != shape0)
         continue;
-      if (std::isfinite(p.mu)) I.push_back(p.I), mu.push_back(p.mu), mu_err.push_back(p.mu_err);
-      if (std::isfinite(p.phi)) {
+      if (std::isfinite(p.mu.v)) I.push_back(p.I.v), mu.push_back(p.mu.v), mu_err.push_back(p.mu.err);
+      if (std::isfinite(p.phi.v)) {
         StatePoint s;
-        s.run = p.run;
-        s.I = {p.I, p.I_err};
-        s.nu = {p.phi, p.phi_err};
+        s.run = p.folder;
+        s.I = {p.I.v, p.I.err};
+        s.nu = {p.phi.v, p.phi.err};
         sp.push_back(s);
       }
     }
@@ -655,12 +546,12 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   // Pressure series: e = e0 - lambda ln(p/p0).
   if (by_p) {
     std::vector<StatePoint> sp;
-    for (const Point& p : points) {
-      if (!p.steady || !std::isfinite(p.phi)) continue;
+    for (const ReportRun& p : scan.runs) {
+      if (!p.steady || !std::isfinite(p.phi.v)) continue;
       StatePoint s;
-      s.run = p.run;
-      s.nu = {p.phi, p.phi_err};
-      s.p = std::isfinite(p.p) ? Val{p.p, p.p_err} : Val{p.pressure, std::nan("")};
+      s.run = p.folder;
+      s.nu = {p.phi.v, p.phi.err};
+      s.p = std::isfinite(p.p.v) ? Val{p.p.v, p.p.err} : Val{p.pressure, std::nan("")};
       sp.push_back(s);
     }
     try {
@@ -688,9 +579,9 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   if (by_eta) {
     try {
       std::vector<SteadyPoint> ref_pts, coh_pts;
-      for (const Point& p : points) {
+      for (const ReportRun& p : scan.runs) {
         if (!p.steady || !std::isfinite(p.eta)) continue;
-        const auto q = steady_point(p.run);
+        const auto q = steady_point(p.folder);
         (q.eta == 0 ? ref_pts : coh_pts).push_back(q);
       }
       if (coh_pts.empty() || ref_pts.empty())
@@ -730,10 +621,10 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
     std::vector<AngularityPoint> ap;
     AngularityOptions opt;
     opt.bins = bins;
-    for (const Point& p : points) {
+    for (const ReportRun& p : scan.runs) {
       if (!p.steady) continue;
       try {
-        ap.push_back(angularity_point(p.run, opt));
+        ap.push_back(angularity_point(p.folder, opt));
       } catch (const AnalysisError& e) {
         sum.problems.push_back(fmt::format("angularity: {}", e.what()));
       }
@@ -791,13 +682,13 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   {
     double lo = INFINITY, hi = 0;
     std::size_t n = 0;
-    for (const Point& p : points) {
-      const double I = p.steady && std::isfinite(p.I) && p.I > 0 ? p.I : p.I_imposed;
+    for (const ReportRun& p : scan.runs) {
+      const double I = p.steady && std::isfinite(p.I.v) && p.I.v > 0 ? p.I.v : p.I_imposed;
       if (p.cost && std::isfinite(I) && I > 0) ++n, lo = std::min(lo, I), hi = std::max(hi, I);
     }
     if (n >= 2 && hi >= 1.5 * lo) {
       sum.cost_plot = true;
-      sum.plots_ok = plot_cost_I(out_dir, points) && sum.plots_ok;
+      sum.plots_ok = plot_cost_I(out_dir, scan) && sum.plots_ok;
       html_cost = "<h2>Cost against I</h2><img src='cost_I.png' width=600>"
                   "<p>Every run with a summary.toml; the runs without a steady window (open symbols) at their "
                   "imposed I. Data: <a href='cost_I.csv'>cost_I.csv</a>.</p>\n";
@@ -815,13 +706,13 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
       "<tr><th>run</th><th>status</th><th>I</th><th>" + std::string(dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") +
       "</th><th>φ</th><th>z</th>"
       "<th>wall time (s)</th><th>CPU time (s)</th><th>steps</th><th>sweeps/step</th><th>at cap</th></tr>\n";
-  for (const Point& p : points) {
+  for (const ReportRun& p : scan.runs) {
     const std::vector<double> c = cost_values(p.cost);
     html_points += fmt::format(
         "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
         "<td>{}</td><td>{}</td><td>{}</td></tr>\n",
-        html_escape(p.name), html_escape(p.status), or_na(p.I, p.I_err), or_na(p.mu, p.mu_err),
-        or_na(p.phi, p.phi_err), or_na(p.z, p.z_err), or_na(c[0], "{:.1f}"), or_na(c[1], "{:.1f}"),
+        html_escape(p.name), html_escape(p.status), or_na(p.I.v, p.I.err), or_na(p.mu.v, p.mu.err),
+        or_na(p.phi.v, p.phi.err), or_na(p.z.v, p.z.err), or_na(c[0], "{:.1f}"), or_na(c[1], "{:.1f}"),
         or_na(c[2], "{:.0f}"), or_na(c[3], "{:.1f}"),
         std::isfinite(c[4]) ? fmt::format("{:.1f} %", 100 * c[4]) : "n/a");
   }
