@@ -15,6 +15,7 @@
 #include "cost.hpp"
 #include "plot.hpp"
 #include "report_scan.hpp"
+#include "report_tables.hpp"
 #include "trends.hpp"
 
 namespace fs = std::filesystem;
@@ -42,24 +43,6 @@ std::string html_escape(const std::string& s) {
     else o += c;
   }
   return o;
-}
-
-// The cost columns of every table, and their values (nan without a summary).
-const std::vector<std::string> kCostColumns = {"wall_time", "cpu_time", "steps", "sweeps_per_step",
-                                               "cap_share"};
-std::vector<double> cost_values(const std::optional<RunCost>& c) {
-  if (!c) return std::vector<double>(kCostColumns.size(), std::nan(""));
-  return {c->wall_time, c->cpu_time, c->steps, c->sweeps_per_step, c->cap_share};
-}
-
-// A value for a text table: "n/a" when not measured.
-std::string or_na(double v, const char* spec = "{:.4g}") {
-  return std::isfinite(v) ? fmt::format(fmt::runtime(spec), v) : "n/a";
-}
-std::string or_na(double v, double err) {
-  return std::isfinite(v) ? (std::isfinite(err) ? fmt::format("{:.4g} ± {:.2g}", v, err)
-                                                : fmt::format("{:.4g}", v))
-                          : "n/a";
 }
 
 // Distinct finite values.
@@ -316,90 +299,9 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   sum.plots_ok = draw_run_plots(scan, out_dir);
   const int dim = scan.dimension;
   const std::string mu_col = mu_column(dim);
-  const std::vector<std::string> quantities = {mu_col, "inertial_number", "packing_fraction", "z", "p"};
-  std::vector<std::string> names = {"run"};
-  for (const auto& q : quantities) {
-    names.push_back(q);
-    names.push_back(q + "_err");
-  }
-  names.insert(names.end(), {"window_begin", "window_end", "tau_int", "n_eff", "rate_min", "rate_min_err"});
-  names.insert(names.end(), kCostColumns.begin(), kCostColumns.end());
-  Table steady(names);
-  // 3D: the spherical-harmonic anisotropies (fabric3.hpp), q/p with q =
-  // (s1 - s3)/3 beside (2/5) sum a, and mu = -sxy/syy of the snapshots:
-  // each the mean over the contact snapshots in the steady window with its
-  // _err (sem over them), the relative deviation check_rel of (2/5) sum a
-  // from q/p, and the count fabric_snapshots (1: the last snapshot alone).
-  std::vector<std::string> fabric_names;
-  if (dim == 3) {
-    fabric_names = {"run"};
-    for (const auto& c : kFabric3Columns) fabric_names.insert(fabric_names.end(), {c, c + "_err"});
-    fabric_names.insert(fabric_names.end(), {"check_rel", "check_rel_err", "fabric_snapshots"});
-  } else {
-    fabric_names = {"run", "a_c", "theta_c", "a_ln", "a_lt", "a_fn", "a_ft", "sum_half",
-                    "q_over_p", "a_c_tensor", "a_ln_tensor", "a_lt_tensor", "a_fn_tensor",
-                    "a_ft_tensor", "sliding", "z", "non_floating"};
-  }
-  fabric_names.insert(fabric_names.end(), kCostColumns.begin(), kCostColumns.end());
-  Table fabric(fabric_names);
-  std::string runs_csv = "run,folder,status";
-  for (const auto& c : kCostColumns) runs_csv += "," + c;
-  runs_csv += ",threads\n";
+  write_tables(scan, out_dir);
   std::string html_runs;
-  for (const ReportRun& r : scan.runs) {
-    const std::vector<double> cost = cost_values(r.cost);
-    if (r.measured) {
-      // The steady means by column name, in the order of quantities.
-      std::map<std::string, double> row = {{"run", static_cast<double>(r.index)}};
-      const Val* mean[] = {&r.mu, &r.I, &r.phi, &r.z, &r.p};
-      for (std::size_t q = 0; q < quantities.size(); ++q) {
-        row[quantities[q]] = mean[q]->v;
-        row[quantities[q] + "_err"] = mean[q]->err;
-      }
-      row["window_begin"] = r.main_stats->window.x_begin;
-      row["window_end"] = r.main_stats->window.x_end;
-      row["tau_int"] = r.main_stats->acf.tau;
-      row["n_eff"] = r.main_stats->acf.n_eff;
-      row["rate_min"] = r.rate_min.v;
-      row["rate_min_err"] = r.rate_min.err;
-      for (std::size_t c = 0; c < kCostColumns.size(); ++c) row[kCostColumns[c]] = cost[c];
-      steady.add_named_row(row);
-    }
-    if (r.fabric3) {
-      const WindowFabric3& fw = *r.fabric3;
-      std::map<std::string, double> frow = {{"run", static_cast<double>(r.index)}};
-      for (const auto& c : kFabric3Columns) {
-        frow[c] = fw.of(c).v;
-        frow[c + "_err"] = fw.of(c).err;
-      }
-      frow["check_rel"] = fw.check_rel;
-      frow["check_rel_err"] = fw.check_rel_err;
-      frow["fabric_snapshots"] = static_cast<double>(fw.files.size());
-      for (std::size_t c = 0; c < kCostColumns.size(); ++c) frow[kCostColumns[c]] = cost[c];
-      fabric.add_named_row(frow);
-    } else if (r.fabric2) {
-      const RunFabric& f = *r.fabric2;
-      const auto& a = f.fft;
-      const auto& b = f.tensor;
-      std::map<std::string, double> frow = {
-          {"run", static_cast<double>(r.index)}, {"a_c", a.c.a()}, {"theta_c", a.c.theta()},
-          {"a_ln", a.ln.a()}, {"a_lt", a.lt.a()}, {"a_fn", a.fn.a()}, {"a_ft", a.ft.a()},
-          {"sum_half", a.sum_half()}, {"q_over_p", f.stress.q_over_p()}, {"a_c_tensor", b.c.a()},
-          {"a_ln_tensor", b.ln.a()}, {"a_lt_tensor", b.lt.a()}, {"a_fn_tensor", b.fn.a()},
-          {"a_ft_tensor", b.ft.a()}, {"sliding", f.sliding},
-          {"z", f.connectivity ? f.connectivity->z : std::nan("")},
-          {"non_floating", f.connectivity ? f.connectivity->non_floating : std::nan("")}};
-      for (std::size_t c = 0; c < kCostColumns.size(); ++c) frow[kCostColumns[c]] = cost[c];
-      fabric.add_named_row(frow);
-    }
-    runs_csv += fmt::format("{},\"{}\",{}", r.index, r.folder, r.status);
-    for (const double v : cost) runs_csv += "," + or_na(v, "{}");  // shortest exact text
-    runs_csv += "," + (r.cost ? fmt::format("{}", r.cost->threads) : std::string("n/a")) + "\n";
-    html_runs += run_html(r);
-  }
-  write_text((fs::path(out_dir) / "runs.csv").string(), runs_csv);
-  steady.write_csv((fs::path(out_dir) / "steady.csv").string());
-  fabric.write_csv((fs::path(out_dir) / "fabric.csv").string());
+  for (const ReportRun& r : scan.runs) html_runs += run_html(r);
 
   std::vector<FitResult> fits;
   std::vector<Model> models;
