@@ -3,7 +3,9 @@
 // checkpoints, the watchdog, signals, --max-steps, the progress line and
 // summary.toml. What depends on the dimension (the world, its checkpoint,
 // its snapshots, its protocol columns) is behind RunEngine; 2d/run.cpp and
-// 3d/run3.cpp each wrap their world in one.
+// 3d/run3.cpp each wrap their world in one. The loop's steps are
+// RunSession's (run_session.hpp), over parts each testable alone
+// (run_session_parts.hpp).
 #pragma once
 #include <cstdint>
 #include <stdexcept>

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -17,66 +18,6 @@
 #include "load.hpp"
 
 namespace cd {
-
-void RunFolder::lock_if_present() {
-  if (std::filesystem::is_directory(dir_)) lock_.emplace(out_);
-}
-
-void RunFolder::make() {
-  std::filesystem::create_directories(out_);
-  if (!lock_) lock_.emplace(out_);
-  check();  // not removed (and made again above) since it was locked
-}
-
-void clear_previous(const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  if (!fs::is_directory(dir)) return;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string f = e.path().filename().string();
-    const bool ours = f == "series.csv" || f == "timings.csv" || f == "scene.toml" || f == "view.py" ||
-                      e.path().extension() == ".pvd" || f.starts_with("checkpoint.bin") ||
-                      f.starts_with("problem_") || f.starts_with("summary.toml") ||
-                      (e.path().extension() == ".vtp" &&
-                       (f.starts_with("particles_") || f.starts_with("contacts_") ||
-                        f.starts_with("walls_") || f.starts_with("shapes_") ||
-                        f.starts_with("spheres_")));
-    if (ours) fs::remove(e.path());
-  }
-}
-
-ResumePoint resume_from_checkpoint(RunEngine& e, const RunPlan& plan, const RunFolder& folder, bool fresh) {
-  ResumePoint r;
-  const std::string ckpt = folder.checkpoint();
-  if (fresh || !std::filesystem::exists(ckpt)) return r;
-  r.resumed = true;
-  const std::string scene_toml = folder.file("scene.toml");
-  try {
-    const std::uint64_t stored = e.load(ckpt, &r.totals);
-    if ((stored != plan.key && !folder_scene_is(scene_toml, plan.key)) || e.steps() > plan.nsteps)
-      throw CheckpointError(fmt::format("checkpoint '{}' was written by a different scene "
-                                        "(compare with {})", ckpt, scene_toml));
-    folder.check();
-    r.series_columns = truncate_series(folder.series(), e.steps());
-    // A run begun before timings.csv existed has the timings in its
-    // series: it goes on so, to its end.
-    r.legacy_timings = !std::filesystem::exists(folder.timings()) &&
-                       std::any_of(r.series_columns.begin(), r.series_columns.end(),
-                                   [](const std::string& c) { return c.starts_with("t_"); });
-    if (!r.legacy_timings) r.timing_columns = truncate_series(folder.timings(), e.steps());
-  } catch (const CheckpointError& err) {
-    throw CheckpointError(std::string(err.what()) +
-                          "; run with --fresh to discard the checkpoint and start over");
-  }
-  r.step = e.steps();
-  return r;
-}
-
-Frames snapshots_up_to(const RunPlan& plan, std::int64_t k0) {
-  Frames frames;
-  for (std::int64_t j = 0; plan.every_snap && j * plan.every_snap <= k0; ++j)
-    frames.emplace_back(static_cast<double>(j * plan.every_snap) * plan.dt, fmt::format("{:05d}", j));
-  return frames;
-}
 
 namespace {
 
@@ -128,12 +69,140 @@ std::string long_interval_warning(const RunPlan& plan, std::int64_t every, const
 
 }  // namespace
 
+// The output folder
+
+RunFolder::RunFolder(const std::string& out) : out_(out), dir_(out) {
+  if (std::filesystem::is_directory(dir_)) lock_.emplace(out_);
+}
+
+void RunFolder::make() {
+  std::filesystem::create_directories(out_);
+  if (!lock_) lock_.emplace(out_);
+  check();  // not removed (and made again above) since it was locked
+}
+
+void clear_previous(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(dir)) return;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string f = e.path().filename().string();
+    const bool ours = f == "series.csv" || f == "timings.csv" || f == "scene.toml" || f == "view.py" ||
+                      e.path().extension() == ".pvd" || f.starts_with("checkpoint.bin") ||
+                      f.starts_with("problem_") || f.starts_with("summary.toml") ||
+                      (e.path().extension() == ".vtp" &&
+                       (f.starts_with("particles_") || f.starts_with("contacts_") ||
+                        f.starts_with("walls_") || f.starts_with("shapes_") ||
+                        f.starts_with("spheres_")));
+    if (ours) fs::remove(e.path());
+  }
+}
+
+// The resume
+
+ResumePoint resume_from_checkpoint(RunEngine& e, const RunPlan& plan, const RunFolder& folder, bool fresh) {
+  ResumePoint r;
+  const std::string ckpt = folder.checkpoint();
+  if (fresh || !std::filesystem::exists(ckpt)) return r;
+  r.resumed = true;
+  const std::string scene_toml = folder.file("scene.toml");
+  try {
+    const std::uint64_t stored = e.load(ckpt, &r.totals);
+    if ((stored != plan.key && !folder_scene_is(scene_toml, plan.key)) || e.steps() > plan.nsteps)
+      throw CheckpointError(fmt::format("checkpoint '{}' was written by a different scene "
+                                        "(compare with {})", ckpt, scene_toml));
+    folder.check();
+    r.series_columns = truncate_series(folder.series(), e.steps());
+    // A run begun before timings.csv existed has the timings in its
+    // series: it goes on so, to its end.
+    r.legacy_timings = !std::filesystem::exists(folder.timings()) &&
+                       std::any_of(r.series_columns.begin(), r.series_columns.end(),
+                                   [](const std::string& c) { return c.starts_with("t_"); });
+    if (!r.legacy_timings) r.timing_columns = truncate_series(folder.timings(), e.steps());
+  } catch (const CheckpointError& err) {
+    throw CheckpointError(std::string(err.what()) +
+                          "; run with --fresh to discard the checkpoint and start over");
+  }
+  r.step = e.steps();
+  return r;
+}
+
+Frames snapshots_up_to(const RunPlan& plan, std::int64_t k0) {
+  Frames frames;
+  for (std::int64_t j = 0; plan.every_snap && j * plan.every_snap <= k0; ++j)
+    frames.emplace_back(static_cast<double>(j * plan.every_snap) * plan.dt, fmt::format("{:05d}", j));
+  return frames;
+}
+
+// The cadence's warnings
+
 std::string long_interval_warnings(const RunPlan& plan) {
   return long_interval_warning(plan, plan.every_ckpt,
                                fmt::format("output.checkpoint_interval = {} s", plan.checkpoint_interval)) +
          long_interval_warning(plan, plan.every_ckpt_strain,
                                fmt::format("output.checkpoint_strain = {}", plan.checkpoint_strain));
 }
+
+// Series rows
+
+void SeriesInterval::add(const StepStats& s) {
+  ++steps;
+  iter_sum += s.solve.iterations;
+  iter_max = std::max(iter_max, s.solve.iterations);
+  cap_hits += s.solve.cap_hit;
+  res_max = std::max(res_max, s.solve.residual_max);
+  res_mean_sum += s.solve.residual_mean;
+  ov_max = std::max(ov_max, s.max_overlap);
+  ov_small = std::max(ov_small, s.max_overlap_small);
+  corr_work += s.correction_work;
+  proj_work += s.projection_work;
+}
+
+Columns series_row(std::int64_t k, RunEngine& e, const StepStats& st, const SeriesInterval& iv) {
+  return {{"step", double(k)},
+          {"time", e.time()},
+          {"contacts", double(st.contacts)},
+          {"active", double(st.active)},
+          {"iterations", double(iv.iter_sum) / iv.steps},
+          {"iterations_max", double(iv.iter_max)},
+          {"residual", iv.res_max},
+          {"residual_mean", iv.res_mean_sum / iv.steps},
+          {"cap_hit", double(iv.cap_hits)},
+          {"max_overlap", iv.ov_max},
+          {"mean_overlap", st.mean_overlap},
+          {"max_overlap_small", iv.ov_small},
+          {"kinetic_energy", e.kinetic_energy()},
+          {"correction_work", iv.corr_work},
+          {"projection_work", iv.proj_work}};
+}
+
+Columns timings_row(std::int64_t k, double time, const StageTimes& now, const StageTimes& t0) {
+  Columns cols = {{"step", double(k)}, {"time", time}};
+  for (int s = 0; s < kStages; ++s) cols.emplace_back(std::string("t_") + kStageNames[s], now.t[s] - t0.t[s]);
+  return cols;
+}
+
+void SeriesFiles::open(const RunFolder& folder, ResumePoint& from) {
+  if (from.resumed) series_.emplace(folder.series(), std::move(from.series_columns));
+  else series_.emplace(folder.series());
+  if (from.legacy_timings) return;
+  if (from.resumed) timings_.emplace(folder.timings(), std::move(from.timing_columns));
+  else timings_.emplace(folder.timings());
+}
+
+void SeriesFiles::write_series(const Columns& row, const RunFolder& folder) {
+  series_->row(row);
+  folder.check();
+  series_->flush();
+}
+
+void SeriesFiles::write_timings(const Columns& row, const RunFolder& folder) {
+  if (!timings_) return;
+  timings_->row(row);
+  folder.check();
+  timings_->flush();
+}
+
+// Signals
 
 void install_stop_handlers() {
   std::signal(SIGINT, on_stop);
@@ -151,6 +220,8 @@ std::string StopNotice::seen(int signal, bool row_due, std::int64_t row, bool af
                      after_progress ? "\n" : "", signal, row);
 }
 
+// Dumps
+
 ProblemDumps::ProblemDumps(const std::vector<std::int64_t>& steps, std::int64_t nsteps) : steps_(steps) {
   for (const std::int64_t k : steps_)
     if (k > nsteps)
@@ -161,21 +232,12 @@ WriteError ProblemDumps::failed(std::int64_t k, const WriteError& e) {
   return WriteError(fmt::format("--dump-problem {}: {}", k, e.what()));
 }
 
-void SeriesInterval::add(const StepStats& s) {
-  ++steps;
-  iter_sum += s.solve.iterations;
-  iter_max = std::max(iter_max, s.solve.iterations);
-  cap_hits += s.solve.cap_hit;
-  res_max = std::max(res_max, s.solve.residual_max);
-  res_mean_sum += s.solve.residual_mean;
-  ov_max = std::max(ov_max, s.max_overlap);
-  ov_small = std::max(ov_small, s.max_overlap_small);
-  corr_work += s.correction_work;
-  proj_work += s.projection_work;
-}
+// The cost record
 
-CostRecord::CostRecord(const RunTotals& so_far, RunClock::time_point start)
-    : totals_(so_far), start_(start), cpu0_(cpu_seconds()) {
+void CostRecord::start(const RunTotals& so_far, RunClock::time_point t) {
+  totals_ = so_far;
+  start_ = t;
+  cpu0_ = cpu_seconds();
   sum_.load_start = load_average();
 }
 
@@ -228,9 +290,22 @@ void CostRecord::write_summary(const char* status, std::int64_t last, std::int64
   write_file_atomic(folder.file("summary.toml"), summary_toml(sum_));
 }
 
-ProgressLines::ProgressLines(const RunOptions& opt, std::int64_t nsteps, std::int64_t k0, RunClock::time_point start)
-    : out_(opt.out), every_(opt.progress_every), terminal_(!opt.quiet && isatty(STDERR_FILENO)), nsteps_(nsteps),
-      k0_(k0), start_(start), last_terminal_(start), last_line_(start) {}
+const char* session_status(const RunSummary& s) {
+  return s.stop_signal            ? "stopped"
+         : s.stopped_at_max_steps ? "max-steps"
+         : s.settled              ? "settled"
+                                  : "done";
+}
+
+// Progress
+
+ProgressLines::ProgressLines(const RunOptions& opt, std::int64_t nsteps)
+    : out_(opt.out), every_(opt.progress_every), terminal_(!opt.quiet && isatty(STDERR_FILENO)), nsteps_(nsteps) {}
+
+void ProgressLines::start(std::int64_t k0, RunClock::time_point t) {
+  k0_ = k0;
+  start_ = last_terminal_ = last_line_ = t;
+}
 
 void ProgressLines::after_step(std::int64_t k, const StepStats& st) {
   if (every_ > 0 && k < nsteps_) {

@@ -1,8 +1,8 @@
-// The parts of a run session (run_loop.hpp), each one concern that can be
+// The parts of a run session (run_session.hpp), each one concern that can be
 // read and tested alone: the output folder and its lock, the resume from a
-// checkpoint, when outputs fall, a stop asked by a signal, the
-// --dump-problem steps, the cost record (summary.toml) and the progress
-// lines.
+// checkpoint, when outputs fall, series.csv and timings.csv, a stop asked
+// by a signal, the --dump-problem steps, the cost record (summary.toml) and
+// the progress lines.
 #pragma once
 #include <algorithm>
 #include <chrono>
@@ -23,11 +23,11 @@ namespace cd {
 using RunClock = std::chrono::steady_clock;
 
 // The output folder of a run: the paths of its files and its one-writer
-// lock, taken before the checkpoint is read (an existing folder) or as soon
-// as the folder is made.
+// lock, taken at once if the folder exists (before its checkpoint is read),
+// or as soon as make() makes it.
 class RunFolder {
  public:
-  explicit RunFolder(const std::string& out) : out_(out), dir_(out) {}
+  explicit RunFolder(const std::string& out);
   const std::string& out() const { return out_; }
   // DIR/name.
   std::string file(const char* name) const { return (dir_ / name).string(); }
@@ -37,8 +37,6 @@ class RunFolder {
   // identical runs give byte-identical series (timings.csv: same rows).
   std::string timings() const { return file("timings.csv"); }
 
-  // Locks the folder if it exists already: before its checkpoint is read.
-  void lock_if_present();
   // Makes the folder and locks it (if not yet locked), then checks that it
   // was not removed and made again since it was locked.
   void make();
@@ -124,6 +122,44 @@ class OutputCadence {
 // checkpoint before the end.
 std::string long_interval_warnings(const RunPlan& plan);
 
+// Step statistics over one series interval (the row's solver, overlap and
+// work columns); t0: the stage timers at its start.
+struct SeriesInterval {
+  int steps = 0;
+  long iter_sum = 0;
+  int iter_max = 0;
+  int cap_hits = 0;
+  double res_max = 0, res_mean_sum = 0;
+  double ov_max = 0, ov_small = 0;
+  double corr_work = 0, proj_work = 0;
+  StageTimes t0;
+
+  void add(const StepStats& s);
+};
+
+// A series row at step k: the step's and the interval's columns, before
+// the engine's protocol columns (RunEngine::add_columns). Asks the engine
+// for its time and kinetic energy.
+Columns series_row(std::int64_t k, RunEngine& e, const StepStats& st, const SeriesInterval& iv);
+// A timings row: step, time, and each stage's wall-clock seconds over the
+// interval (`now` less the timers at its start).
+Columns timings_row(std::int64_t k, double time, const StageTimes& now, const StageTimes& t0);
+
+// series.csv and timings.csv: made new for a fresh run, continued after a
+// resume. Rows are written whole, the folder checked before each write.
+class SeriesFiles {
+ public:
+  // Takes the resume's column names; a fresh run's files are made empty.
+  void open(const RunFolder& folder, ResumePoint& from);
+  // A run begun before timings.csv existed: the timings go on in series.csv.
+  bool legacy_timings() const { return !timings_; }
+  void write_series(const Columns& row, const RunFolder& folder);
+  void write_timings(const Columns& row, const RunFolder& folder);  // nothing if legacy
+
+ private:
+  std::optional<Series> series_, timings_;
+};
+
 // The signal that asked the run to stop (SIGINT, SIGTERM or SIGHUP, caught
 // since install_stop_handlers), 0 if none: set once, by the first of them.
 int stop_signal();
@@ -159,30 +195,15 @@ class ProblemDumps {
   std::vector<std::int64_t> steps_;
 };
 
-// Step statistics over one series interval (the row's solver, overlap and
-// work columns); t0: the stage timers at its start.
-struct SeriesInterval {
-  int steps = 0;
-  long iter_sum = 0;
-  int iter_max = 0;
-  int cap_hits = 0;
-  double res_max = 0, res_mean_sum = 0;
-  double ov_max = 0, ov_small = 0;
-  double corr_work = 0, proj_work = 0;
-  StageTimes t0;
-
-  void add(const StepStats& s);
-};
-
 // The cost record of a session: its statistics (RunSummary, cdsim's closing
 // lines) and the run's totals over every session (summary.toml), counted
 // step by step, with the session's wall and CPU time.
 class CostRecord {
  public:
-  // The session starts at `start`: its CPU clock and the machine's load are
+  // The session starts at `t`: its CPU clock and the machine's load are
   // read now. `so_far`: the run's totals at the checkpoint it resumes from
   // (zero for a fresh run).
-  CostRecord(const RunTotals& so_far, RunClock::time_point start);
+  void start(const RunTotals& so_far, RunClock::time_point t);
   // A session that takes steps is one more of the run's.
   void count_session() { totals_.sessions += 1; }
   void add(const StepStats& st);
@@ -198,19 +219,23 @@ class CostRecord {
  private:
   RunSummary sum_;
   RunTotals totals_;
-  RunClock::time_point start_;
-  double cpu0_;
+  RunClock::time_point start_{};
+  double cpu0_ = 0;
   long iterations_ = 0;  // the session's sweeps, for its mean
 };
+
+// How a session ended, as summary.toml's status says (a divergence aside).
+const char* session_status(const RunSummary& s);
 
 // The progress of a session: on a terminal (unless quiet), a line on stderr
 // rewritten every half second; with --progress, a whole line on stdout
 // every so many seconds of wall clock, quiet or not, terminal or log.
 class ProgressLines {
  public:
-  // The session runs steps k0+1 .. nsteps from `start`.
-  ProgressLines(const RunOptions& opt, std::int64_t nsteps, std::int64_t k0, RunClock::time_point start);
+  ProgressLines(const RunOptions& opt, std::int64_t nsteps);
   bool on_terminal() const { return terminal_; }
+  // The session runs steps k0+1 .. nsteps from `t`.
+  void start(std::int64_t k0, RunClock::time_point t);
   void after_step(std::int64_t k, const StepStats& st);
   // Ends the terminal's line.
   void end() const;
@@ -219,8 +244,8 @@ class ProgressLines {
   std::string out_;
   double every_;  // s between the stdout lines; 0: none
   bool terminal_;
-  std::int64_t nsteps_, k0_;
-  RunClock::time_point start_, last_terminal_, last_line_;
+  std::int64_t nsteps_, k0_ = 0;
+  RunClock::time_point start_{}, last_terminal_{}, last_line_{};
 };
 
 }  // namespace cd
