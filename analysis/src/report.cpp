@@ -1,23 +1,17 @@
 #include "report.hpp"
 
 #include <fmt/core.h>
-#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <map>
 #include <numbers>
 
-#include "cohesion.hpp"
-#include "cost.hpp"
 #include "plot.hpp"
 #include "report_html.hpp"
 #include "report_scan.hpp"
+#include "report_sections.hpp"
 #include "report_tables.hpp"
-#include "trends.hpp"
 
 namespace fs = std::filesystem;
 
@@ -33,19 +27,6 @@ std::string toml_escape(const std::string& s) {
     else o += c;
   }
   return o;
-}
-
-// Distinct finite values.
-std::vector<double> distinct(std::vector<double> v) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
-  std::sort(v.begin(), v.end());
-  v.erase(std::unique(v.begin(), v.end()), v.end());
-  return v;
-}
-
-std::string made_by(const std::string& report_cmd, const std::string& fit_cmd) {
-  return fmt::format("<p><small>Made by <code>{}</code> (alone: <code>{}</code>).</small></p>\n",
-                     html_escape(report_cmd), html_escape(fit_cmd));
 }
 
 // Wall time and sweeps per step against the measured I (log-log), the
@@ -79,6 +60,23 @@ bool plot_cost_I(const std::string& dir, const ReportScan& scan) {
   return plot_both(dir, "cost_I", body);
 }
 
+// Cost against I, for a campaign over I: the measured I (not steady: the
+// imposed one) of the costed runs spanning a factor 1.5 or more. The page's
+// section, or empty.
+std::string cost_section(const ReportScan& scan, const std::string& out_dir, ReportSummary& sum) {
+  double lo = INFINITY, hi = 0;
+  std::size_t n = 0;
+  for (const ReportRun& p : scan.runs) {
+    const double I = p.steady && std::isfinite(p.I.v) && p.I.v > 0 ? p.I.v : p.I_imposed;
+    if (p.cost && std::isfinite(I) && I > 0) ++n, lo = std::min(lo, I), hi = std::max(hi, I);
+  }
+  if (n < 2 || hi < 1.5 * lo) return "";
+  sum.cost_plot = true;
+  sum.plots_ok = plot_cost_I(out_dir, scan) && sum.plots_ok;
+  return "<h2>Cost against I</h2><img src='cost_I.png' width=600>"
+         "<p>Every run with a summary.toml; the runs without a steady window (open symbols) at their "
+         "imposed I. Data: <a href='cost_I.csv'>cost_I.csv</a>.</p>\n";
+}
 
 // Each run's series, its steady window shaded, and (2D) the polar diagrams
 // of its last contact snapshot. False when gnuplot failed on one of them.
@@ -229,305 +227,21 @@ ReportSummary write_report(const std::string& campaign, const std::string& out_d
   fs::create_directories(out_dir);
   ReportSummary sum = summarize(scan);
   sum.plots_ok = draw_run_plots(scan, out_dir);
-  const int dim = scan.dimension;
-  const std::string mu_col = mu_column(dim);
   write_tables(scan, out_dir);
 
-  std::vector<FitResult> fits;
-  std::vector<Model> models;
-  std::vector<RefusedFit> refused;
-  std::string html_fit;
-  const std::string report_cmd = fmt::format("cdanalysis report {} --out {}", campaign, out_dir);
+  // The fits by the campaign's kind, each kind its section of the page.
+  const CampaignKind kind = campaign_kind(scan);
+  sum.kinds = kind.names();
+  ReportFits fits(campaign, out_dir, sum);
+  fits.html = kind_html(kind);
+  if (kind.inertial) inertial_section(scan, kind, fits);
+  if (kind.pressure) pressure_section(scan, fits);
+  if (kind.cohesive) cohesive_section(scan, fits);
+  if (kind.angularity) angularity_section(scan, bins, fits);
+  write_text((fs::path(out_dir) / "fits.toml").string(), fits_to_toml(fits.fits, fits.models, fits.refused));
 
-  // The campaign's kind, from the runs: what their scenes (and shapes) vary.
-  std::vector<double> etas, Is, ps, ns;
-  for (const ReportRun& p : scan.runs) {
-    etas.push_back(p.eta);
-    Is.push_back(p.I_imposed);
-    ps.push_back(p.pressure);
-    ns.push_back(p.nsides >= 0 ? p.nsides : std::nan(""));
-  }
-  const bool by_shape = distinct(ns).size() >= 2, by_eta = distinct(etas).size() >= 2,
-             by_p = distinct(ps).size() >= 2;
-  bool by_I = distinct(Is).size() >= 2;
-  if (distinct(Is).empty()) {  // no scene says I: the measured I spanning a factor 1.5
-    double lo = INFINITY, hi = 0;
-    for (const ReportRun& p : scan.runs)
-      if (std::isfinite(p.I.v) && p.I.v > 0) lo = std::min(lo, p.I.v), hi = std::max(hi, p.I.v);
-    by_I = hi >= 1.5 * lo;
-  }
-  std::vector<std::string> kinds;
-  if (by_I) kinds.push_back("inertial (I varies)");
-  if (by_eta) kinds.push_back("cohesive (cohesion_number varies)");
-  if (by_shape) kinds.push_back("angularity (nsides varies)");
-  if (by_p) kinds.push_back("pressure series (pressure varies)");
-  sum.kinds = kinds;
-  html_fit += fmt::format("<h2>Fits</h2><p>Campaign kind, from the runs' scenes: {}.</p>\n",
-                          kinds.empty() ? std::string("none (the runs differ in none of I, cohesion_number, "
-                                                      "nsides, pressure): no fit across runs")
-                                        : html_escape(fmt::format("{}", fmt::join(kinds, "; "))));
-
-  // Never a dead end: a fit the data do not determine is written (fits.toml:
-  // determined = false and the reason, or the undetermined parameters) and
-  // drawn (the points alone, or the curve with the parameters flagged), with
-  // what would determine it.
-  const auto undetermined_html = [&](const std::string& model, const std::string& why) {
-    sum.undetermined.push_back(fmt::format("{}: {}", model, why));
-    return fmt::format("<p><b>Undetermined</b>: {}. What would determine it: {}.</p>\n", html_escape(why),
-                       html_escape(what_would_determine(model)));
-  };
-  const auto flagged = [&](const FitResult& r, const std::string& model) {
-    const auto u = undetermined_params(r);
-    if (u.empty()) return std::string();
-    return undetermined_html(model, fmt::format("{} not determined by the data (error not below the value)",
-                                                fmt::join(u, ", ")));
-  };
-  // Inertial: mu(I) and nu(I) over the cohesionless runs of one shape.
-  if (by_I) {
-    std::vector<double> I, mu, mu_err;
-    std::vector<StatePoint> sp;
-    const int shape0 = [&] {
-      for (const ReportRun& p : scan.runs)
-        if (p.steady) return p.nsides;
-      return -1;
-    }();
-    for (const ReportRun& p : scan.runs) {
-      if (!p.steady || !std::isfinite(p.I.v) || (std::isfinite(p.eta) && p.eta != 0) || p.nsides != shape0)
-        continue;
-      if (std::isfinite(p.mu.v)) I.push_back(p.I.v), mu.push_back(p.mu.v), mu_err.push_back(p.mu.err);
-      if (std::isfinite(p.phi.v)) {
-        StatePoint s;
-        s.run = p.folder;
-        s.I = {p.I.v, p.I.err};
-        s.nu = {p.phi.v, p.phi.err};
-        sp.push_back(s);
-      }
-    }
-    const std::string sel = by_eta || by_shape ? " (runs with cohesion_number 0 and the first run's shape)" : "";
-    if (I.size() >= 4) {
-      std::optional<FitResult> r;
-      std::string why;
-      try {
-        r = fit_mu_I(I, mu, mu_err);
-        fits.push_back(*r);
-        models.push_back(mu_of_I());
-        sum.fits.push_back("mu_I");
-      } catch (const AnalysisError& e) {
-        why = e.what();
-        refused.push_back({"mu_I", mu_of_I().formula, why});
-        sum.problems.push_back(fmt::format("mu(I) fit: {}", why));
-      }
-      sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, r ? &*r : nullptr, dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") &&
-                     sum.plots_ok;
-      if (r)
-        html_fit += fmt::format("<h3>μ(I){}</h3><img src='mu_I.png' width=600><p>{}: μ1 = {:.4f} ± {:.2g}{}, "
-                                "μ2 = {:.4f} ± {:.2g}{}, I0 = {:.4g} ± {:.2g}{}, χ²/dof = {:.2f}</p>\n",
-                                sel, html_escape(mu_of_I().formula), (*r)["mu1"], r->err("mu1"),
-                                undetermined_flag(*r, "mu1"), (*r)["mu2"], r->err("mu2"), undetermined_flag(*r, "mu2"),
-                                (*r)["I0"], r->err("I0"), undetermined_flag(*r, "I0"), r->chi2_dof) +
-                    flagged(*r, "mu_I");
-      else
-        html_fit += fmt::format("<h3>μ(I){}</h3><img src='mu_I.png' width=600><p>{}: fit refused.</p>\n", sel,
-                                html_escape(mu_of_I().formula)) +
-                    undetermined_html("mu_I", why);
-      html_fit += made_by(report_cmd, fmt::format("cdanalysis fit mu-i {} --out DIR", campaign));
-    } else {
-      html_fit += fmt::format("<p>μ(I) fit skipped: {} steady runs with {} and inertial_number{} "
-                              "(4 needed)</p>\n", I.size(), mu_col, sel);
-      if (!I.empty()) {
-        const std::string why = fmt::format("{} steady runs, 4 needed", I.size());
-        refused.push_back({"mu_I", mu_of_I().formula, why});
-        sum.plots_ok = plot_mu_I(out_dir, I, mu, mu_err, nullptr, dim == 3 ? "μ = −σ_xy/σ_yy" : "μ* = q/p") &&
-                       sum.plots_ok;
-        html_fit += "<img src='mu_I.png' width=600>\n" + undetermined_html("mu_I", why);
-      }
-    }
-    if (sp.size() >= 3) {
-      std::optional<FitResult> r;
-      std::string why;
-      try {
-        r = fit_nu_I_points(sp);
-        fits.push_back(*r);
-        models.push_back(nu_of_I());
-        sum.plots_ok = plot_nu_I(out_dir, sp, *r, report_cmd) && sum.plots_ok;
-        sum.fits.push_back("nu_I");
-      } catch (const AnalysisError& e) {
-        why = e.what();
-        refused.push_back({"nu_I", nu_of_I().formula, why});
-        sum.problems.push_back(fmt::format("nu(I) fit: {}", why));
-      }
-      if (r)
-        html_fit += fmt::format("<h3>ν(I){}</h3><img src='nu_I.png' width=600><p>{}: ν_max = {:.4f} ± {:.2g}{}, "
-                                "a = {:.4g} ± {:.2g}{}, χ²/dof = {:.2f}</p>\n",
-                                sel, html_escape(nu_of_I().formula), (*r)["nu_max"], r->err("nu_max"),
-                                undetermined_flag(*r, "nu_max"), (*r)["a"], r->err("a"), undetermined_flag(*r, "a"),
-                                r->chi2_dof) +
-                    flagged(*r, "nu_I");
-      else
-        html_fit += fmt::format("<h3>ν(I){}</h3><p>{}: fit refused.</p>\n", sel, html_escape(nu_of_I().formula)) +
-                    undetermined_html("nu_I", why);
-      html_fit += made_by(report_cmd, fmt::format("cdanalysis fit nu-i {} --out DIR", campaign));
-    } else {
-      html_fit += fmt::format("<p>ν(I) fit skipped: {} steady runs with packing_fraction{} (3 needed)</p>\n",
-                              sp.size(), sel);
-      if (!sp.empty())
-        html_fit += undetermined_html("nu_I", fmt::format("{} steady runs with packing_fraction, 3 needed", sp.size()));
-    }
-  }
-
-  // Pressure series: e = e0 - lambda ln(p/p0).
-  if (by_p) {
-    std::vector<StatePoint> sp;
-    for (const ReportRun& p : scan.runs) {
-      if (!p.steady || !std::isfinite(p.phi.v)) continue;
-      StatePoint s;
-      s.run = p.folder;
-      s.nu = {p.phi.v, p.phi.err};
-      s.p = std::isfinite(p.p.v) ? Val{p.p.v, p.p.err} : Val{p.pressure, std::nan("")};
-      sp.push_back(s);
-    }
-    try {
-      const double p0 = default_p0(sp);
-      const auto r = fit_compaction_points(sp, p0);
-      fits.push_back(r);
-      models.push_back(void_ratio(p0));
-      sum.plots_ok = plot_compaction(out_dir, sp, r, p0, report_cmd) && sum.plots_ok;
-      sum.fits.push_back("void_ratio");
-      html_fit += fmt::format("<h3>Compaction e(p)</h3><img src='compaction.png' width=600><p>{}: e0 = {:.4f} ± "
-                              "{:.2g}, λ = {:.4g} ± {:.2g}, χ²/dof = {:.2f}</p>\n",
-                              html_escape(void_ratio(p0).formula), r["e0"], r.err("e0"), r["lambda"],
-                              r.err("lambda"), r.chi2_dof) +
-                  flagged(r, "void_ratio") +
-                  made_by(report_cmd, fmt::format("cdanalysis fit compaction {} --out DIR", campaign));
-    } catch (const AnalysisError& e) {
-      sum.problems.push_back(fmt::format("compaction fit: {}", e.what()));
-      refused.push_back({"void_ratio", "e = e0 - lambda ln(p/p0)", e.what()});
-      html_fit += fmt::format("<p>Compaction fit refused: {}</p>\n", html_escape(e.what())) +
-                  undetermined_html("void_ratio", e.what());
-    }
-  }
-
-  // Cohesive: c/p against the eta = 0 runs of the campaign.
-  if (by_eta) {
-    try {
-      std::vector<SteadyPoint> ref_pts, coh_pts;
-      for (const ReportRun& p : scan.runs) {
-        if (!p.steady || !std::isfinite(p.eta)) continue;
-        const auto q = steady_point(p.folder);
-        (q.eta == 0 ? ref_pts : coh_pts).push_back(q);
-      }
-      if (coh_pts.empty() || ref_pts.empty())
-        throw AnalysisError(fmt::format("{} eta = 0 and {} eta > 0 steady runs: both are needed", ref_pts.size(),
-                                        coh_pts.size()));
-      const SinPhiReference ref(ref_pts, SinPhiReference::Mode::Auto);
-      std::vector<CohesionPoint> cps;
-      std::vector<double> eta, I, c, ce;
-      for (const auto& q : coh_pts) {
-        cps.push_back(cohesion_point(q, ref));
-        eta.push_back(q.eta), I.push_back(q.I), c.push_back(cps.back().c_over_p), ce.push_back(cps.back().c_over_p_err);
-      }
-      const auto r = fit_cohesion(eta, I, c, ce);
-      fits.push_back(r);
-      models.push_back(cohesion());
-      sum.plots_ok = plot_cohesion(out_dir, cps, &r) && sum.plots_ok;
-      sum.fits.push_back("cohesion");
-      html_fit += fmt::format("<h3>Cohesion c/p</h3><img src='cohesion.png' width=600><p>{}: k0 = {:.4g} ± {:.2g}, "
-                              "β = {:.4g} ± {:.2g}, α = {:.4g} ± {:.2g}, χ²/dof = {:.2f}; {} from {} η = 0 "
-                              "runs by {}</p>\n",
-                              html_escape(cohesion().formula), r["k0"], r.err("k0"), r["beta"], r.err("beta"),
-                              r["alpha"], r.err("alpha"), r.chi2_dof,
-                              ref.dim() == 3 ? "c/p = μ − μ0(I), μ0(I)" : "sin φ(I)", ref_pts.size(),
-                              ref.uses_fit() ? "the μ(I) fit" : "interpolation in ln I") +
-                  flagged(r, "cohesion") +
-                  made_by(report_cmd, fmt::format("cdanalysis fit cohesion {} --out DIR", campaign));
-    } catch (const AnalysisError& e) {
-      sum.problems.push_back(fmt::format("cohesion fit: {}", e.what()));
-      refused.push_back({"cohesion", cohesion().formula, e.what()});
-      html_fit += fmt::format("<p>Cohesion fit refused: {}</p>\n", html_escape(e.what())) +
-                  undetermined_html("cohesion", e.what());
-    }
-  }
-
-  // Angularity: the table of steady quantities against alpha and mu*(alpha).
-  if (by_shape) {
-    std::vector<AngularityPoint> ap;
-    AngularityOptions opt;
-    opt.bins = bins;
-    for (const ReportRun& p : scan.runs) {
-      if (!p.steady) continue;
-      try {
-        ap.push_back(angularity_point(p.folder, opt));
-      } catch (const AnalysisError& e) {
-        sum.problems.push_back(fmt::format("angularity: {}", e.what()));
-      }
-    }
-    std::sort(ap.begin(), ap.end(), [](const auto& a, const auto& b) { return a.alpha < b.alpha; });
-    std::optional<FitResult> r;
-    try {
-      r = fit_angularity(ap);
-      fits.push_back(*r);
-      models.push_back(mu_of_alpha());
-      sum.fits.push_back("mu_alpha");
-    } catch (const AnalysisError& e) {
-      sum.problems.push_back(fmt::format("mu*(alpha) fit: {}", e.what()));
-      refused.push_back({"mu_alpha", mu_of_alpha().formula, e.what()});
-    }
-    if (!ap.empty()) {
-      const std::string fit_cmd = fmt::format("cdanalysis fit angularity {} --out DIR", campaign);
-      sum.plots_ok = plot_angularity(out_dir, ap, r ? &*r : nullptr, report_cmd) && sum.plots_ok;
-      sum.angularity = ap.size();
-      html_fit += "<h3>Angularity</h3>\n";
-      if (r)
-        html_fit += fmt::format("<p>{}: μ0 = {:.4f} ± {:.2g}, μ1 = {:.4f} ± {:.2g}, α_c = {:.4g} ± {:.2g}, "
-                                "χ²/dof = {:.2f} (dof {})</p>\n",
-                                html_escape(mu_of_alpha().formula), (*r)["mu0"], r->err("mu0"), (*r)["mu1"],
-                                r->err("mu1"), (*r)["alpha_c"], r->err("alpha_c"), r->chi2_dof, r->dof) +
-                    flagged(*r, "mu_alpha");
-      else
-        html_fit += "<p>μ*(α) fit refused (see Problems).</p>\n" +
-                    undetermined_html("mu_alpha", sum.problems.empty() ? "" : sum.problems.back());
-      html_fit +=
-          "<p>Table: <a href='angularity.csv'>angularity.csv</a>. Series quantities: steady mean ± block-"
-          "averaging error; fabric: mean ± sem over the last 5 contact snapshots. Sliding: |f_t| ≥ μ f_n (1 − "
-          "tol) with the run's solver tol. Check q/p ≈ ½Σa: contact-stress q/p of the snapshots against the "
-          "Fourier sum and the tensor sum with directions.</p>\n"
-          "<table border=1 cellspacing=0 cellpadding=3><tr><th>n_s</th><th>α</th><th>μ*</th><th>ν*</th><th>z</th>"
-          "<th>a_c</th><th>a_ln</th><th>a_lt</th><th>a_fn</th><th>a_ft</th><th>sliding</th><th>side–side</th>"
-          "<th>q_sv/p</th><th>q_ss/p</th><th>q/p (snapshots)</th><th>½Σa (Fourier)</th><th>½|ΣA| (tensor)</th></tr>\n";
-      for (const auto& a : ap) {
-        html_fit += fmt::format("<tr><td>{}</td><td>{:.4f}</td>", a.nsides, a.alpha);
-        for (const Val* v : {&a.mu, &a.nu, &a.z, &a.a_c, &a.a_ln, &a.a_lt, &a.a_fn, &a.a_ft, &a.sliding,
-                             &a.ss_share, &a.q_sv, &a.q_ss, &a.q_over_p_snap, &a.sum_half_fft, &a.sum_half_tensor})
-          html_fit += "<td>" + or_na(v->v, v->err) + "</td>";
-        html_fit += "</tr>\n";
-      }
-      html_fit += "</table>\n";
-      for (const auto& stem : kAngularityPlots)
-        html_fit += fmt::format("<img src='{}.png' width=450>\n", stem);
-      html_fit += made_by(report_cmd, fit_cmd);
-    }
-  }
-  write_text((fs::path(out_dir) / "fits.toml").string(), fits_to_toml(fits, models, refused));
-
-  // Cost against I, for a campaign over I (measured I spanning a factor 1.5 or more).
-  std::string html_cost;
-  {
-    double lo = INFINITY, hi = 0;
-    std::size_t n = 0;
-    for (const ReportRun& p : scan.runs) {
-      const double I = p.steady && std::isfinite(p.I.v) && p.I.v > 0 ? p.I.v : p.I_imposed;
-      if (p.cost && std::isfinite(I) && I > 0) ++n, lo = std::min(lo, I), hi = std::max(hi, I);
-    }
-    if (n >= 2 && hi >= 1.5 * lo) {
-      sum.cost_plot = true;
-      sum.plots_ok = plot_cost_I(out_dir, scan) && sum.plots_ok;
-      html_cost = "<h2>Cost against I</h2><img src='cost_I.png' width=600>"
-                  "<p>Every run with a summary.toml; the runs without a steady window (open symbols) at their "
-                  "imposed I. Data: <a href='cost_I.csv'>cost_I.csv</a>.</p>\n";
-    }
-  }
-
-  write_text((fs::path(out_dir) / "index.html").string(), report_page(scan, sum, html_fit, html_cost));
+  const std::string cost_html = cost_section(scan, out_dir, sum);
+  write_text((fs::path(out_dir) / "index.html").string(), report_page(scan, sum, fits.html, cost_html));
   return sum;
 }
 
