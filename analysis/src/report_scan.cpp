@@ -146,6 +146,8 @@ ReportRun scan_run(const std::string& folder, std::size_t index, int dim, int bi
       r.not_steady_why = e.what();
       r.problems.push_back(fmt::format("{}: {}", folder, e.what()));
     }
+    // Without its main column (neither mu nor kinetic_energy) a run has
+    // nothing to draw: it is unreadable, after the steady attempt said why.
     r.curve = series_curve(series, r.x_column, r.main_column);
     measure_fabric(r, series, dim, bins);
   } catch (const AnalysisError& e) {
