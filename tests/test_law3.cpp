@@ -7,10 +7,14 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
+#include <set>
+#include <string>
+#include <variant>
 
 #include <Eigen/Eigenvalues>
 
 #include "law3.hpp"
+#include "law_parts3.hpp"
 
 namespace {
 
@@ -160,3 +164,64 @@ TEST(Law3, RandomBlocksSatisfyTheLawAndMatchTheReference) {
 }
 
 }  // namespace
+
+// The 3D law from named parts (law_parts3.hpp): the variant lists each valid
+// combination of one friction, adhesion and offsets part once, each law's
+// name is its own (the .cdp3 files read a law back by name), a spec picks
+// the law with exactly its parts, and a spec no law has is refused.
+TEST(Law3, LawsFromNamedParts) {
+  using cd::Friction3;
+  using cd::LawSpec3;
+  using cd::LocalLaw3;
+  std::set<std::string> names;
+  int n = 0;
+  for (const Friction3 f : {Friction3::None, Friction3::Round, Friction3::Orthotropic})
+    for (const bool adhesion : {false, true})
+      for (const bool offsets : {false, true}) {
+        const LawSpec3 s{.friction = f, .adhesion = adhesion, .offsets = offsets};
+        if (offsets && f == Friction3::None) {
+          EXPECT_THROW(cd::choose_law3(s), std::logic_error);
+          continue;
+        }
+        const LocalLaw3 l = cd::choose_law3(s);
+        std::visit(
+            [&](auto x) {
+              using L = decltype(x);
+              EXPECT_EQ(L::tangential, f != Friction3::None);
+              EXPECT_EQ(L::orthotropic, f == Friction3::Orthotropic);
+              EXPECT_EQ(L::cohesive, adhesion);
+              EXPECT_EQ(L::offsets, offsets);
+              EXPECT_EQ(L::extra, offsets || f == Friction3::Orthotropic);
+            },
+            l);
+        names.insert(cd::law_name3(l));
+        ++n;
+      }
+  EXPECT_EQ(n, 10);
+  EXPECT_EQ(static_cast<int>(names.size()), 10);
+  EXPECT_EQ(static_cast<int>(std::variant_size_v<LocalLaw3>), 10);
+  EXPECT_EQ(cd::law_name3(cd::choose_law3({.friction = Friction3::Orthotropic, .adhesion = true, .offsets = true})),
+            "coulomb+adhesion+offsets+orthotropic");
+  EXPECT_EQ(cd::law_name3(cd::choose_law3(LawSpec3{})), "frictionless");
+}
+
+// Each part does what its law3.hpp solver does: the composed law's solve
+// is the projection of the part, shifted by the adhesion part.
+TEST(Law3, PartsComposeTheLocalSolve) {
+  cd::SweepRow3 r{};
+  r.mu = 0.4;
+  r.adh = 0.3;
+  cd::RowExtra3 e{};
+  e.mu_b = 0.2;
+  const Vec3 g(0.5, 0.7, -0.4);
+  Vec3 out, ref;
+  using namespace cd::law3;
+  cd::Law3<Frictionless, Adhesion, NoOffsets>::solve(r, nullptr, Vec3(-1.0, 2.0, 3.0), out);
+  EXPECT_EQ(out, Vec3(-0.3, 0.0, 0.0));  // open at the adhesion's -a, no tangential impulse
+  cd::Law3<RoundCone, Adhesion, TangentialOffsets>::solve(r, &e, g, out);
+  cd::project_sphere3(g, 0.4, 0.3, ref);
+  EXPECT_EQ(out, ref);
+  cd::Law3<OrthotropicCone, NoAdhesion, NoOffsets>::solve(r, &e, g, out);
+  cd::project_sphere3_ortho(g, 0.4, 0.2, 0.0, ref);
+  EXPECT_EQ(out, ref);
+}

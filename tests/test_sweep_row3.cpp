@@ -110,7 +110,7 @@ TEST(SweepRow3, NotASphereRowIsRefused) {
     prob.rows[0].b2 = 1;
     prob.colouring.start = {0, 2};
     prob.colouring.split = {0};
-    prob.law = choose_law3(true, false, false, false);
+    prob.law = choose_law3({.friction = Friction3::Round});
     SolverParams prm;
     try {
       nlgs_solve3(prob, prm);

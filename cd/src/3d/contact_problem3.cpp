@@ -68,8 +68,8 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
       [&](auto law) {
         using L = decltype(law);
         if (p.compliance > 0) {
-          sweep::CompliantCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size()), r0.data(),
-                                      p.compliance, rho_t};
+          sweep::CompliantCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size()),
+                                      {r0.data(), p.compliance, rho_t}};
           return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
         }
         sweep::BodyCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size())};

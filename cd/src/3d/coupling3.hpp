@@ -1,8 +1,8 @@
 // The 3D sphere rows for the sweep (core/sweep.hpp): rows coupled through
 // the velocities of their bodies (BodyCoupling3, the sibling of 2D's
-// BodyCoupling), the laws chosen once per scene, and what the sweep asks of
-// a row (its law residual, its impulse norm; the boundary dof is
-// contact_problem3.hpp's CellDof3).
+// BodyCoupling) under a law from named parts (law_parts3.hpp), and what the
+// sweep asks of a row (its law residual, its impulse norm; the boundary dof
+// is contact_problem3.hpp's CellDof3).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -13,82 +13,10 @@
 
 #include "contact3.hpp"
 #include "law3.hpp"
+#include "law_parts3.hpp"
 #include "sweep.hpp"
 
 namespace cd {
-
-// The local law of a scene, fixed once (no test inside the sweep):
-// frictionless or Coulomb, with or without adhesion, with or without
-// tangential offsets (Offsets: restitution or moving periodic images put
-// constant terms b_t into the tangential velocity the law sees; without them
-// b_t is never read, so such scenes compute exactly what they did before),
-// round or orthotropic cone (Orthotropic: |(s_t1/mu, s_t2/mu_b)| <= s_n,
-// project_sphere3_ortho). Offsets and mu_b live in the row's RowExtra3 (e,
-// null for the instances that read neither). The local solve is law3's
-// exact solver for the sphere block diag(W_nn, W_tt, W_tt), from the stick
-// trial g = r - W^-1 u (u the velocity at the row's current impulse r).
-template <bool Friction, bool Cohesion, bool Offsets = false, bool Orthotropic = false>
-struct SphereLaw3 {
-  static constexpr bool tangential = Friction;
-  static constexpr bool offsets = Offsets && Friction;
-  static constexpr bool orthotropic = Orthotropic && Friction;
-  static constexpr bool extra = offsets || orthotropic;  // reads RowExtra3
-  static constexpr bool cohesive = Cohesion;
-  static void solve(const SweepRow3& r, [[maybe_unused]] const RowExtra3* e, const Vec3& g, Vec3& out) {
-    const double a = Cohesion ? r.adh : 0.0;
-    if constexpr (orthotropic) {
-      project_sphere3_ortho(g, r.mu, e->mu_b, a, out);
-    } else if constexpr (Friction) {
-      project_sphere3(g, r.mu, a, out);
-    } else {
-      out = Vec3(std::max(-a, g[0]), 0.0, 0.0);
-    }
-  }
-};
-
-// The laws a scene can need, one type each: the variant a ContactProblem3
-// carries, resolved once per solve into a template instance of the sweep.
-using LocalLaw3 =
-    std::variant<SphereLaw3<false, false>, SphereLaw3<false, true>, SphereLaw3<true, false, false, false>,
-                 SphereLaw3<true, false, false, true>, SphereLaw3<true, false, true, false>,
-                 SphereLaw3<true, false, true, true>, SphereLaw3<true, true, false, false>,
-                 SphereLaw3<true, true, false, true>, SphereLaw3<true, true, true, false>,
-                 SphereLaw3<true, true, true, true>>;
-
-// The law of a scene: friction and the two RowExtra3 options only with
-// friction (a frictionless law reads neither).
-inline LocalLaw3 choose_law3(bool friction, bool cohesion, bool offsets, bool orthotropic) {
-  LocalLaw3 out;
-  bool found = false;
-  auto pick = [&]<std::size_t... I>(std::index_sequence<I...>) {
-    (([&] {
-       using L = std::variant_alternative_t<I, LocalLaw3>;
-       if (!found && L::tangential == friction && L::cohesive == cohesion &&
-           L::offsets == (friction && offsets) && L::orthotropic == (friction && orthotropic)) {
-         out = L{};
-         found = true;
-       }
-     }()),
-     ...);
-  };
-  pick(std::make_index_sequence<std::variant_size_v<LocalLaw3>>{});
-  return out;
-}
-
-// "frictionless" or "coulomb", then "+adhesion", "+offsets", "+orthotropic"
-// as the law has them (the .cdp3 files' law line).
-inline std::string law_name3(const LocalLaw3& l) {
-  return std::visit(
-      [](auto x) {
-        using L = decltype(x);
-        std::string s = L::tangential ? "coulomb" : "frictionless";
-        if (L::cohesive) s += "+adhesion";
-        if (L::offsets) s += "+offsets";
-        if (L::orthotropic) s += "+orthotropic";
-        return s;
-      },
-      l);
-}
 
 // A lever arm the sweep may take as l n (contact3.hpp's SweepRow3): along n
 // to round-off, or of a body that neither turns nor is turned (a plane).
@@ -167,10 +95,11 @@ namespace sweep {
 // nlgs_solve3), so the stick trial is g = r - (u + rho (r - r0)) iwnn
 // without a division, and the cell dofs' damped update and the law
 // residual's scale see the compliant block. The rigid instance
-// (false) reads neither r0 nor rho, so rigid scenes compute what they did
-// before the option existed.
-template <bool Compliant>
+// (law3::RigidNormal) reads neither r0 nor rho, so rigid scenes compute
+// what they did before the option existed.
+template <class Normal>
 struct BodyCouplingT3 {
+  static constexpr bool Compliant = Normal::compliant;
   BodyVel3* vel;
   // The rows' RowExtra3, same index as the rows from `base` (null in scenes
   // without them).
@@ -206,7 +135,7 @@ struct BodyCouplingT3 {
   static constexpr int kImpulseDim = 3;
   // update's pabs is |p_n| + |p_t1| + |p_t2|, a bound of |p| without the
   // square root (12 % of an update): the sweep sums the exact |p| only when
-  // the stop may come (sweep.hpp, LazyNorm).
+  // the stop may come (sweep.hpp: norm_bound, exact_psum).
   static constexpr bool kNormBound = true;
   void read_impulse(const SweepRow3& r, double* x) const {
     x[0] = r.r[0];
@@ -225,18 +154,17 @@ struct BodyCouplingT3 {
   // products W p go through a copy of the bodies (masses kept, velocities
   // zeroed each time); nbodies is the size of vel.
   int nbodies = 0;
-  // Compliant: the impulses at the solve's start, same index as the rows
-  // from `base`, and rho (velocity per impulse), rho_t of the tangential
-  // springs (k_t = k: rho_t = rho).
-  const Vec3* r0 = nullptr;
-  double rho = 0.0, rho_t = 0.0;
+  // The normal part (law_parts3.hpp). Compliant: the impulses at the
+  // solve's start (r0, same index as the rows from `base`), rho (velocity
+  // per impulse), rho_t of the tangential springs (k_t = k: rho_t = rho).
+  [[no_unique_address]] Normal normal{};
   // The velocity the law sees: u, and rho (r - r0) on a compliant row
   // (rho_t on the tangential components).
   Vec3 law_velocity(const SweepRow3& r) const {
     const Vec3 u = velocity(r);
     if constexpr (Compliant) {
-      const Vec3 d = r.r - r0[&r - base];
-      return Vec3(u[0] + rho * d[0], u[1] + rho_t * d[1], u[2] + rho_t * d[2]);
+      const Vec3 d = r.r - normal.r0[&r - base];
+      return Vec3(u[0] + normal.rho * d[0], u[1] + normal.rho_t * d[1], u[2] + normal.rho_t * d[2]);
     }
     return u;
   }
@@ -285,9 +213,9 @@ struct BodyCouplingT3 {
       y[3 * i + 1] = r.t1.dot(dv) + r.t2.dot(om);
       y[3 * i + 2] = r.t2.dot(dv) - r.t1.dot(om);
       if constexpr (Compliant) {
-        y[3 * i] += rho * p[3 * i];
-        y[3 * i + 1] += rho_t * p[3 * i + 1];
-        y[3 * i + 2] += rho_t * p[3 * i + 2];
+        y[3 * i] += normal.rho * p[3 * i];
+        y[3 * i + 1] += normal.rho_t * p[3 * i + 1];
+        y[3 * i + 2] += normal.rho_t * p[3 * i + 2];
       }
     }
   }
@@ -333,7 +261,7 @@ struct BodyCouplingT3 {
     // rho term is then zero (the same sign of the trial, so the same open
     // impulse).
     const Vec3* z0 = nullptr;
-    if constexpr (Compliant) z0 = r0 + (&r - base);
+    if constexpr (Compliant) z0 = normal.r0 + (&r - base);
     {
       const double a = L::cohesive ? r.adh : 0.0;
       if (r.r[0] == -a && r.r[1] == 0.0 && r.r[2] == 0.0 && (!Compliant || *z0 == r.r)) {
@@ -351,10 +279,10 @@ struct BodyCouplingT3 {
     Vec3 g;
     if constexpr (Compliant) {
       const Vec3 d = r.r - *z0;
-      g[0] = r.r[0] - (u[0] + rho * d[0]) * r.iwnn;
+      g[0] = r.r[0] - (u[0] + normal.rho * d[0]) * r.iwnn;
       if constexpr (L::tangential) {
-        g[1] = r.r[1] - (u[1] + rho_t * d[1]) * r.iwtt;
-        g[2] = r.r[2] - (u[2] + rho_t * d[2]) * r.iwtt;
+        g[1] = r.r[1] - (u[1] + normal.rho_t * d[1]) * r.iwtt;
+        g[2] = r.r[2] - (u[2] + normal.rho_t * d[2]) * r.iwtt;
       } else {
         g[1] = g[2] = 0.0;
       }
@@ -387,16 +315,16 @@ struct BodyCouplingT3 {
   }
 };
 
-using BodyCoupling3 = BodyCouplingT3<false>;
-using CompliantCoupling3 = BodyCouplingT3<true>;
+using BodyCoupling3 = BodyCouplingT3<law3::RigidNormal>;
+using CompliantCoupling3 = BodyCouplingT3<law3::CompliantNormal>;
 
 }  // namespace sweep
 
 // The law residual of a row (law3.hpp, rho = 1/W_nn) at the velocity its
 // coupling gives the law (compliant: with rho (r - r0)), with its RowExtra3
 // when the scene has them.
-template <bool Compliant>
-double row_residual(const sweep::BodyCouplingT3<Compliant>& c, const SweepRow3& r) {
+template <class Normal>
+double row_residual(const sweep::BodyCouplingT3<Normal>& c, const SweepRow3& r) {
   const RowExtra3* e = c.extra_of(r);
   return law_residual3(c.law_velocity(r), r.r, Cone3{r.mu, e ? e->mu_b : r.mu}, r.adh, r.iwnn);
 }

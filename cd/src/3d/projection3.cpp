@@ -29,7 +29,7 @@ void World3::project_overlaps() {
   q.rows = prob_.rows;
   q.extra = prob_.extra;
   q.colouring = prob_.colouring;
-  q.law = choose_law3(false, false, false, false);
+  q.law = choose_law3(LawSpec3{});  // frictionless, no adhesion
   q.vel = bodies.vel;
   for (BodyVel3& v : q.vel) v.v = v.w = Vec3::Zero();
   for (std::size_t k = 0; k < nr; ++k) {

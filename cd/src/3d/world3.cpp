@@ -71,7 +71,11 @@ void World3::configure() {
   // the orthotropic mu_b are the rows' RowExtra3.
   const bool offsets = prm_.e_t > 0.0 || moving_images;
   extras_on_ = friction_on_ && (offsets || prm_.orthotropic);
-  prob_.law = choose_law3(friction_on_, adhesion_on_, offsets, prm_.orthotropic);
+  prob_.law = choose_law3({.friction = !friction_on_       ? Friction3::None
+                                        : prm_.orthotropic ? Friction3::Orthotropic
+                                                           : Friction3::Round,
+                            .adhesion = adhesion_on_,
+                            .offsets = friction_on_ && offsets});
   prob_.compliance = prm_.stiffness > 0.0 ? 1.0 / (prm_.stiffness * prm_.dt * prm_.dt) : 0.0;
   // k_t = k: 0, the tangential springs take the normal compliance.
   prob_.compliance_t =
