@@ -19,6 +19,7 @@
 
 #include <omp.h>
 
+#include "projection_trigger.hpp"
 #include "world3.hpp"
 
 using namespace cd;
@@ -126,4 +127,23 @@ TEST(Projection3, DenseCellLosesItsOverlapsWithoutEnergy) {
   // Below the trigger: 1e-3 of the smaller diameter (projection3.cpp).
   EXPECT_LT(max_overlap_small(a), 1e-3);
   EXPECT_EQ(a.bodies.pos, b.bodies.pos);
+}
+
+// The projection's pseudo-velocity solve is plain NLGS whatever the scene's
+// accelerations (projection_trigger.hpp): neither Anderson's mixing nor the
+// subspace correction (which would act on its frictionless law), at most
+// kSweeps sweeps, no law-residual stop; the tolerance is the scene's.
+TEST(Projection3, ItsSolveIsPlainNlgs) {
+  cd::SolverParams sp;
+  sp.tol = 3e-4;
+  sp.max_iter = 2000;
+  sp.residual_tol = 3e-3;
+  sp.anderson = 5;
+  sp.subspace = 10;
+  const cd::SolverParams q = cd::projection::solver_params(sp);
+  EXPECT_EQ(q.anderson, 0);
+  EXPECT_EQ(q.subspace, 0);
+  EXPECT_EQ(q.residual_tol, 0.0);
+  EXPECT_EQ(q.max_iter, cd::projection::kSweeps);
+  EXPECT_EQ(q.tol, 3e-4);
 }

@@ -13,6 +13,7 @@
 
 #include "cli_util.hpp"
 #include "config.hpp"
+#include "setup3.hpp"
 #include "shear_policy.hpp"
 
 namespace {
@@ -219,6 +220,28 @@ TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
     EXPECT_EQ(c.subspace, 0) << coh;
     EXPECT_EQ(c.anderson, cd::kAnderson) << coh;
     EXPECT_EQ(c.tol, cd::shear_settings(0.01, cd::Acceleration::Anderson, kCohesiveSpheres).tol) << coh;
+  }
+  // An orthotropic cone: the subspace correction does not act on it, so
+  // "auto" gives none and the tolerance of what then runs (the band's
+  // Anderson choice); a number is refused, naming both keys.
+  for (const double I : {0.001, 0.01, 0.3}) {
+    std::ostringstream is;
+    is << "shear.inertial_number=" << I;
+    for (const char* ortho : {"contact.mu_b=0.2", "contact.mu_wall_b=0.1"}) {
+      const cd::Scene o = cd::parse_scene(scene, "a.toml", {is.str(), ortho});
+      EXPECT_EQ(o.subspace, 0) << ortho << ", I = " << I;
+      EXPECT_EQ(o.anderson, I < 0.01 ? cd::kAnderson : 0) << ortho << ", I = " << I;
+      const auto acc = I < 0.01 ? cd::Acceleration::Anderson : cd::Acceleration::None;
+      EXPECT_EQ(o.tol, cd::shear_settings(I, acc).tol) << ortho << ", I = " << I;
+      try {
+        cd::check_scene3(cd::parse_scene(scene, "a.toml", {is.str(), ortho, "solver.subspace=10"}));
+        ADD_FAILURE() << "an orthotropic scene took the subspace correction";
+      } catch (const std::exception& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("solver.subspace = 10"), std::string::npos) << m;
+        EXPECT_NE(m.find(std::string(ortho).substr(0, std::string(ortho).find('='))), std::string::npos) << m;
+      }
+    }
   }
   // 2D: Anderson's mixing with disks, none with polygons, in every band;
   // the tolerance follows.

@@ -124,6 +124,12 @@ void check_scene3(const Scene& s) {
   const auto fail = fail3;
   if (s.dimension != 3) fail(fmt::format("dimension = {}: not a 3D scene", s.dimension));
   if (s.gravity.size() != 3) fail("gravity.g: a 3D scene needs [gx, gy, gz]");
+  // A setting that cannot act under the scene's law is refused, not ignored.
+  if (s.subspace > 0 && (s.mu_b >= 0 || s.mu_wall_b >= 0))
+    fail(fmt::format("solver.subspace = {}: the subspace correction acts on the round cone only, and "
+                     "contact.{} = {} makes the cone orthotropic: give solver.subspace = 0 (solver.anderson "
+                     "accelerates any cone)",
+                     s.subspace, s.mu_b >= 0 ? "mu_b" : "mu_wall_b", s.mu_b >= 0 ? s.mu_b : s.mu_wall_b));
   if (s.shear_mode == ShearMode::Periodic) {
     check_derived(s);
     return check_cell3(with_auto_cell3(s));

@@ -38,12 +38,16 @@ bool due(std::size_t n, Gap&& gap, Diameter&& diameter) {
 inline double offset(double g, double beta, double dt) { return g < 0.0 ? beta * g / dt : g / dt; }
 
 // The projection's solver settings from the scene's: at most kSweeps
-// sweeps, no law-residual stop, plain NLGS (no Anderson mixing) for the
-// frictionless pseudo-velocity problem; the tolerance is the scene's.
+// sweeps, no law-residual stop, plain NLGS (neither Anderson's mixing nor
+// the subspace correction) for the frictionless pseudo-velocity problem;
+// the tolerance is the scene's. (No shear policy band runs the subspace
+// correction with the projection; a scene that gave both ran the correction
+// inside the projection too.)
 inline SolverParams solver_params(SolverParams sp) {
   sp.max_iter = std::min(sp.max_iter, kSweeps);
   sp.residual_tol = 0.0;
   sp.anderson = 0;
+  sp.subspace = 0;
   return sp;
 }
 

@@ -149,7 +149,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"solver", "max_iter", &Scene::max_iter, "", in(1, 1e8), "NLGS iteration cap per time step"},
       {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "anderson", &Scene::anderson, "", in(0, 50), "> 0: Anderson acceleration of the sweep with this memory (5 is the measured choice): after each forward-backward pair of sweeps the impulses are mixed over the last pairs, and the mixing is off for the rest of a step's solve once it stalls (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it (docs/shear.md, Settings by I); 0: plain NLGS; \"auto\": the shear policy's choice by shear.inertial_number (measured on spheres)"},
-      {"solver", "subspace", &Scene::subspace, "", in(0, 1000), "> 0: the subspace correction of the sweep (3D only; it acts on the round cone, with adhesion or not, and does nothing under the orthotropic one): every two forward-backward pairs of sweeps, the linear problem of the contacts that stick (u = 0) and slide (u_n = 0) is solved by at most this many conjugate-gradient iterations and put into the impulses, until a stall stops them for the step (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it; 0: off; \"auto\": the shear policy's choice by shear.inertial_number (docs/shear.md, Settings by I)"},
+      {"solver", "subspace", &Scene::subspace, "", in(0, 1000), "> 0: the subspace correction of the sweep (3D only; it acts on the round cone, with adhesion or not: an orthotropic scene refuses it): every two forward-backward pairs of sweeps, the linear problem of the contacts that stick (u = 0) and slide (u_n = 0) is solved by at most this many conjugate-gradient iterations and put into the impulses, until a stall stops them for the step (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it; 0: off; \"auto\": the shear policy's choice by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "threads", &Scene::threads, "", in(0, 1024), "OpenMP threads; 0: OpenMP default"},
       {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
@@ -523,7 +523,8 @@ Scene read_scene(const toml::value& root, const std::string& path) {
   // "auto": the shear settings at the scene's I (after every key and
   // override is read, so that --set shear.inertial_number counts).
   const SceneKind kind{s.dimension, s.adhesion > 0 || s.cohesion_number > 0,
-                       std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; })};
+                       std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; }),
+                       s.dimension == 3 && (s.mu_b >= 0 || s.mu_wall_b >= 0)};
   for (const bool acceleration : {true, false})
     for (const auto& [a, at] : out.autos) {
       if (a->acceleration() != acceleration) continue;

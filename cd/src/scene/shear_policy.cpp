@@ -16,7 +16,7 @@ ShearSettings shear_settings(double I, Acceleration acc, SceneKind kind) {
   const double dt_tp = std::stod(fmt::format("{:.4g}", std::min(kSlidePerStep / I, kDtMaxTp)));
   const bool spheres = kind.dimension == 3 && !kind.cohesive;
   const int anderson = kind.dimension == 2 ? (kind.polygons ? 0 : kAnderson) : kind.cohesive ? kAnderson : b->auto_anderson;
-  const int subspace = spheres ? b->auto_subspace : 0;
+  const int subspace = spheres && !kind.orthotropic ? b->auto_subspace : 0;
   const bool polygons = kind.dimension == 2 && kind.polygons && !kind.cohesive;
   const Stop& stop = acc == Acceleration::Subspace   ? b->subspace
                      : acc == Acceleration::Anderson ? (kind.cohesive ? b->cohesive : b->anderson)

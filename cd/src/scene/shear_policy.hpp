@@ -72,7 +72,7 @@ inline constexpr std::array<ShearBand, 3> kShearBands = {{
     // 1.4x plain tol 1e-3's CPU (7e-4: the same CPU, z 0.008 high). 1000
     // disks: within 1.2 sigma at 0.93x plain tol 1e-3's CPU. The subspace
     // correction at tol 7e-4 holds all three within 0.5 sigma at 0.57x
-    // Anderson's CPU at 5e-4 (spheres, three samples, one sitting).
+    // Anderson's CPU at 5e-4 (spheres, three samples, side by side).
     // Polygons (1000 hexagons at I = 0.01, five samples against plain tol
     // 1e-4 + residual_tol 3e-3): plain tol 1e-3 puts mu 2.0 sigma high with
     // overlaps of 4.5e-3 d; tol 2e-3 with the overlap projection holds mu,
@@ -114,6 +114,10 @@ struct SceneKind {
   int dimension = 3;
   bool cohesive = false;
   bool polygons = false;  // 2D: some particle is a polygon
+  // 3D: the orthotropic cone (contact.mu_b or mu_wall_b >= 0), on which the
+  // subspace correction does not act: "auto" gives it none (and the band's
+  // Anderson choice), so its stop is the plain or Anderson column's.
+  bool orthotropic = false;
 };
 ShearSettings shear_settings(double inertial_number, Acceleration acc = Acceleration::None, SceneKind kind = {});
 
