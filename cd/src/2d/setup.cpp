@@ -8,7 +8,9 @@
 #include <fmt/format.h>
 
 #include "checkpoint.hpp"
+#include "continuation.hpp"
 #include "observables.hpp"
+#include "protocol.hpp"
 #include "start_hint.hpp"
 
 namespace cd {
@@ -21,53 +23,19 @@ std::string body_name(const Scene& s, int i, int first_generated) {
   return fmt::format("generated particle {}", i - first_generated);
 }
 
-// What the parser's per-key rules cannot see: keys that only make sense
-// together.
+// The protocol's rules are the scene layer's (scene/protocol.hpp); what is
+// left is the cell's size, which the placement below needs.
 void check_shear(const Scene& s) {
-  auto fail = [](const std::string& m) { throw SceneError(m); };
-  const bool shear = s.shear_mode != ShearMode::None;
-  if (s.checkpoint_strain > 0 && (!shear || s.inertial_number <= 0))
-    fail("output.checkpoint_strain > 0 needs a shear rate (shear.mode \"periodic\" or \"walls\" "
-         "and shear.inertial_number > 0); use output.checkpoint_interval or "
-         "output.checkpoint_wall for other runs");
-  if (s.cohesion_number > 0) {
-    if (s.pressure <= 0) fail("contact.cohesion_number > 0 needs shear.pressure > 0 (f_a = eta p d)");
-    if (s.adhesion > 0) fail("give contact.adhesion or contact.cohesion_number, not both");
-  }
-  if (s.dt_tp > 0 && s.pressure <= 0) fail("shear.dt_tp > 0 needs shear.pressure > 0 (t_p = d sqrt(rho/p))");
-  if (!shear) {
-    if (s.inertial_number > 0 || s.isotropic || !s.start.empty() || s.strain > 0 || s.compaction_rate > 0)
-      fail("shear.inertial_number, shear.isotropic, shear.strain, shear.start and "
-           "shear.compaction_rate need shear.mode \"periodic\" or \"walls\"");
-    return;
-  }
+  check_protocol(s);
+  if (s.shear_mode == ShearMode::None) return;
   // 0 x 0: a periodic cell sized for the generated particles (with_auto_cell)
   // or the start sample's cell.
   const bool auto_cell = s.shear_mode == ShearMode::Periodic && s.cell_width == 0 && s.cell_height == 0 &&
                          (s.n > 0 || !s.start.empty());
   if (!auto_cell && (s.cell_width <= 0 || s.cell_height <= 0))
-    fail(fmt::format("shear.mode = \"{}\" needs shear.width > 0 and shear.height > 0 (periodic: "
-                     "or both 0, for a cell sized for the particles)", name_of(s.shear_mode)));
-  if (s.gravity[0] != 0 || s.gravity[1] != 0)
-    fail("shear protocols run without gravity: set [gravity] g = [0.0, 0.0]");
-  if (s.box_width > 0 || !s.walls.empty()) fail("shear protocols take no [box] and no [[wall]]");
-  if (s.inertial_number > 0 && s.pressure <= 0)
-    fail("shear.inertial_number > 0 needs shear.pressure > 0 (shear rate = I sqrt(p/rho)/d)");
-  if (s.isotropic && (s.shear_mode != ShearMode::Periodic || s.inertial_number > 0))
-    fail("shear.isotropic (compaction) needs shear.mode = \"periodic\" and shear.inertial_number = 0");
-  if (s.strain > 0 && s.inertial_number <= 0) fail("shear.strain > 0 needs shear.inertial_number > 0");
-  if (s.compaction_rate > 0 && (s.shear_mode != ShearMode::Periodic || s.pressure <= 0))
-    fail("shear.compaction_rate > 0 needs shear.mode = \"periodic\" and shear.pressure > 0 (it "
-         "bounds the rate of the cell's pressure-controlled lengths)");
-  if (s.pressure > 0 && !(s.alert > 0))
-    fail(fmt::format("shear.mode = \"{}\" with shear.pressure > 0 needs contact.alert > 0: {} by at most a "
-                     "quarter of the alert distance a step (so that {} contacts are detected before they "
-                     "close), and would not move", name_of(s.shear_mode),
-                     s.shear_mode == ShearMode::Walls ? "the top wall falls" : "the cell's lengths shrink",
-                     s.shear_mode == ShearMode::Walls ? "its" : "their"));
-  if (!s.start.empty() && s.shear_mode != ShearMode::Periodic)
-    fail("shear.start needs shear.mode = \"periodic\" (a walls run places its own grains "
-         "between its walls)");
+    throw SceneError(fmt::format("shear.mode = \"{}\" needs shear.width > 0 and shear.height > 0 (periodic: "
+                                 "or both 0, for a cell sized for the particles)",
+                                 name_of(s.shear_mode)));
 }
 
 }  // namespace
@@ -108,7 +76,7 @@ WorldParams world_params(const Scene& s0) {
     CellParams& c = p.cell;
     c.mode = s.shear_mode == ShearMode::Periodic ? CellParams::Mode::LeesEdwards : CellParams::Mode::Walls;
     c.width = s.cell_width;
-    c.pressure = s.pressure;
+    c.pressure = imposed_pressure(s);  // 0 under volume control: the lengths stay
     c.isotropic = s.isotropic;
     c.shear_rate = shear_rate(s);
     const double tp = pressure_time(s);
@@ -169,56 +137,42 @@ World build_world(const Scene& s0) {
           scene_polygons ? std::string("disks only")
                          : fmt::format("polygons ({}-gon: body {})", B.nsides[poly], poly),
           fmt::join(s.nsides, ", "), scene_polygons ? "polygons" : "disks only"));
-    for (std::size_t i = 0; i < B.size(); ++i) {
+    for (std::size_t i = 0; i < B.size(); ++i)
       if (!B.is_dynamic(i))
         throw SceneError(fmt::format("shear.start: '{}' holds walls or wall grains (body {}); a "
                                      "periodic run starts from a periodic preparation", s.start, i));
-      // The masses come with the sample: they must be the scene's.
-      const double area = obs::particle_area(B.radius[i], B.nsides[i]);
-      if (std::abs(B.mass[i] / area - s.density) > 1e-9 * s.density)
-        throw SceneError(fmt::format("shear.start: the sample's particles have density {:.6g} "
-                                     "kg/m^2 (body {}), particles.density is {:.6g}; set "
-                                     "particles.density to the preparation's",
-                                     B.mass[i] / area, i, s.density));
-    }
+    // The grains (all dynamic: checked above) to core/continuation.hpp.
+    continuation::Grains grains{
+        B.size(),
+        [&](std::size_t i) { return B.pos[i].y(); },
+        [&](std::size_t i) -> double& { return B.vel[i].vx; },
+        [&](std::size_t i) { return 2 * B.radius[i]; },
+        [&](std::size_t i) { return B.mass[i] / obs::particle_area(B.radius[i], B.nsides[i]); },
+        "particles",
+        "kg/m^2"};
+    continuation::check_density(grains, s.density);
     // A sheared sample (strain > 0) is continued: its Lees-Edwards offset
     // and cell rates are kept (the images stay where the grains see them:
     // resetting the offset would overlap grains across the sheared
-    // boundary), and its mean flow a + g y (least squares over the
-    // particles) is replaced by the new run's profile. A compacted sample
-    // starts from rest as before. Either way the strain counts from 0.
+    // boundary), and its mean flow replaced by the new run's profile. A
+    // compacted sample starts from rest. Either way the strain counts from
+    // 0. Under volume control the lengths stay: their rates are 0.
     const bool sheared = w.cell.strain != 0.0;
     if (!sheared) w.cell.offset = w.cell.hdot = w.cell.wdot = 0.0;
+    if (imposed_pressure(s) <= 0) w.cell.hdot = w.cell.wdot = 0.0;
+    if (s.volume_fraction > 0) {
+      double area = 0;
+      for (std::size_t i = 0; i < B.size(); ++i) area += obs::particle_area(B.radius[i], B.nsides[i]);
+      const double f = continuation::volume_scale(area, w.cell.width * w.cell.height, s.volume_fraction, 2);
+      for (Vec2& x : B.pos) x *= f;
+      w.cell.width *= f;
+      w.cell.height *= f;
+      w.cell.offset *= f;
+    }
     w.cell.strain = 0.0;
     w.set_warm_start(prep.warm_start());
-    const double gd = wp.cell.shear_rate;
-    double a = 0, g = 0;  // the sample's mean flow vx = a + g y
-    if (sheared) {
-      double sy = 0, sv = 0, syy = 0, syv = 0, m = 0;
-      for (std::size_t i = 0; i < B.size(); ++i)
-        if (B.is_dynamic(i)) {
-          const double y = B.pos[i].y(), v = B.vel[i].vx;
-          sy += y, sv += v, syy += y * y, syv += y * v, m += 1;
-        }
-      const double den = m * syy - sy * sy;
-      g = den > 0 ? (m * syv - sy * sv) / den : 0.0;
-      a = m > 0 ? (sv - g * sy) / m : 0.0;
-    }
-    double dsum = 0;
-    int nd = 0;
-    for (std::size_t i = 0; i < B.size(); ++i)
-      if (B.is_dynamic(i)) {
-        const double y = B.pos[i].y();
-        if (sheared) B.vel[i].vx -= a + g * y;
-        B.vel[i].vx += gd * (y - 0.5 * w.cell.height);
-        dsum += 2 * B.radius[i];
-        ++nd;
-      }
-    // d sets the shear rate, t_p and f_a: it must be the sample's.
-    if (nd == 0 || std::abs(dsum / nd - wp.d_ref) > 0.1 * wp.d_ref)
-      throw SceneError(fmt::format("shear.start: the sample's mean diameter is {:.4g} m, "
-                                   "particles.d_mean is {:.4g} m; set particles.d_mean to the "
-                                   "preparation's", nd ? dsum / nd : 0.0, wp.d_ref));
+    continuation::set_flow(grains, sheared, wp.cell.shear_rate, 0.5 * w.cell.height);
+    continuation::check_mean_diameter(grains, wp.d_ref);
   }
 
   // In a box, every body starts inside it: one outside would fall for ever

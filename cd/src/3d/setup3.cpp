@@ -9,7 +9,10 @@
 #include <fmt/format.h>
 
 #include "checkpoint3.hpp"
+#include "detect3.hpp"
+#include "continuation.hpp"
 #include "pile3d.hpp"
+#include "protocol.hpp"
 #include "start_hint.hpp"
 
 namespace cd {
@@ -24,40 +27,8 @@ double cell_pitch3(const Scene& s) { return 1.02 * diameter_bounds(s).second; }
 // The tri-periodic cell (shear.mode = "periodic"): the keys that apply,
 // and the lattice fitting the cell.
 void check_cell3(const Scene& s) {
-  // The protocol's keys (2D's, docs/3d.md "Tri-periodic protocol"): what
-  // each needs, by name.
-  // The cohesion number (2D's rules): f_a = eta p d^2 (pull_off_force),
-  // so it needs the imposed pressure, and excludes a given f_a.
-  if (s.cohesion_number > 0) {
-    if (s.pressure <= 0)
-      fail3("contact.cohesion_number > 0 needs shear.pressure > 0 (f_a = eta p d^2, p in N/m^2); without an "
-            "imposed pressure give the pull-off force itself, contact.adhesion (N)");
-    if (s.adhesion > 0) fail3("give contact.adhesion or contact.cohesion_number, not both");
-  }
-  if (s.pressure <= 0) {
-    const std::pair<const char*, bool> need_p[] = {
-        {"shear.inertial_number", s.inertial_number != 0}, {"shear.isotropic", s.isotropic},
-        {"shear.compaction_rate", s.compaction_rate != 0}, {"shear.dt_tp", s.dt_tp != 0},
-        {"shear.strain", s.strain != 0},                   {"output.checkpoint_strain", s.checkpoint_strain != 0}};
-    for (const auto& [key, set] : need_p)
-      if (set)
-        fail3(fmt::format("{} needs shear.pressure > 0 (the cell's lengths at imposed stress; t_p = d "
-                          "sqrt(rho/p), shear rate I sqrt(p/rho)/d)", key));
-  }
-  if (s.pressure > 0 && !(s.alert > 0))
-    fail3("shear.pressure > 0 needs contact.alert > 0: the cell's lengths shrink by at most a quarter of the "
-          "alert distance a step (so that their contacts are detected before they close), and would not move");
-  if (s.isotropic && s.inertial_number > 0)
-    fail3("shear.isotropic (compaction: all three lengths at sigma = p) needs shear.inertial_number = 0");
-  if (s.strain > 0 && s.inertial_number <= 0) fail3("shear.strain > 0 needs shear.inertial_number > 0");
-  if (s.checkpoint_strain > 0 && s.inertial_number <= 0)
-    fail3("output.checkpoint_strain > 0 needs shear.inertial_number > 0 (a shear rate); use "
-          "output.checkpoint_interval or output.checkpoint_wall");
-  if (s.gravity[0] != 0 || s.gravity[1] != 0 || s.gravity[2] != 0)
-    fail3("gravity.g: a tri-periodic cell has no floor; use [0, 0, 0]");
-  if (s.box_width != 0 || s.box_depth != 0 || s.box_height != 0)
-    fail3("box.width, box.depth, box.height: a periodic cell has no box; its lengths are shear.width, "
-          "shear.height and shear.depth");
+  // The protocol's keys: the scene layer's rules (scene/protocol.hpp).
+  check_protocol(s);
   if (!s.rotation) fail3("contact.rotation = false: the 3D engine always integrates rotations");
   if (!s.disks.empty()) fail3("[[disk]]: explicit disks are 2D only");
   if (!s.walls.empty()) fail3("[[wall]]: segment walls are 2D only");
@@ -134,15 +105,7 @@ void check_scene3(const Scene& s) {
     check_derived(s);
     return check_cell3(with_auto_cell3(s));
   }
-  if (s.shear_mode != ShearMode::None)
-    fail(fmt::format("shear.mode = \"{}\": a 3D scene is \"none\" (the box) or \"periodic\" (a "
-                     "tri-periodic cell)", name_of(s.shear_mode)));
-  if (s.pressure != 0 || s.inertial_number != 0 || s.isotropic || s.strain != 0 || s.dt_tp != 0 ||
-      !s.start.empty() || s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0 ||
-      s.cohesion_number != 0 || s.checkpoint_strain != 0)
-    fail("shear.* (pressure, inertial_number, isotropic, strain, dt_tp, start, width, height, depth), "
-         "contact.cohesion_number and output.checkpoint_strain need shear.mode = \"periodic\": leave them "
-         "at their defaults");
+  check_protocol(s);  // no protocol (a 3D scene has no walls protocol): no protocol key
   if (!s.disks.empty()) fail("[[disk]]: explicit disks are 2D only");
   if (!s.walls.empty()) fail("[[wall]]: segment walls are 2D only; the 3D box is [box] width and depth");
   if (s.nsides.size() != 1 || s.nsides[0] != 0)
@@ -207,8 +170,8 @@ WorldParams3 world_params3(const Scene& s0) {
     p.periodic = {true, true, true};
     // At imposed pressure: L_y a dof (sigma_yy = p); isotropic, all three.
     // cell_mass is set by build_cell3, which knows the spheres' mass.
-    p.pressure = s.pressure;
-    if (s.pressure > 0) p.cell_dof = {s.isotropic, true, s.isotropic};
+    p.pressure = imposed_pressure(s);  // 0 under volume control: the lengths stay
+    if (p.pressure > 0) p.cell_dof = {s.isotropic, true, s.isotropic};
     p.shear_rate = shear_rate(s);  // I sqrt(p/rho)/d
     const double tp = pressure_time(s);
     p.max_strain_rate = s.compaction_rate > 0 && tp > 0 ? s.compaction_rate / tp : 0.0;
@@ -232,56 +195,75 @@ void load_start3(const Scene& s, World3& w) {
     throw SceneError(fmt::format("shear.start: {}{}", e.what(), missing_start_hint(s)));
   }
   Bodies3& B = w.bodies;
-  double dsum = 0;
-  int nd = 0;
-  for (std::size_t i = 0; i < B.size(); ++i) {
+  for (std::size_t i = 0; i < B.size(); ++i)
     if (B.shape[i] != Shape3::Sphere || !B.is_dynamic(i))
       throw SceneError(fmt::format("shear.start: '{}' holds a plane or a driven sphere (body {}); a periodic "
                                    "run starts from a periodic run's spheres", s.start, i));
-    // The masses come with the sample: they must be the scene's.
-    const double rho = B.mass[i] / obs::sphere_volume(B.radius[i]);
-    if (std::abs(rho - s.density) > 1e-9 * s.density)
-      throw SceneError(fmt::format("shear.start: the sample's spheres have density {:.6g} kg/m^3 (body {}), "
-                                   "particles.density is {:.6g}; set particles.density to the preparation's",
-                                   rho, i, s.density));
-    dsum += 2 * B.radius[i];
-    ++nd;
-  }
-  // d sets the shear rate and t_p: it must be the sample's.
-  const double d_ref = w.params().d_ref;
-  if (nd == 0 || std::abs(dsum / nd - d_ref) > 0.1 * d_ref)
-    throw SceneError(fmt::format("shear.start: the sample's mean diameter is {:.4g} m, particles.d_mean is "
-                                 "{:.4g} m; set particles.d_mean to the preparation's",
-                                 nd ? dsum / nd : 0.0, d_ref));
+  // The spheres (all dynamic: checked above) to core/continuation.hpp.
+  continuation::Grains grains{B.size(),
+                              [&](std::size_t i) { return B.pos[i].y(); },
+                              [&](std::size_t i) -> double& { return B.vel[i].v.x(); },
+                              [&](std::size_t i) { return 2 * B.radius[i]; },
+                              [&](std::size_t i) { return B.mass[i] / obs::sphere_volume(B.radius[i]); },
+                              "spheres",
+                              "kg/m^3"};
+  continuation::check_density(grains, s.density);
+  continuation::check_mean_diameter(grains, w.params().d_ref);
   CellState3 c = w.cell();
   const bool sheared = c.strain != 0.0;
   if (!sheared) {
     c.le_offset = 0.0;
     c.rate = Vec3::Zero();
   }
+  if (imposed_pressure(s) <= 0) c.rate = Vec3::Zero();  // volume control: the lengths stay
+  if (s.volume_fraction > 0) {
+    double volume = 0;
+    for (std::size_t i = 0; i < B.size(); ++i) volume += obs::sphere_volume(B.radius[i]);
+    const double f = continuation::volume_scale(volume, c.size.prod(), s.volume_fraction, 3);
+    const Vec3 o = w.params().cell_origin;
+    for (Vec3& x : B.pos) x = o + f * (x - o);
+    c.size *= f;
+    c.le_offset *= f;
+  }
   c.strain = 0.0;
   w.set_cell(c);
   w.steps = 0;
   w.time = 0.0;
   w.times = StageTimes{};
-  double a = 0, g = 0;  // the sample's mean flow v_x = a + g y
-  if (sheared) {
-    double sy = 0, sv = 0, syy = 0, syv = 0, m = 0;
-    for (std::size_t i = 0; i < B.size(); ++i) {
-      const double y = B.pos[i].y(), v = B.vel[i].v.x();
-      sy += y, sv += v, syy += y * y, syv += y * v, m += 1;
-    }
-    const double den = m * syy - sy * sy;
-    g = den > 0 ? (m * syv - sy * sv) / den : 0.0;
-    a = m > 0 ? (sv - g * sy) / m : 0.0;
-  }
   const WorldParams3& q = w.params();
-  const double y0 = q.cell_origin.y() + 0.5 * c.size.y();
-  for (std::size_t i = 0; i < B.size(); ++i) {
-    const double y = B.pos[i].y();
-    if (sheared) B.vel[i].v.x() -= a + g * y;
-    B.vel[i].v.x() += q.shear_rate * (y - y0);
+  continuation::set_flow(grains, sheared, q.shear_rate, q.cell_origin.y() + 0.5 * c.size.y());
+}
+
+// A started sample comes from a simulation, with its solver-sized
+// overlaps (2D's rule): up to kStartOverlap d of any pair, through the
+// cell's images too; more means another cell than the grains' (a damaged
+// sample, or shear.volume_fraction compressing it too far).
+void check_start_overlaps3(const Scene& s, const World3& w) {
+  constexpr double kStartOverlap = 0.05;
+  const CellState3& c = w.cell();
+  PeriodicCell3 cell;
+  cell.origin = w.params().cell_origin;
+  cell.size = c.size;
+  cell.periodic = {true, true, true};
+  cell.le_offset = c.le_offset;
+  CellGrid3 grid;
+  std::vector<SphereRow> rows;
+  std::vector<ContactInfo3> info;
+  try {
+    detect3(w.bodies, w.bodies.pos, 0.0, cell, grid, rows, info, w.params().solver.min_parallel);
+  } catch (const std::exception& e) {
+    throw SceneError(fmt::format("shear.start: '{}': {}", s.start, e.what()));
   }
+  const double d = w.params().d_ref;
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    if (info[k].gap < -kStartOverlap * d)
+      throw SceneError(fmt::format("shear.start: spheres {} and {} of '{}' overlap by {:.3g} mean diameters{}; a "
+                                   "started sample may overlap by at most {}",
+                                   rows[k].b1, rows[k].b2, s.start, -info[k].gap / d,
+                                   s.volume_fraction > 0
+                                       ? fmt::format(" once scaled to shear.volume_fraction = {}", s.volume_fraction)
+                                       : std::string(),
+                                   kStartOverlap));
 }
 
 }  // namespace
@@ -293,6 +275,7 @@ World3 build_cell3(const Scene& s0) {
     p.cell = Vec3::Ones();  // a placeholder: the sample's cell replaces it
     World3 w(p);
     load_start3(s, w);
+    check_start_overlaps3(s, w);
     set_cell_mass3(s, w);
     return w;
   }

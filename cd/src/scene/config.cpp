@@ -3,6 +3,7 @@
 // resolved scene.toml and the Markdown table are all generated from them.
 // Defaults are never written here: they are the initialisers in scene.hpp.
 #include "config.hpp"
+#include "protocol.hpp"
 
 #include <algorithm>
 #include <array>
@@ -109,7 +110,7 @@ Rule disk_density() {
 template <class T>
 using Field = std::variant<double T::*, int T::*, unsigned T::*, bool T::*, std::string T::*,
                            std::array<double, 2> T::*, std::vector<double> T::*, ShearMode T::*,
-                           SizeDist T::*>;
+                           ShearControl T::*, SizeDist T::*>;
 
 template <class T>
 struct Param {
@@ -174,7 +175,10 @@ const std::vector<Param<Scene>>& scene_params() {
       {"shear", "width", &Scene::cell_width, "m", ge(0), "cell width (period in x)"},
       {"shear", "height", &Scene::cell_height, "m", ge(0), "initial cell height (periodic) or gap between the wall grains' centres (walls)"},
       {"shear", "depth", &Scene::cell_depth, "m", ge(0), "3D only: the periodic cell's length along z (vorticity direction; width along x is the shear direction, height along y the gradient); width, height and depth all 0: the cube that holds the generated spheres on a loose lattice"},
-      {"shear", "pressure", &Scene::pressure, "N/m", ge(0), "imposed normal stress sigma_yy (2D: force per length, N/m; 3D: force per area, N/m^2)"},
+      {"shear", "control", &Scene::shear_control, "", one_of<ShearControl>(), "what the periodic cell imposes besides the shear: pressure (its height, with shear.isotropic every length, a degree of freedom at sigma = shear.pressure; shear rate from shear.inertial_number) or volume (its lengths fixed: the shear.start sample's, or shear.width and shear.height (3D: and shear.depth); shear rate shear.rate; the pressure and I are measured, and shear.pressure, if > 0, is only the scale p of t_p = d sqrt(rho/p) for shear.dt_tp, the \"auto\" settings (at I = shear.rate t_p) and the cohesion and stiffness numbers)"},
+      {"shear", "pressure", &Scene::pressure, "N/m", ge(0), "imposed normal stress sigma_yy (2D: force per length, N/m; 3D: force per area, N/m^2); shear.control = \"volume\": the pressure scale of t_p, not imposed"},
+      {"shear", "volume_fraction", &Scene::volume_fraction, "", in(0, 1), "shear.control = \"volume\" from a sample (shear.start): its cell, positions and Lees-Edwards offset scaled about the cell's origin, the same factor on every axis, so that the grains fill this fraction of it (a compression is refused if it overlaps grains by more than the start check's 0.05 d); the grains keep their sizes, orientations and velocities; 0: the sample's cell as it is"},
+      {"shear", "rate", &Scene::imposed_rate, "1/s", ge(0), "shear.control = \"volume\": the imposed shear rate gamma-dot (the inertial number is then measured: the series' inertial_number column); 0: no shear"},
       {"shear", "inertial_number", &Scene::inertial_number, "", ge(0), "imposed inertial number I: shear rate = I sqrt(p/rho)/d (walls: top wall speed = shear rate x current gap); 0: no shear"},
       {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width; 3D: and depth) degree of freedom, in units of the particles' total mass; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"shear", "isotropic", &Scene::isotropic, "", any(), "compaction: the width (3D: and the depth) is a degree of freedom too, at sigma_xx (= sigma_zz) = pressure (periodic, inertial_number = 0)"},
@@ -528,17 +532,25 @@ Scene read_scene(const toml::value& root, const std::string& path) {
   for (const bool acceleration : {true, false})
     for (const auto& [a, at] : out.autos) {
       if (a->acceleration() != acceleration) continue;
-      if (!(s.inertial_number > 0)) {
+      // Under volume control, the nominal I of shear.rate at the pressure
+      // scale (scene/protocol.hpp).
+      const double I = nominal_inertial_number(s);
+      if (!(I > 0)) {
         out.add(at, a->key.substr(a->key.find('.') + 1),
-                fmt::format("{} = \"auto\" is set by shear.inertial_number (docs/shear.md, \"Settings "
-                            "by I\"), which is {}: give shear.inertial_number > 0 or a number",
-                            a->key, text(s.inertial_number, false)));
+                s.shear_control == ShearControl::Volume
+                    ? fmt::format("{} = \"auto\" is set by the nominal inertial number shear.rate x t_p "
+                                  "(docs/shear.md, \"Settings by I\"), which is {}: give shear.rate > 0 and "
+                                  "shear.pressure > 0 (the pressure scale of t_p), or a number",
+                                  a->key, text(I, false))
+                    : fmt::format("{} = \"auto\" is set by shear.inertial_number (docs/shear.md, \"Settings "
+                                  "by I\"), which is {}: give shear.inertial_number > 0 or a number",
+                                  a->key, text(s.inertial_number, false)));
         continue;
       }
       const Acceleration acc = s.subspace > 0  ? Acceleration::Subspace
                                : s.anderson > 0 ? Acceleration::Anderson
                                                 : Acceleration::None;
-      const ShearSettings set = shear_settings(s.inertial_number, acc, kind);
+      const ShearSettings set = shear_settings(I, acc, kind);
       std::visit([&](const auto& f) { s.*f.member = set.*f.value; }, a->field);
     }
   out.throw_if_any();
@@ -668,6 +680,7 @@ void apply_override(toml::value& root, const std::string& set) {
     // "auto" key, the word auto.
     const bool word = std::holds_alternative<std::string Scene::*>(p->field) ||
                       std::holds_alternative<ShearMode Scene::*>(p->field) ||
+                      std::holds_alternative<ShearControl Scene::*>(p->field) ||
                       std::holds_alternative<SizeDist Scene::*>(p->field) ||
                       (value == "auto" && auto_key(key));
     if (!word)

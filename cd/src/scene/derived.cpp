@@ -87,6 +87,7 @@ double pressure_time(const Scene& s) {
 }
 
 double shear_rate(const Scene& s) {
+  if (s.shear_control == ShearControl::Volume) return s.imposed_rate;
   const double tp = pressure_time(s);
   return tp > 0 ? s.inertial_number / tp : 0.0;
 }

@@ -37,8 +37,10 @@ std::pair<double, double> diameter_bounds(const Scene& s);
 // Diameters of the n generated particles (deterministic for a seed).
 std::vector<double> generated_diameters(const Scene& s);
 
-// Shear protocols: the imposed shear rate gamma-dot = I sqrt(p/rho)/d, the
-// pressure time t_p = d sqrt(rho/p); 0 when the scene imposes no pressure.
+// Shear protocols: the imposed shear rate gamma-dot = I sqrt(p/rho)/d at
+// imposed pressure, shear.rate at imposed volume (scene/protocol.hpp); the
+// pressure time t_p = d sqrt(rho/p) at shear.pressure (imposed, or the
+// scale of a volume-controlled run); 0 without a pressure.
 double shear_rate(const Scene& s);
 double pressure_time(const Scene& s);
 // The pull-off force f_a of the adhesion law: contact.adhesion, or from

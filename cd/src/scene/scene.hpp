@@ -19,6 +19,13 @@ namespace cd {
 enum class ShearMode { None, Periodic, Walls };
 inline constexpr std::array<std::string_view, 3> kShearModeNames = {"none", "periodic", "walls"};
 
+// shear.control: what a shear protocol imposes besides the shear
+// (scene/protocol.hpp): the normal stress (the cell's height a dof at
+// shear.pressure, the rate from shear.inertial_number) or the volume (the
+// cell's lengths fixed, the rate shear.rate).
+enum class ShearControl { Pressure, Volume };
+inline constexpr std::array<std::string_view, 2> kShearControlNames = {"pressure", "volume"};
+
 // particles.size_dist: the size law of the generated particles.
 enum class SizeDist { Uniform, UniformArea };
 inline constexpr std::array<std::string_view, 2> kSizeDistNames = {"uniform", "uniform_area"};
@@ -27,6 +34,7 @@ inline constexpr std::array<std::string_view, 2> kSizeDistNames = {"uniform", "u
 // through this overload; a new enum adds its names here and its member type
 // to config.cpp's Field), and the name of one value, for messages.
 constexpr const auto& enum_names(ShearMode) { return kShearModeNames; }
+constexpr const auto& enum_names(ShearControl) { return kShearControlNames; }
 constexpr const auto& enum_names(SizeDist) { return kSizeDistNames; }
 template <class E>
 constexpr std::string_view name_of(E e) { return enum_names(e)[static_cast<std::size_t>(e)]; }
@@ -127,7 +135,10 @@ struct Scene {
   double cell_width = 0.0;          // cell width (m)
   double cell_height = 0.0;         // initial cell height / wall gap (m)
   double cell_depth = 0.0;          // 3D periodic cell: its length along z (m)
-  double pressure = 0.0;            // imposed normal stress (N/m)
+  ShearControl shear_control = ShearControl::Pressure;
+  double pressure = 0.0;            // imposed normal stress (N/m); volume control: the scale of t_p
+  double imposed_rate = 0.0;        // shear.rate: the shear rate under volume control (1/s)
+  double volume_fraction = 0.0;     // volume control from a sample: scaled to this packing fraction; 0: as is
   double inertial_number = 0.0;     // imposed I: gamma-dot = I sqrt(p/rho) / d
   double cell_mass = 0.1;           // mass of the height (width) dof, in total particle mass
   bool isotropic = false;           // compaction: the width is a dof too (periodic, I = 0)
