@@ -70,7 +70,7 @@ help:
 	@echo "  make campaign-pressure          steady shear at PRESSURE_I under each p of PRESSURE_P"
 	@echo "  make campaign-pressure-ladder   the same from the lowest p up, each from the point below"
 	@echo "  make validate-angularity        the polygon study's shapes at VAL_I in the bi-periodic cell into VALIDATE"
-	@echo "                                  (N = VAL_N, size ratio 4; hours a shape; docs/validation.md)"
+	@echo "                                  (N = VAL_N, size ratio 4; hours a shape; docs/shear.md, Campaigns)"
 	@echo "  make campaign-status [CAMPAIGN=inertial]  each run: done / running / not started / failed / stopped,"
 	@echo "                       its progress, cost (CPU, steps) and ETA (every campaign in CAMPAIGNS unless CAMPAIGN)"
 	@echo "  (each campaign folder's manifest.toml holds what made it: make refuses to add runs made with another"
@@ -324,7 +324,7 @@ ANGULAR_I ?= 0.01
 # Threads of each cdsim run: `make -jJ` runs J at once, so each gets nproc/J
 # threads (at least 1; plain -j: 1); THREADS=n overrides. More threads than
 # free cores make the solver's spinning barriers slow every run many-fold
-# (28x measured: docs/accuracy.md, Performance); results do not depend on it.
+# (28x measured: docs/accuracy.md, "Performance of a step"); results do not depend on it.
 NPROC := $(shell nproc)
 run_jobs = $(if $(filter -j,$(MAKEFLAGS)),$(NPROC),$(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),1))
 run_threads = $(or $(THREADS),$(shell echo $$(( $(NPROC) / $(run_jobs) > 1 ? $(NPROC) / $(run_jobs) : 1 ))))
@@ -520,7 +520,7 @@ $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done | $(CAMPAIGNS)/
 	$(call shear_run,$(ANGULAR_I),$*)
 	touch $@
 
-# ---- Validation: the angularity study (docs/validation.md) -----------------
+# ---- Validation: the angularity study -----------------------------------------
 # The polygon study of Azema, Estrada & Radjai (PRE 86, 041301, 2012):
 # regular polygons of VAL_NS sides and disks (0), circumscribed diameters
 # d_max/d_min = 4 with equal area per size class, mu_p = 0.4, e = 0, sheared
@@ -530,7 +530,7 @@ $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done | $(CAMPAIGNS)/
 # campaign (make -j, checkpoints, manifests, campaign-status with
 # CAMPAIGNS=$(VALIDATE)). N = 1000: the smallest N the study's fits are
 # read at, and what one 2-core machine shears to strain 3 at I = 1e-3 in a
-# few CPU hours a shape (docs/validation.md).
+# few CPU hours a shape.
 VALIDATE ?= outputs/validation
 VAL_N ?= 1000
 VAL_NS ?= 0 6 3 4 5 7 8 10 12 20 60
@@ -542,7 +542,7 @@ val_vars = CAMPAIGNS=$(VALIDATE) DIM=2 N=$(VAL_N) SIZE_RATIO=4 SIZE_DIST=uniform
 validate-angularity: programs
 	+$(MAKE) --no-print-directory $(val_vars) campaign-angularity
 
-# ---- Frozen dense-shear problems (issue 14, item 2; tests/data/frozen-shear) --
+# ---- Frozen dense-shear problems (tests/data/frozen-shear) -------------------
 # Steady bi-periodic shear of N disks (ns_0) and hexagons (ns_6) at p = P,
 # the campaign protocol (prep, then shear at imposed p and I), and the contact
 # problems of a few steps dumped with --dump-problem (.cdp: exact replay by
@@ -592,7 +592,7 @@ $(CAMPAIGNS)/frozen/ns_%/I_0.001/.done: $(CAMPAIGNS)/prep/ns_%/.done
 	$(call frozen_run,0.001,$(FS_QS_STRAIN),$(CAMPAIGNS)/prep/ns_$*/checkpoint.bin)
 	touch $@
 
-# ---- A frozen 3D dense-shear step (issue 30; tests/data/frozen-shear3) ------
+# ---- A frozen 3D dense-shear step (tests/data/frozen-shear3) -----------------
 # FS3_N spheres compacted by the 3D campaign's preparation (configs/
 # shear3-prep.toml at p = 1e5 N/m^2, until jammed), then sheared at I = 1e-2
 # under cdsim's own policy for that I (solver.tol 1e-3, dt 0.05 t_p: the
@@ -611,7 +611,7 @@ $(CAMPAIGNS)/frozen3/I_0.01/.done: $(CAMPAIGNS)/prep/ns_0/.done
 	  --set solver.subspace=0 --dump-problem $(call fs_steps,0.01,$(FS3_STRAIN))
 	touch $@
 
-# ---- Accuracy against cost in steady shear (issue 14, item 1) ----------------
+# ---- Accuracy against cost in steady shear -----------------------------------
 # The campaign protocol (one compacted sample per shape, then shear at imposed
 # p and I) run under several solver settings from the same sample, and a
 # table of what each setting gives (steady mu* = q/p, packing fraction, z,
@@ -658,7 +658,7 @@ $(ACC)/ns_$(1)/I_$(2)/$(3)/.done: $(ACC)/prep/ns_$(1)/.done
 endef
 $(foreach s,$(ACC_SHAPES),$(foreach i,$(ACC_I),$(foreach k,$(acc_settings),$(eval $(call acc_rule,$(s),$(i),$(k))))))
 
-# ---- Three samples against a tight reference, 3D (issue 30, target 4) ------
+# ---- Three samples against a tight reference, 3D ----------------------------
 # make accuracy-shear3 [A3_SEEDS="11 12 13"] [A3_I=0.01] [A3_SETTINGS=...] [A3_STRAIN=1]
 # For each seed: a sample of A3_N spheres (configs/shear3-prep.toml,
 # particles.seed), sheared at I = 0.01 at the policy's settings to
@@ -679,11 +679,10 @@ a3_set_mid    := --set solver.tol=2e-3 --set solver.subspace=0 --set solver.ande
 a3_set_fast   := --set solver.tol=3e-3 --set solver.subspace=0 --set solver.anderson=5 --set contact.overlap_projection=0.5
 a3_set_anderson1e-3 := --set solver.tol=1e-3 --set solver.subspace=0 --set solver.anderson=5 --set contact.overlap_projection=0.5 --set solver.max_iter=600
 # ref is plain NLGS; policy is the 3D scene's own (the subspace correction
-# at the policy's tol_subspace), plain the same policy without it (the
-# policy before the sixth session), anderson the sixth session's (Anderson's
-# mixing at tol_anderson). 1000 spheres, 3 seeds, I = 0.01, the five
-# settings: ~2 CPU hours, most of it the reference's (docs/accuracy.md,
-# "Three samples").
+# at the band's subspace stop), plain the same policy without it, anderson
+# Anderson's mixing at the band's Anderson stop. 1000 spheres, 3 seeds,
+# I = 0.01, the five settings: ~2 CPU hours, most of it the reference's
+# (docs/accuracy.md, "1000 spheres (make accuracy-shear3)").
 A3_N ?= 1000
 A3_SEEDS ?= 11 12 13
 A3_I ?= 0.01
@@ -795,9 +794,9 @@ mutants: deps
 clean:
 	rm -rf $(BUILD)
 
-# ---- Dense shear side by side with LIGGGHTS (issue 30; docs/accuracy.md) -----
+# ---- Dense shear side by side with LIGGGHTS (docs/accuracy.md) ---------------
 # make compare-liggghts-shear [QUICK=1] [CMP_STRAIN=2] [CMP_I=0.01] [SHEAR_TOL=...] [SHEAR_SET=...]
-# One 1000-grain mu(I) point by both codes in one sitting, one thread each:
+# One 1000-grain mu(I) point by both codes side by side, one thread each:
 # LIGGGHTS 3.8 (Debian's, installed here if missing) shearing 1000 spheres
 # between rough walls at imposed p, E/p = 1e5 (cd/bench/peers/liggghts-shear/),
 # and cdsim's 3D campaign point (make campaign-inertial DIM=3 N=1000: the

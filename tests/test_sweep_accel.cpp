@@ -247,7 +247,7 @@ std::pair<SolveStats, std::vector<Vec3>> solve_with(const ContactProblem3& q, co
 // the sweep count and every impulse are those of the exact sum taken on
 // every sweep, bit for bit, through a slow plain tail (tol 1e-5), Anderson's
 // mixing and the subspace correction (each resets the bound).
-TEST(SweepStop, TheLazyNormStopsWhereTheExactOneDoes) {
+TEST(SweepStop, TheBoundedNormStopsWhereTheExactOneDoes) {
   World3 w = sheared();
   ContactProblem3 frozen;
   w.set_problem_hook([&](const ContactProblem3& p, const SolverParams&) { frozen = p; });

@@ -111,7 +111,7 @@ std::vector<int> parse_caps(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Where the sweeps of a 3D dense-shear step go (issue 30)"};
+  CLI::App app{"Where the sweeps of a 3D dense-shear step go"};
   std::string scene_path, out = "outputs/shear3-sweeps", caps_s = "1,2,5,10,20,50,100,200,300,500,700,1000,1500,2000,3000,5000,10000";
   std::vector<std::string> sets;
   int warm = 20, samples = 3, every = 20, anderson = 0;

@@ -1,6 +1,6 @@
 // solvers3: accelerations of the 3D sweep on a frozen step, by
 // what they do to the loaded-contact set, the figure whose slow convergence
-// biases z in dense shear (docs/accuracy.md, "Why z moves"). A .cdp3 step
+// biases z in dense shear (docs/accuracy.md, "What z measures"). A .cdp3 step
 // (cdsim --dump-problem) is put in matrix form (to_matrix: W = H^T M^-1 H
 // with the cell dofs condensed, q, mu) and solved from its warm start by:
 //   gs        symmetric Gauss-Seidel in row order with the exact local solve
@@ -236,7 +236,7 @@ void set(std::vector<Vec3>& r, const Eigen::VectorXd& x) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Accelerations of the 3D sweep on a frozen step: the loaded-contact set (issue 30)"};
+  CLI::App app{"Accelerations of the 3D sweep on a frozen step: the loaded-contact set"};
   std::string file, methods_s = "gs,nncg,anderson:5", csv;
   int pairs = 1000, every = 5, ref_sweeps = 20000;
   double ref_residual = 1e-7;

@@ -524,7 +524,7 @@ Dyn run_dynamic(const cd::World& w0, const std::string& v, int steps) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"ss_pair: side-side contacts as one block in the NLGS (issue 3, item 3)"};
+  CLI::App app{"ss_pair: side-side contacts as one block in the NLGS"};
   std::string out_dir = "outputs/ss-pair";
   int n = 1000, steps = 200, repeat = 3, max_iter = 20000, checks = 200000, flow_steps = 150;
   double tilt = 40.0;

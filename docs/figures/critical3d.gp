@@ -1,4 +1,4 @@
-# The 3D critical states of the README (issue 13): mu(I) and phi(I) of the
+# The 3D critical states of the README: mu(I) and phi(I) of the
 # 1000-sphere inertial ladder with the fits and their 1-sigma bands, beside
 # the law of Jop, Forterre & Pouliquen, Nature 441, 727 (2006) for glass
 # beads (mu1 = tan 20.9 deg, mu2 = tan 32.76 deg, I0 = 0.279). From the

@@ -1,4 +1,4 @@
-# The solver comparison of docs/accuracy.md (issue 14): law residual against
+# The solver comparison of docs/accuracy.md: law residual against
 # time for each method on the four frozen dense-shear steps of
 # tests/data/frozen-shear, from the history.csv that cd/bench/solvers writes:
 #   for f in tests/data/frozen-shear/*.cdp.gz; do gunzip -c $f > /tmp/fz/$(basename $f .gz); done

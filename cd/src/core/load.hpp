@@ -32,7 +32,7 @@ inline std::string oversubscription_warning(int threads, double load1, int cores
   return fmt::format(
       "the machine is loaded (1-min load average {:.2f} on {} cores) and this run uses {} "
       "threads: threads spinning at the solver's barriers can slow it many-fold. Use "
-      "--threads 1 (or OMP_NUM_THREADS=1), or OMP_WAIT_POLICY=passive (docs/accuracy.md, Performance)",
+      "--threads 1 (or OMP_NUM_THREADS=1), or OMP_WAIT_POLICY=passive (docs/accuracy.md, \"Performance of a step\")",
       load1, cores, threads);
 }
 

@@ -1,6 +1,6 @@
 // The stage table of a time step: names, order and wall-clock timers. The
 // step of either engine (2D and 3D) runs these stages; their names are the
-// series columns t_<name> and the checkpoint's record of the timers.
+// columns of the run's timings.csv and the checkpoint's record of the timers.
 #pragma once
 #include <array>
 #include <chrono>
@@ -12,7 +12,7 @@
 namespace cd {
 
 // The stages of a step, in the order they run, and `output` (timed by the
-// run loop). Their names are the series columns t_<name> and the
+// run loop). Their names are the columns of timings.csv and the
 // checkpoint's record of the timers.
 enum class Stage : int { Predict, Detect, Build, Colour, Solve, Integrate, Observe, Output };
 inline constexpr int kStages = 8;
