@@ -306,11 +306,10 @@ prep-overlap: build
 # run's state, cost and ETA (cd/campaign/status.sh).
 N        ?= 200
 STRAIN   ?= 2
-# The imposed pressure and the grains' density: 2D per length and per area
-# (N/m, kg/m^2), 3D per area and per volume (N/m^2, kg/m^3); the 3D values
-# are 2D's read as a 1 mm thick layer, so t_p = d sqrt(rho/p) is the same.
+# The imposed pressure: 2D per length (N/m), 3D per area (N/m^2); the 3D
+# value is 2D's read as a 1 mm thick layer, and so are the scenes'
+# densities, so t_p = d sqrt(rho/p) is the same.
 P        ?= $(if $(dim3),1e5,100)
-RHO      := $(if $(dim3),2600,2.6)
 PREP_SCENE  := configs/shear$(if $(dim3),3)-prep.toml
 SHEAR_SCENE := configs/shear$(if $(dim3),3)-inertial.toml
 INERTIAL_I ?= 0.001 0.003 0.01 0.03 0.1 0.3
@@ -343,11 +342,11 @@ SIZE_DIST  ?= uniform_area
 # will use, as its scene.toml will say: $(1) I, $(2) the key (e.g. dt_tp).
 resolved = $(shell $(BUILD)/cd/cdsim $(SHEAR_SCENE) --set shear.inertial_number=$(1) --print-scene \
   | awk '$$1 == "$(2)" { print $$3; exit }')
-# 100 series rows per unit strain: 0.01 / shear rate = 0.01 t_p / I.
-# (A second argument, when given, is the pressure instead of P.)
-series_dt = $(shell awk 'BEGIN { printf "%.6g", 0.01e-3 * sqrt($(RHO) / $(or $(2),$(P))) / $(1) }')
-# A contact snapshot every 0.2 strain (fabric, cdanalysis fabric / report).
-snapshot_dt = $(shell awk 'BEGIN { printf "%.6g", 0.2e-3 * sqrt($(RHO) / $(or $(2),$(P))) / $(1) }')
+# 100 series rows per unit strain, and a contact snapshot every 0.2 strain
+# (fabric: cdanalysis fabric / report), by strain: cdsim turns them into
+# steps at the run's own rate.
+SERIES_BY_STRAIN = --set output.series_strain=0.01
+SNAPSHOTS_BY_STRAIN = --set output.snapshot_strain=0.2
 # Checkpoints every CKPT_STRAIN of shear strain and at most every CKPT_WALL
 # seconds of wall clock (at the next series row), so that a kill loses little
 # (docs/shear.md). Preparations have no strain: the wall clock alone.
@@ -453,7 +452,7 @@ shear_solver = $(if $(SHEAR_TOL),--set solver.tol=$(SHEAR_TOL) --set solver.resi
 shear_cmd = $(CDSIM) $(SHEAR_SCENE) --out $(@D) $(CAMPAIGN_SET) $(shear_solver) \
 	  --set shear.start='"$(2)/checkpoint.bin"' --set shear.pressure=$(3) \
 	  --set shear.inertial_number=$(1) --set shear.strain=$(4) \
-	  --set output.series_interval=$(call series_dt,$(1),$(3)) --set output.snapshot_interval=$(call snapshot_dt,$(1),$(3)) \
+	  $(SERIES_BY_STRAIN) $(SNAPSHOTS_BY_STRAIN) \
 	  $(SHEAR_SET)
 # SHEAR_SET: more --set options for every shear run (e.g. --set solver.anderson=5).
 SHEAR_SET ?=
@@ -581,7 +580,7 @@ fs_steps = $(shell awk 'BEGIN { printf "%d", $(2) / ($(1) * $(call resolved,$(1)
 frozen_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --fresh \
 	  --set shear.start='"$(3)"' --set shear.pressure=$(P) --set particles.nsides=[$*] \
 	  --set shear.inertial_number=$(1) --set shear.strain=$(2) --set solver.tol=1e-4 --set solver.residual_tol=0 \
-	  --set solver.anderson=0 --set output.series_interval=$(call series_dt,$(1)) --set output.snapshot_interval=0 \
+	  --set solver.anderson=0 $(SERIES_BY_STRAIN) --set output.snapshot_interval=0 \
 	  --dump-problem $(shell echo $$(( $(call fs_steps,$(1),$(2)) - $(FS_GAP) ))) \
 	  --dump-problem $(call fs_steps,$(1),$(2))
 .PRECIOUS: $(CAMPAIGNS)/frozen/ns_%/I_0.01/.done
@@ -607,7 +606,7 @@ frozen-shear3:
 	@ls -l $(FROZEN)/3d/N_$(FS3_N)/frozen3/I_0.01/problem_*.cdp3
 frozen-shear3-run: $(CAMPAIGNS)/frozen3/I_0.01/.done
 $(CAMPAIGNS)/frozen3/I_0.01/.done: $(CAMPAIGNS)/prep/ns_0/.done
-	$(call shear_cmd,0.01,$(CAMPAIGNS)/prep/ns_0,$(P),$(FS3_STRAIN)) --fresh --set output.snapshot_interval=0 \
+	$(call shear_cmd,0.01,$(CAMPAIGNS)/prep/ns_0,$(P),$(FS3_STRAIN)) --fresh --set output.snapshot_strain=0 --set output.snapshot_interval=0 \
 	  --set solver.subspace=0 --dump-problem $(call fs_steps,0.01,$(FS3_STRAIN))
 	touch $@
 
@@ -691,10 +690,10 @@ A3_START ?= 0.5
 A3_STRAIN ?= 1
 A3_W0 ?= 0.1
 A3_DIR ?= outputs/accuracy-shear3/N_$(A3_N)
-a3_tp := $(shell awk 'BEGIN { printf "%.6g", 1e-3 * sqrt(2600 / 1e5) }')
 a3_cmd = OMP_NUM_THREADS=1 $(BUILD)/cd/cdsim $(1) --out $(@D) --fresh --set output.quiet=true --set output.snapshot_interval=0
+# A series row every t_p: strain I ($(2)) at the run's I.
 a3_shear = $(call a3_cmd,configs/shear3-inertial.toml) --set shear.start='"$(1)/checkpoint.bin"' --set shear.pressure=1e5 \
-  --set output.series_interval=$(a3_tp)
+  --set output.series_strain=$(2) --set shear.inertial_number=$(2)
 .PHONY: accuracy-shear3 accuracy-shear3-runs
 accuracy-shear3: programs
 	$(MAKE) --no-print-directory accuracy-shear3-runs
@@ -707,12 +706,12 @@ $(A3_DIR)/prep/s%/.done:
 	touch $@
 $(A3_DIR)/start/s%/.done: $(A3_DIR)/prep/s%/.done
 	rm -rf $(@D)
-	$(call a3_shear,$(A3_DIR)/prep/s$*) --set shear.inertial_number=0.01 --set shear.strain=$(A3_START)
+	$(call a3_shear,$(A3_DIR)/prep/s$*,0.01) --set shear.strain=$(A3_START)
 	touch $@
 define a3_rule
 $(A3_DIR)/I_$(A3_I)/s$(1)/$(2)/.done: $(A3_DIR)/start/s$(1)/.done
 	rm -rf $$(@D)
-	$$(call a3_shear,$(A3_DIR)/start/s$(1)) --set shear.inertial_number=$(A3_I) --set shear.strain=$(A3_STRAIN) $$(a3_set_$(2))
+	$$(call a3_shear,$(A3_DIR)/start/s$(1),$(A3_I)) --set shear.strain=$(A3_STRAIN) $$(a3_set_$(2))
 	touch $$@
 endef
 $(foreach s,$(A3_SEEDS),$(foreach k,$(A3_SETTINGS),$(eval $(call a3_rule,$(s),$(k)))))

@@ -37,7 +37,7 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 void compare(const Scene& x, const Scene& y, bool same) {
   const auto& [name, source, dimension, dt, duration, gravity, mu, mu_wall, mu_b, mu_wall_b, axis_a, e_n, e_t, alert, rotation, overlap_correction, overlap_projection, adhesion, stiffness, debond, tol,
                max_iter, residual_tol, anderson, subspace, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
-               box_width, box_height, box_depth, disks, walls, series_interval, snapshot_interval,
+               box_width, box_height, box_depth, disks, walls, series_interval, snapshot_interval, series_strain, snapshot_strain,
                checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, cell_depth, shear_control, pressure,
                imposed_rate, volume_fraction, inertial_number, cell_mass, isotropic, compaction_rate, settle_stress, settle_phi, settle_time, strain, dt_tp, start, cohesion_number, stiffness_number, stiffness_ratio] = x;
   (void)source;  // not a parameter: the file the scene was read from
@@ -48,6 +48,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(region); CHECK_FIELD(box_width);
   CHECK_FIELD(box_height); CHECK_FIELD(box_depth); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
+  CHECK_FIELD(series_strain); CHECK_FIELD(snapshot_strain);
   CHECK_FIELD(checkpoint_interval); CHECK_FIELD(checkpoint_strain); CHECK_FIELD(checkpoint_wall);
   CHECK_FIELD(quiet);
   CHECK_FIELD(shear_mode); CHECK_FIELD(cell_width); CHECK_FIELD(cell_height); CHECK_FIELD(cell_depth); CHECK_FIELD(shear_control); CHECK_FIELD(pressure);
@@ -108,6 +109,8 @@ Scene nondefault() {
   s.box_depth = 0.3;
   s.series_interval = 1e-3;
   s.snapshot_interval = 0.0;
+  s.series_strain = 0.02;
+  s.snapshot_strain = 0.3;
   s.checkpoint_interval = 0.05;
   s.checkpoint_strain = 0.1;
   s.checkpoint_wall = 300.5;
@@ -396,9 +399,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 65 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 67 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 65u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 67u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

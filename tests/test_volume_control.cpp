@@ -23,6 +23,7 @@
 #include "cli_util.hpp"
 #include "config.hpp"
 #include "observables.hpp"
+#include "run_plan.hpp"
 #include "setup.hpp"
 #include "setup3.hpp"
 #include "shear3_util.hpp"
@@ -274,6 +275,46 @@ TEST(VolumeControl, KeysOfTheOtherControlAreRefusedByName) {
   const cd::Scene s = cd::parse_scene(text(v + "rate = 100.0\npressure = 100.0\n", 2, "[solver]\ntol = \"auto\"\n"), "a.toml");
   const double tp = 1e-3 * std::sqrt(2.6 / 100.0);
   EXPECT_EQ(s.tol, cd::shear_settings(100.0 * tp, cd::Acceleration::None, {2, false, false}).tol);
+}
+
+// Rows and snapshots by strain (output.series_strain, snapshot_strain): so
+// many steps as the strain takes at the run's own rate, whatever sets it
+// (I and p, or shear.rate), instead of the intervals in seconds; refused
+// without a rate.
+TEST(VolumeControl, RowsAndSnapshotsByStrainFollowTheRate) {
+  cd::Scene s = disks();
+  s.cell_width = s.cell_height = 0.02;
+  s.n = 50;
+  s.inertial_number = 0.01;
+  s.dt_tp = 0.05;
+  s.strain = 1;
+  s.series_interval = 1.0;  // overridden
+  s.series_strain = 0.01;
+  s.snapshot_strain = 0.2;
+  const double dt = cd::time_step(s);
+  cd::RunPlan plan = cd::plan_of(s, dt);
+  // strain per step I dt / t_p = 5e-4: 20 steps a row, 400 a snapshot.
+  EXPECT_EQ(plan.every_row, 20);
+  EXPECT_EQ(plan.every_snap, 400);
+  EXPECT_EQ(plan.nsteps, 2000);
+  cd::Scene v = s;
+  v.inertial_number = 0;
+  v.shear_control = cd::ShearControl::Volume;
+  v.imposed_rate = 50.0;  // 1/s: strain 5e-4 a step at dt = 1e-5 s
+  v.dt_tp = 0;
+  v.dt = 1e-5;
+  plan = cd::plan_of(v, v.dt);
+  EXPECT_EQ(plan.every_row, 20);
+  EXPECT_EQ(plan.every_snap, 400);
+  cd::Scene r = s;
+  r.inertial_number = 0;
+  r.strain = 0;
+  EXPECT_THROW(cd::world_params(r), cd::SceneError);
+  try {
+    cd::world_params(r);
+  } catch (const cd::SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("output.series_strain"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -22,8 +22,13 @@ RunPlan plan_of(const Scene& s, double dt) {
     return k >= double(nsteps) ? std::max<std::int64_t>(1, nsteps)
                                : std::max<std::int64_t>(1, std::llround(k));
   };
-  p.every_row = steps_of(s.series_interval);
-  p.every_snap = s.snapshot_interval > 0 ? steps_of(s.snapshot_interval) : 0;
+  // Rows and snapshots by simulated time, or by shear strain (the strain
+  // keys need a rate: scene/protocol.cpp).
+  const double rate = shear_rate(s);
+  p.every_row = steps_of(s.series_strain > 0 && rate > 0 ? s.series_strain / rate : s.series_interval);
+  p.every_snap = s.snapshot_strain > 0 && rate > 0 ? steps_of(s.snapshot_strain / rate)
+                 : s.snapshot_interval > 0        ? steps_of(s.snapshot_interval)
+                                                  : 0;
   // Checkpoints fall on series rows, so that no row's interval spans a
   // restart: every so much simulated time, or shear strain, rounded up to
   // whole rows; or at the first row after checkpoint_wall seconds of wall
@@ -33,7 +38,6 @@ RunPlan plan_of(const Scene& s, double dt) {
     return p.every_row * std::max<std::int64_t>(1, (k + p.every_row - 1) / p.every_row);
   };
   p.every_ckpt = s.checkpoint_interval > 0 ? on_rows(steps_of(s.checkpoint_interval)) : 0;
-  const double rate = shear_rate(s);
   p.every_ckpt_strain =
       s.checkpoint_strain > 0 && rate > 0 ? on_rows(steps_of(s.checkpoint_strain / rate)) : 0;
   p.ckpt_wall = s.checkpoint_wall;

@@ -167,6 +167,8 @@ const std::vector<Param<Scene>>& scene_params() {
       {"box", "depth", &Scene::box_depth, "m", ge(0), "3D only: the box is [0, width] x [0, depth] with a floor at z = 0 and four side walls; width and depth both 0: the square that holds the lattice of generated spheres (docs/3d.md)"},
       {"output", "series_interval", &Scene::series_interval, "s", gt(0), "time between rows of series.csv"},
       {"output", "snapshot_interval", &Scene::snapshot_interval, "s", ge(0), "time between VTK snapshots; 0: none"},
+      {"output", "series_strain", &Scene::series_strain, "", ge(0), "> 0: a series row every this much shear strain (a shear run: shear.inertial_number or shear.rate > 0), instead of output.series_interval; 0: output.series_interval"},
+      {"output", "snapshot_strain", &Scene::snapshot_strain, "", ge(0), "> 0: a VTK snapshot every this much shear strain (a shear run), instead of output.snapshot_interval; 0: output.snapshot_interval"},
       {"output", "checkpoint_interval", &Scene::checkpoint_interval, "s", ge(0), "simulated time between checkpoints (checkpoint.bin: rerunning the same command resumes), rounded up to whole series intervals; 0: none. Any of the three checkpoint keys writes one (and one at the end)"},
       {"output", "checkpoint_strain", &Scene::checkpoint_strain, "", ge(0), "shear strain between checkpoints (needs shear.inertial_number > 0), rounded up to whole series intervals; 0: none"},
       {"output", "checkpoint_wall", &Scene::checkpoint_wall, "s (wall clock)", ge(0), "a checkpoint at the first series row after this much wall-clock time since the last one (so at most this plus one series interval's wall time between checkpoints); changes no result; 0: none"},

@@ -26,17 +26,19 @@ void check_no_protocol(const Scene& s, bool three, const auto& fail) {
   if (three) {
     if (s.pressure != 0 || s.inertial_number != 0 || s.isotropic || s.strain != 0 || s.dt_tp != 0 ||
         !s.start.empty() || s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0 ||
-        s.cohesion_number != 0 || s.checkpoint_strain != 0 || s.imposed_rate != 0 || s.volume_fraction != 0 ||
+        s.cohesion_number != 0 || s.checkpoint_strain != 0 || s.series_strain != 0 || s.snapshot_strain != 0 ||
+        s.imposed_rate != 0 || s.volume_fraction != 0 ||
         s.shear_control != ShearControl::Pressure)
       fail("shear.* (pressure, inertial_number, isotropic, strain, dt_tp, start, width, height, depth, control, "
-           "rate, volume_fraction), contact.cohesion_number and output.checkpoint_strain need shear.mode = \"periodic\": leave "
-           "them at their defaults");
+           "rate, volume_fraction), contact.cohesion_number and output.checkpoint_strain (series_strain, "
+           "snapshot_strain) need shear.mode = \"periodic\": leave them at their defaults");
     return;
   }
   if (s.inertial_number > 0 || s.isotropic || !s.start.empty() || s.strain > 0 || s.compaction_rate > 0 ||
-      s.imposed_rate > 0 || s.volume_fraction > 0 || s.shear_control != ShearControl::Pressure)
+      s.imposed_rate > 0 || s.volume_fraction > 0 || s.series_strain > 0 || s.snapshot_strain > 0 ||
+      s.shear_control != ShearControl::Pressure)
     fail("shear.inertial_number, shear.isotropic, shear.strain, shear.start, shear.compaction_rate, "
-         "shear.control, shear.rate and shear.volume_fraction need shear.mode \"periodic\" or \"walls\"");
+         "shear.control, shear.rate, shear.volume_fraction, output.series_strain and output.snapshot_strain need shear.mode \"periodic\" or \"walls\"");
 }
 
 // What the cell imposes besides the shear: the keys of one control that the
@@ -132,6 +134,9 @@ void check_protocol(const Scene& s) {
   }
 
   // The strain counts the shear: it needs a rate.
+  for (const auto& [key, set] : {std::pair{"output.series_strain", s.series_strain > 0},
+                                 std::pair{"output.snapshot_strain", s.snapshot_strain > 0}})
+    if (set && !sheared) fail(fmt::format("{} > 0 needs a shear rate ({} > 0)", key, rate_key));
   if (s.checkpoint_strain > 0 && !sheared)
     fail(fmt::format("output.checkpoint_strain > 0 needs a shear rate ({} > 0); use output.checkpoint_interval "
                      "or output.checkpoint_wall for other runs",

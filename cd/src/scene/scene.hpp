@@ -125,6 +125,8 @@ struct Scene {
   // [output]
   double series_interval = 0.005;    // time between series rows (s)
   double snapshot_interval = 0.025;  // time between VTK snapshots (s); 0: none
+  double series_strain = 0.0;        // > 0: shear strain between series rows (instead of the interval)
+  double snapshot_strain = 0.0;      // > 0: shear strain between snapshots (instead of the interval)
   double checkpoint_interval = 0.0;  // time between checkpoints (s); 0: none
   double checkpoint_strain = 0.0;    // shear strain between checkpoints; 0: none
   double checkpoint_wall = 0.0;      // most wall-clock seconds between checkpoints; 0: none
