@@ -91,6 +91,170 @@ WorldParams world_params(const Scene& s0) {
   return p;
 }
 
+namespace {
+
+// shear.start: the particles and the cell of a sample (a preparation's or a
+// shear run's checkpoint) into w, checked against the scene, its flow set
+// for the new run (core/continuation.hpp).
+void continue_sample(const Scene& s, const WorldParams& wp, World& w) {
+  Bodies& B = w.bodies;
+  // The particles and the cell a preparation run reached; time, strain
+  // and the cell's rates start from zero, and the shear starts from the
+  // linear velocity profile (so that there is no start-up transient of
+  // momentum diffusion across the cell).
+  World prep(wp);
+  try {
+    load_checkpoint(s.start, prep);
+  } catch (const CheckpointError& e) {
+    throw SceneError(fmt::format("shear.start: {}{}", e.what(), missing_start_hint(s)));
+  }
+  B = prep.bodies;
+  w.cell = prep.cell;
+  if (w.cell.width <= 0 || w.cell.height <= 0)
+    throw SceneError(fmt::format("shear.start: '{}' holds no periodic cell (not a periodic "
+                                 "preparation run)", s.start));
+  if (!s.disks.empty() || s.n > 0)
+    throw SceneError("shear.start gives the particles: set particles.n = 0 and no [[disk]]");
+  // The shapes come with the sample, but the scene's "auto" settings were
+  // chosen (config.cpp, before the sample is read) for the shapes
+  // particles.nsides names: polygons take no Anderson mixing and their own
+  // stop (docs/shear.md, "Settings by I"), so the two must agree.
+  const bool scene_polygons = std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; });
+  std::size_t poly = B.size();  // the sample's first polygon
+  for (std::size_t i = 0; i < B.size() && poly == B.size(); ++i)
+    if (B.nsides[i] >= 3) poly = i;
+  if ((poly < B.size()) != scene_polygons)
+    throw SceneError(fmt::format(
+        "shear.start: the sample's particles are {}, but particles.nsides = [{}] names {}; the \"auto\" "
+        "shear settings depend on it (docs/shear.md, \"Settings by I\"): set particles.nsides to the "
+        "preparation's",
+        scene_polygons ? std::string("disks only")
+                       : fmt::format("polygons ({}-gon: body {})", B.nsides[poly], poly),
+        fmt::join(s.nsides, ", "), scene_polygons ? "polygons" : "disks only"));
+  for (std::size_t i = 0; i < B.size(); ++i)
+    if (!B.is_dynamic(i))
+      throw SceneError(fmt::format("shear.start: '{}' holds walls or wall grains (body {}); a "
+                                   "periodic run starts from a periodic preparation", s.start, i));
+  // The grains (all dynamic: checked above) to core/continuation.hpp.
+  continuation::Grains grains{
+      B.size(),
+      [&](std::size_t i) { return B.pos[i].y(); },
+      [&](std::size_t i) -> double& { return B.vel[i].vx; },
+      [&](std::size_t i) { return 2 * B.radius[i]; },
+      [&](std::size_t i) { return B.mass[i] / obs::particle_area(B.radius[i], B.nsides[i]); },
+      "particles",
+      "kg/m^2"};
+  continuation::check_density(grains, s.density);
+  // A sheared sample (strain > 0) is continued: its Lees-Edwards offset
+  // and cell rates are kept (the images stay where the grains see them:
+  // resetting the offset would overlap grains across the sheared
+  // boundary), and its mean flow replaced by the new run's profile. A
+  // compacted sample starts from rest. Either way the strain counts from
+  // 0. Under volume control the lengths stay: their rates are 0.
+  const bool sheared = w.cell.strain != 0.0;
+  if (!sheared) w.cell.offset = w.cell.hdot = w.cell.wdot = 0.0;
+  if (imposed_pressure(s) <= 0) w.cell.hdot = w.cell.wdot = 0.0;
+  if (s.volume_fraction > 0) {
+    double area = 0;
+    for (std::size_t i = 0; i < B.size(); ++i) area += obs::particle_area(B.radius[i], B.nsides[i]);
+    const double f = continuation::volume_scale(area, w.cell.width * w.cell.height, s.volume_fraction, 2);
+    for (Vec2& x : B.pos) x *= f;
+    w.cell.width *= f;
+    w.cell.height *= f;
+    w.cell.offset *= f;
+  }
+  w.cell.strain = 0.0;
+  w.set_warm_start(prep.warm_start());
+  continuation::set_flow(grains, sheared, wp.cell.shear_rate, 0.5 * w.cell.height);
+  continuation::check_mean_diameter(grains, wp.d_ref);
+}
+
+// particles.n grains on a loose jittered lattice in the region, the cell
+// (between the walls' grains) or the box.
+void place_generated(const Scene& s, Bodies& B) {
+  const bool shear = s.shear_mode != ShearMode::None, walls = s.shear_mode == ShearMode::Walls;
+  // Loose placement on a jittered square lattice of pitch 1.02 d_max: no
+  // overlap by construction, filled row by row from the bottom.
+  std::vector<double> region = s.region;
+  if (region.empty() && shear) {
+    // The cell; between the walls' grains, a grain's clearance away.
+    const double m = walls ? 1.0 * s.d_mean * 1.01 : 0.0;
+    region = {0.0, m, s.cell_width, s.cell_height - m};
+  }
+  if (region.empty()) {
+    if (s.box_width <= 0)
+      throw SceneError("particles.n > 0 needs particles.region or a [box] to place them in");
+    region = {0.0, 0.0, s.box_width, s.box_height};
+  }
+  const std::vector<double> d = generated_diameters(s);
+  const double dmax = *std::max_element(d.begin(), d.end());
+  const double pitch = 1.02 * dmax;
+  // Counted in doubles (a region of 1e10 pitches overflows an int), and
+  // no more columns than grains.
+  const double cols = std::floor((region[2] - region[0]) / pitch), rows = std::floor((region[3] - region[1]) / pitch);
+  if (!(cols * rows >= s.n))
+    throw SceneError(fmt::format(
+        "particles.n = {} does not fit in the region [{}, {}] x [{}, {}]: room for {:.0f} disks "
+        "of the largest diameter {:.4g} on a loose lattice; enlarge the region or the box",
+        s.n, region[0], region[2], region[1], region[3], std::max(0.0, cols * rows), dmax));
+  const int nx = static_cast<int>(std::min<double>(cols, s.n));
+  std::mt19937_64 g(s.seed + 1);
+  std::mt19937_64 gs(s.seed + 2);  // shapes and orientations: their own stream, so a
+                                   // disk-only scene places exactly as before
+  for (int k = 0; k < s.n; ++k) {
+    const int ix = k % nx, iy = k / nx;
+    const double slack = 0.5 * (pitch - d[k]);
+    const double x = region[0] + (ix + 0.5) * pitch + slack * (2 * uniform01(g) - 1);
+    const double y = region[1] + (iy + 0.5) * pitch + slack * (2 * uniform01(g) - 1);
+    const int sides =
+        s.nsides.size() == 1
+            ? static_cast<int>(s.nsides[0])
+            : static_cast<int>(s.nsides[std::min<std::size_t>(
+                  s.nsides.size() - 1, static_cast<std::size_t>(uniform01(gs) * s.nsides.size()))]);
+    if (sides > 0)
+      B.add_polygon({x, y}, 0.5 * d[k], sides, 2 * std::numbers::pi * uniform01(gs), s.density);
+    else
+      B.add_disk({x, y}, 0.5 * d[k], s.density);
+  }
+}
+
+// No overlap at t = 0 (a started sample: at most kStartOverlap d).
+void check_initial_overlaps(const Scene& s, const World& w, int first_generated) {
+  const Bodies& B = w.bodies;
+  const bool shear = s.shear_mode != ShearMode::None, walls = s.shear_mode == ShearMode::Walls;
+  // No overlap at t = 0: run the detector with zero alert on the initial
+  // configuration. Round-off sized overlaps (1e-9 d) are tolerated so that
+  // disks placed exactly touching are accepted. A started state comes from a
+  // simulation, with its solver-sized overlaps: up to kStartOverlap d.
+  std::vector<ContactRow> rows;
+  std::vector<ContactInfo> info;
+  CellGrid grid;
+  PeriodicCell cell{shear, shear && !walls, w.cell.width, w.cell.height, w.cell.offset};
+  try {
+    detect(B, B.pos, B.angle, 0.0, grid, rows, info, shear ? &cell : nullptr);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(fmt::format("shear.width, shear.height: {}", e.what()));
+  }
+  constexpr double kStartOverlap = 0.05;
+  const double tol = (s.start.empty() ? 1e-9 : kStartOverlap) * w.params().d_ref;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (info[k].gap >= -tol) continue;
+    const int i = rows[k].b1, j = rows[k].b2;
+    const std::string a = B.driven[i] ? fmt::format("a wall (body {})", i)
+                                      : body_name(s, i, first_generated);
+    throw SceneError(fmt::format(
+        "initial overlap: {} at ({:.6g}, {:.6g}) and {} at ({:.6g}, {:.6g}) overlap by {:.3g} "
+        "(= {:.3g} mean diameters); {}",
+        a, B.pos[i].x(), B.pos[i].y(), body_name(s, j, first_generated), B.pos[j].x(),
+        B.pos[j].y(), -info[k].gap, -info[k].gap / w.params().d_ref,
+        s.start.empty() ? std::string("particles must not overlap at t = 0")
+                        : fmt::format("a started sample may overlap by at most {} mean diameters "
+                                      "(shear.start = '{}')", kStartOverlap, s.start)));
+  }
+}
+
+}  // namespace
+
 World build_world(const Scene& s0) {
   if (s0.dimension != 2)
     throw SceneError(fmt::format("dimension = {}: build_world makes 2D worlds (3D: build_world3)", s0.dimension));
@@ -103,77 +267,7 @@ World build_world(const Scene& s0) {
     w.cell.width = s.cell_width;
     w.cell.height = s.cell_height;
   }
-  if (!s.start.empty()) {
-    // The particles and the cell a preparation run reached; time, strain
-    // and the cell's rates start from zero, and the shear starts from the
-    // linear velocity profile (so that there is no start-up transient of
-    // momentum diffusion across the cell).
-    World prep(wp);
-    try {
-      load_checkpoint(s.start, prep);
-    } catch (const CheckpointError& e) {
-      throw SceneError(fmt::format("shear.start: {}{}", e.what(), missing_start_hint(s)));
-    }
-    B = prep.bodies;
-    w.cell = prep.cell;
-    if (w.cell.width <= 0 || w.cell.height <= 0)
-      throw SceneError(fmt::format("shear.start: '{}' holds no periodic cell (not a periodic "
-                                   "preparation run)", s.start));
-    if (!s.disks.empty() || s.n > 0)
-      throw SceneError("shear.start gives the particles: set particles.n = 0 and no [[disk]]");
-    // The shapes come with the sample, but the scene's "auto" settings were
-    // chosen (config.cpp, before the sample is read) for the shapes
-    // particles.nsides names: polygons take no Anderson mixing and their own
-    // stop (docs/shear.md, "Settings by I"), so the two must agree.
-    const bool scene_polygons = std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; });
-    std::size_t poly = B.size();  // the sample's first polygon
-    for (std::size_t i = 0; i < B.size() && poly == B.size(); ++i)
-      if (B.nsides[i] >= 3) poly = i;
-    if ((poly < B.size()) != scene_polygons)
-      throw SceneError(fmt::format(
-          "shear.start: the sample's particles are {}, but particles.nsides = [{}] names {}; the \"auto\" "
-          "shear settings depend on it (docs/shear.md, \"Settings by I\"): set particles.nsides to the "
-          "preparation's",
-          scene_polygons ? std::string("disks only")
-                         : fmt::format("polygons ({}-gon: body {})", B.nsides[poly], poly),
-          fmt::join(s.nsides, ", "), scene_polygons ? "polygons" : "disks only"));
-    for (std::size_t i = 0; i < B.size(); ++i)
-      if (!B.is_dynamic(i))
-        throw SceneError(fmt::format("shear.start: '{}' holds walls or wall grains (body {}); a "
-                                     "periodic run starts from a periodic preparation", s.start, i));
-    // The grains (all dynamic: checked above) to core/continuation.hpp.
-    continuation::Grains grains{
-        B.size(),
-        [&](std::size_t i) { return B.pos[i].y(); },
-        [&](std::size_t i) -> double& { return B.vel[i].vx; },
-        [&](std::size_t i) { return 2 * B.radius[i]; },
-        [&](std::size_t i) { return B.mass[i] / obs::particle_area(B.radius[i], B.nsides[i]); },
-        "particles",
-        "kg/m^2"};
-    continuation::check_density(grains, s.density);
-    // A sheared sample (strain > 0) is continued: its Lees-Edwards offset
-    // and cell rates are kept (the images stay where the grains see them:
-    // resetting the offset would overlap grains across the sheared
-    // boundary), and its mean flow replaced by the new run's profile. A
-    // compacted sample starts from rest. Either way the strain counts from
-    // 0. Under volume control the lengths stay: their rates are 0.
-    const bool sheared = w.cell.strain != 0.0;
-    if (!sheared) w.cell.offset = w.cell.hdot = w.cell.wdot = 0.0;
-    if (imposed_pressure(s) <= 0) w.cell.hdot = w.cell.wdot = 0.0;
-    if (s.volume_fraction > 0) {
-      double area = 0;
-      for (std::size_t i = 0; i < B.size(); ++i) area += obs::particle_area(B.radius[i], B.nsides[i]);
-      const double f = continuation::volume_scale(area, w.cell.width * w.cell.height, s.volume_fraction, 2);
-      for (Vec2& x : B.pos) x *= f;
-      w.cell.width *= f;
-      w.cell.height *= f;
-      w.cell.offset *= f;
-    }
-    w.cell.strain = 0.0;
-    w.set_warm_start(prep.warm_start());
-    continuation::set_flow(grains, sheared, wp.cell.shear_rate, 0.5 * w.cell.height);
-    continuation::check_mean_diameter(grains, wp.d_ref);
-  }
+  if (!s.start.empty()) continue_sample(s, wp, w);
 
   // In a box, every body starts inside it: one outside would fall for ever
   // (one across a wall is refused as an overlap below).
@@ -200,51 +294,7 @@ World build_world(const Scene& s0) {
   }
   const int first_generated = static_cast<int>(B.size());
 
-  if (s.n > 0) {
-    // Loose placement on a jittered square lattice of pitch 1.02 d_max: no
-    // overlap by construction, filled row by row from the bottom.
-    std::vector<double> region = s.region;
-    if (region.empty() && shear) {
-      // The cell; between the walls' grains, a grain's clearance away.
-      const double m = walls ? 1.0 * s.d_mean * 1.01 : 0.0;
-      region = {0.0, m, s.cell_width, s.cell_height - m};
-    }
-    if (region.empty()) {
-      if (s.box_width <= 0)
-        throw SceneError("particles.n > 0 needs particles.region or a [box] to place them in");
-      region = {0.0, 0.0, s.box_width, s.box_height};
-    }
-    const std::vector<double> d = generated_diameters(s);
-    const double dmax = *std::max_element(d.begin(), d.end());
-    const double pitch = 1.02 * dmax;
-    // Counted in doubles (a region of 1e10 pitches overflows an int), and
-    // no more columns than grains.
-    const double cols = std::floor((region[2] - region[0]) / pitch), rows = std::floor((region[3] - region[1]) / pitch);
-    if (!(cols * rows >= s.n))
-      throw SceneError(fmt::format(
-          "particles.n = {} does not fit in the region [{}, {}] x [{}, {}]: room for {:.0f} disks "
-          "of the largest diameter {:.4g} on a loose lattice; enlarge the region or the box",
-          s.n, region[0], region[2], region[1], region[3], std::max(0.0, cols * rows), dmax));
-    const int nx = static_cast<int>(std::min<double>(cols, s.n));
-    std::mt19937_64 g(s.seed + 1);
-    std::mt19937_64 gs(s.seed + 2);  // shapes and orientations: their own stream, so a
-                                     // disk-only scene places exactly as before
-    for (int k = 0; k < s.n; ++k) {
-      const int ix = k % nx, iy = k / nx;
-      const double slack = 0.5 * (pitch - d[k]);
-      const double x = region[0] + (ix + 0.5) * pitch + slack * (2 * uniform01(g) - 1);
-      const double y = region[1] + (iy + 0.5) * pitch + slack * (2 * uniform01(g) - 1);
-      const int sides =
-          s.nsides.size() == 1
-              ? static_cast<int>(s.nsides[0])
-              : static_cast<int>(s.nsides[std::min<std::size_t>(
-                    s.nsides.size() - 1, static_cast<std::size_t>(uniform01(gs) * s.nsides.size()))]);
-      if (sides > 0)
-        B.add_polygon({x, y}, 0.5 * d[k], sides, 2 * std::numbers::pi * uniform01(gs), s.density);
-      else
-        B.add_disk({x, y}, 0.5 * d[k], s.density);
-    }
-  }
+  if (s.n > 0) place_generated(s, B);
 
   if (walls) {
     // Rough walls: a row of touching grains of the mean diameter glued to
@@ -282,35 +332,7 @@ World build_world(const Scene& s0) {
   for (const WallSpec& ws : s.walls)
     B.add_wall({ws.a[0], ws.a[1]}, {ws.b[0], ws.b[1]}, {ws.vel[0], ws.vel[1]}, ws.omega);
 
-  // No overlap at t = 0: run the detector with zero alert on the initial
-  // configuration. Round-off sized overlaps (1e-9 d) are tolerated so that
-  // disks placed exactly touching are accepted. A started state comes from a
-  // simulation, with its solver-sized overlaps: up to kStartOverlap d.
-  std::vector<ContactRow> rows;
-  std::vector<ContactInfo> info;
-  CellGrid grid;
-  PeriodicCell cell{shear, shear && !walls, w.cell.width, w.cell.height, w.cell.offset};
-  try {
-    detect(B, B.pos, B.angle, 0.0, grid, rows, info, shear ? &cell : nullptr);
-  } catch (const std::runtime_error& e) {
-    throw SceneError(fmt::format("shear.width, shear.height: {}", e.what()));
-  }
-  constexpr double kStartOverlap = 0.05;
-  const double tol = (s.start.empty() ? 1e-9 : kStartOverlap) * w.params().d_ref;
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    if (info[k].gap >= -tol) continue;
-    const int i = rows[k].b1, j = rows[k].b2;
-    const std::string a = B.driven[i] ? fmt::format("a wall (body {})", i)
-                                      : body_name(s, i, first_generated);
-    throw SceneError(fmt::format(
-        "initial overlap: {} at ({:.6g}, {:.6g}) and {} at ({:.6g}, {:.6g}) overlap by {:.3g} "
-        "(= {:.3g} mean diameters); {}",
-        a, B.pos[i].x(), B.pos[i].y(), body_name(s, j, first_generated), B.pos[j].x(),
-        B.pos[j].y(), -info[k].gap, -info[k].gap / w.params().d_ref,
-        s.start.empty() ? std::string("particles must not overlap at t = 0")
-                        : fmt::format("a started sample may overlap by at most {} mean diameters "
-                                      "(shear.start = '{}')", kStartOverlap, s.start)));
-  }
+  check_initial_overlaps(s, w, first_generated);
   return w;
 }
 
