@@ -3,8 +3,9 @@
 // row, the others renamed into place), so a run stopping (SIGTERM) while
 // its folder was removed and made again by a new run of the same --out
 // appended its last row to the new run's series.csv, ahead of the new
-// header. The run loop (core/run_loop.cpp) checks the folder's identity
-// (FolderLock::check_unchanged, core/files.hpp) before each write and stops
+// header. The run session checks the folder's identity (RunFolder::check,
+// core/run_session_parts.hpp; FolderLock::check_unchanged, core/files.hpp)
+// before each write and stops
 // with FolderGone, writing nothing. Reproduced here without signals: an
 // engine that stands in for a world swaps the folder from inside the run,
 // just before the write under test.
