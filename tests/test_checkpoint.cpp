@@ -386,9 +386,14 @@ TEST(CdsimRestart, KilledRunResumesBitIdentical) {
   EXPECT_LT(killed_at, 1000);
 
   // The same command again resumes and finishes.
-  const Result b = cdsim(scene.string() + " --quiet --out " + out_b);
+  // With progress lines every millisecond: the run's lines while it steps.
+  const Result b = cdsim(scene.string() + " --quiet --progress 0.001 --out " + out_b);
   ASSERT_EQ(b.code, 0) << b.out;
   EXPECT_NE(b.out.find("resumed from"), std::string::npos) << b.out;
+  // Said when the run resumes, before its first progress line (so a log has
+  // it even if the resumed run is killed), not after the run returns.
+  ASSERT_NE(b.out.find("% (step "), std::string::npos) << b.out;
+  EXPECT_LT(b.out.find("resumed from"), b.out.find("% (step ")) << b.out;
   expect_same_outputs(d / "A", B);
 
   // The final checkpoints hold the same state; B's stage timers went on
@@ -849,7 +854,8 @@ TEST(CdsimRestart, AWriteFailureMidRunIsExitFourAndResumable) {
   expect_same_outputs(d / "A", B);
   EXPECT_EQ(summary_physics(d / "A"), summary_physics(B));
 
-  // A snapshot's place taken by a folder: exit 4, one message, no VTK log.
+  // A snapshot's place taken by a folder: exit 4, one message (after the
+  // line saying the run resumed, said when it did), no VTK log.
   const fs::path C = d / "C";
   ASSERT_EQ(cdsim(scene.string() + " --quiet --threads 1 --set output.snapshot_interval=0.025"
                   " --max-steps 130 --out " + C.string()).code, 0);
@@ -857,7 +863,8 @@ TEST(CdsimRestart, AWriteFailureMidRunIsExitFourAndResumable) {
   const Result snap = cdsim(scene.string() + " --quiet --threads 1 --set output.snapshot_interval=0.025 --out " + C.string());
   EXPECT_EQ(snap.code, 4) << snap.out;
   EXPECT_NE(snap.out.find("could not write '" + (C / "particles_00002.vtp").string() + "'"), std::string::npos) << snap.out;
-  EXPECT_EQ(std::count(snap.out.begin(), snap.out.end(), '\n'), 1) << snap.out;
+  EXPECT_EQ(snap.out.rfind("cdsim: resumed from ", 0), 0u) << snap.out;
+  EXPECT_EQ(std::count(snap.out.begin(), snap.out.end(), '\n'), 2) << snap.out;
   expect_whole_rows(C / "series.csv");
   if (!HasFailure()) fs::remove_all(d);
 }

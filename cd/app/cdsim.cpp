@@ -121,9 +121,6 @@ int main(int argc, char** argv) {
     cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps, max_steps};
     opt.progress_every = progress_every;
     const cd::RunSummary s = three ? cd::run3(*world3, scene, opt) : cd::run(*world, scene, opt);
-    if (s.first_step > 0)
-      fmt::print("cdsim: resumed from {}/checkpoint.bin at step {} of {}\n", out, s.first_step,
-                 s.total_steps);
     const double per_step = s.steps ? s.wall_time / s.steps : 0.0;
     fmt::print(
         "cdsim: {} steps in {:.2f} s ({:.3g} ms/step, {} threads); iterations/step mean {:.1f}, "

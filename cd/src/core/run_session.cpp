@@ -58,6 +58,13 @@ void RunSession::open() {
   e_.start();
   std::fputs(long_interval_warnings(plan_).c_str(), stderr);
   open_outputs();
+  // Said when it happens and flushed, so that a log has it even if the
+  // resumed run is killed before it ends.
+  if (from_.resumed) {
+    std::printf("cdsim: resumed from %s/checkpoint.bin at step %lld of %lld\n", opt_.out.c_str(),
+                static_cast<long long>(k0_), static_cast<long long>(plan_.nsteps));
+    std::fflush(stdout);
+  }
   interval_.t0 = e_.times();  // restored on resume
   // The session's cost counts the steps and their outputs, not the setup
   // before them (summary.toml: "in the run loop").
