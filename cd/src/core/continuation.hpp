@@ -49,11 +49,11 @@ template <class G>
 void check_mean_diameter(const G& g, double d_ref) {
   double dsum = 0;
   for (std::size_t i = 0; i < g.n; ++i) dsum += g.d(i);
-  const std::size_t nd = g.n;
-  if (nd == 0 || std::abs(dsum / nd - d_ref) > 0.1 * d_ref)
+  const double mean = g.n ? dsum / static_cast<double>(g.n) : 0.0;
+  if (g.n == 0 || std::abs(mean - d_ref) > 0.1 * d_ref)
     throw SceneError(fmt::format("shear.start: the sample's mean diameter is {:.4g} m, particles.d_mean is "
                                  "{:.4g} m; set particles.d_mean to the preparation's",
-                                 nd ? dsum / nd : 0.0, d_ref));
+                                 mean, d_ref));
 }
 
 // shear.volume_fraction: the factor on every length of the cell (and on

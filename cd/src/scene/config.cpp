@@ -531,12 +531,12 @@ Scene read_scene(const toml::value& root, const std::string& path) {
   const SceneKind kind{s.dimension, s.adhesion > 0 || s.cohesion_number > 0,
                        std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; }),
                        s.dimension == 3 && (s.mu_b >= 0 || s.mu_wall_b >= 0)};
+  // Under volume control, the nominal I of shear.rate at the pressure scale
+  // (scene/protocol.hpp); no "auto" key changes what it is made of.
+  const double I = nominal_inertial_number(s);
   for (const bool acceleration : {true, false})
     for (const auto& [a, at] : out.autos) {
       if (a->acceleration() != acceleration) continue;
-      // Under volume control, the nominal I of shear.rate at the pressure
-      // scale (scene/protocol.hpp).
-      const double I = nominal_inertial_number(s);
       if (!(I > 0)) {
         out.add(at, a->key.substr(a->key.find('.') + 1),
                 s.shear_control == ShearControl::Volume
