@@ -234,53 +234,59 @@ void World::integrate() {
 // main-solve sweeps a step at ratio 4, N = 300, beta_p = 0.2); at most
 // projection::kSweeps sweeps, which are not in StepStats (their time is in
 // the integrate stage's).
-void World::project_overlaps() {
-  last_.projection_work = 0.0;
-  const std::size_t nr = prob_.rows.size();
-  // The pair's smaller grain's diameter (a wall's grain's).
-  const auto smaller = [&](std::size_t k) {
-    const ContactRow& r = prob_.rows[k];
-    const bool s1 = bodies.shape[r.b1] == Shape::Segment, s2 = bodies.shape[r.b2] == Shape::Segment;
-    return 2.0 * (s1 ? bodies.radius[r.b2]
-                     : s2 ? bodies.radius[r.b1]
-                          : std::min(bodies.radius[r.b1], bodies.radius[r.b2]));
-  };
-  if (!projection::due(nr, [&](std::size_t k) { return info_[k].gap; }, smaller)) return;
-  const double beta = prm_.overlap_projection, dt = prm_.dt;
-  ContactProblem& q = proj_;
-  q.rows = prob_.rows;
-  q.colouring = prob_.colouring;
-  q.rotation = prob_.rotation;
-  q.law = Frictionless{};
-  q.vel = bodies.vel;
-  for (BodyVel& v : q.vel) v.vx = v.vy = v.w = 0.0;
-  for (std::size_t k = 0; k < nr; ++k) {
+// The projection's adaptor (core/projection_trigger.hpp's project()): the
+// step's rows, disks' and polygons' (a wall's grain's diameter is its pair's
+// smaller one), the boundary's dofs as it frees them.
+struct World::Projection {
+  World& w;
+  ContactProblem& q = w.proj_;
+  double smaller(std::size_t k) const {
+    const ContactRow& r = w.prob_.rows[k];
+    const Bodies& b = w.bodies;
+    const bool s1 = b.shape[r.b1] == Shape::Segment, s2 = b.shape[r.b2] == Shape::Segment;
+    return 2.0 * (s1 ? b.radius[r.b2] : s2 ? b.radius[r.b1] : std::min(b.radius[r.b1], b.radius[r.b2]));
+  }
+  void start() {
+    q.rows = w.prob_.rows;
+    q.colouring = w.prob_.colouring;
+    q.rotation = w.prob_.rotation;
+    q.law = Frictionless{};
+    q.vel = w.bodies.vel;
+    for (BodyVel& v : q.vel) v.vx = v.vy = v.w = 0.0;
+    q.dofs = w.prob_.dofs;
+    std::visit([&](const auto& b) { b.pseudo_dofs(q.dofs); }, w.boundary_);
+  }
+  void set_offset(std::size_t k, double bn) {
     ContactRow& r = q.rows[k];
-    const double g = info_[k].gap;
-    r.bn = projection::offset(g, beta, dt);
+    r.bn = bn;
     r.bt = r.pn = r.pt = r.mu = r.adh = 0.0;
   }
-  q.dofs = prob_.dofs;
-  std::visit([&](const auto& b) { b.pseudo_dofs(q.dofs); }, boundary_);
-  nlgs_solve(q, projection::solver_params(prm_.solver));
-  // The contact forces' work on the displacements: sum f_n (dt u_n).
-  double work = 0.0;
-  for (std::size_t k = 0; k < nr; ++k) {
-    if (prob_.rows[k].pn <= 0.0) continue;
+  void solve() { nlgs_solve(q, projection::solver_params(w.prm_.solver)); }
+  double impulse(std::size_t k) const { return w.prob_.rows[k].pn; }
+  double normal_velocity(std::size_t k) const {
     double un, ut;
     row_velocity(q.rows[k], q.vel, q.rotation, un, ut);
-    work += prob_.rows[k].pn * un;
+    return un;
   }
-  for (const BoundaryDof& d : q.dofs)
-    for (std::size_t i = 0; i < d.rows.size(); ++i)
-      if (prob_.rows[d.rows[i]].pn > 0.0) work += prob_.rows[d.rows[i]].pn * d.an[i] * d.v;
-  const bool rot = prm_.rotation;
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    xm_[i] += dt * Vec2(q.vel[i].vx, q.vel[i].vy);
-    if (rot) thm_[i] += dt * q.vel[i].w;
+  double add_dof_work(double work) const {
+    for (const BoundaryDof& d : q.dofs)
+      for (std::size_t i = 0; i < d.rows.size(); ++i)
+        if (w.prob_.rows[d.rows[i]].pn > 0.0) work += w.prob_.rows[d.rows[i]].pn * d.an[i] * d.v;
+    return work;
   }
-  std::visit([&](const auto& b) { b.apply_pseudo_dofs(*this, q.dofs, dt); }, boundary_);
-  last_.projection_work = work;
+  void move(double dt) {
+    for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+      w.xm_[i] += dt * Vec2(q.vel[i].vx, q.vel[i].vy);
+      if (w.prm_.rotation) w.thm_[i] += dt * q.vel[i].w;
+    }
+    std::visit([&](const auto& b) { b.apply_pseudo_dofs(w, q.dofs, dt); }, w.boundary_);
+  }
+};
+
+void World::project_overlaps() {
+  Projection e{*this};
+  const auto gap = [&](std::size_t k) { return info_[k].gap; };
+  last_.projection_work = projection::project(e, prob_.rows.size(), gap, prm_.overlap_projection, prm_.dt);
 }
 
 BoundaryDof World::make_dof(double v_start, double load, double length, double v_floor) {

@@ -167,6 +167,7 @@ class World : public WorldShell<Bodies, ContactProblem, ContactInfo, std::pair<d
   BoundaryDof make_dof(double v_start, double load, double length,
                        double v_floor = -std::numeric_limits<double>::infinity());
   void project_overlaps();
+  struct Projection;  // its adaptor (world.cpp)
   void couple_dof(BoundaryDof& d, std::size_t k, double an, double at, double v_start);
 
   WorldParams prm_;

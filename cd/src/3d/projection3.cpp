@@ -14,48 +14,55 @@
 
 namespace cd {
 
-void World3::project_overlaps() {
-  last_.projection_work = 0.0;
-  const std::size_t nr = prob_.rows.size();
-  // The pair's smaller diameter (a plane's sphere's).
-  const auto smaller = [&](std::size_t k) {
-    const SphereRow& r = prob_.rows[k];
-    const double r1 = bodies.radius[r.b1], r2 = bodies.radius[r.b2];
+// The projection's adaptor (core/projection_trigger.hpp's project()): the
+// step's sphere rows (a plane's sphere's diameter is its pair's smaller
+// one), the periodic cell's lengths as dofs from rest.
+struct World3::Projection {
+  World3& w;
+  ContactProblem3& q = w.proj_;
+  double smaller(std::size_t k) const {
+    const SphereRow& r = w.prob_.rows[k];
+    const double r1 = w.bodies.radius[r.b1], r2 = w.bodies.radius[r.b2];
     return 2.0 * (r1 <= 0.0 ? r2 : r2 <= 0.0 ? r1 : std::min(r1, r2));
-  };
-  if (!projection::due(nr, [&](std::size_t k) { return info_[k].gap; }, smaller)) return;
-  const double beta = prm_.overlap_projection, dt = prm_.dt;
-  ContactProblem3& q = proj_;
-  q.rows = prob_.rows;
-  q.extra = prob_.extra;
-  q.colouring = prob_.colouring;
-  q.law = choose_law3(LawSpec3{});  // frictionless, no adhesion
-  q.vel = bodies.vel;
-  for (BodyVel3& v : q.vel) v.v = v.w = Vec3::Zero();
-  for (std::size_t k = 0; k < nr; ++k) {
+  }
+  void start() {
+    q.rows = w.prob_.rows;
+    q.extra = w.prob_.extra;
+    q.colouring = w.prob_.colouring;
+    q.law = choose_law3(LawSpec3{});  // frictionless, no adhesion
+    q.vel = w.bodies.vel;
+    for (BodyVel3& v : q.vel) v.v = v.w = Vec3::Zero();
+    q.dofs = w.prob_.dofs;
+    for (CellDof3& d : q.dofs) d.v0 = d.v = 0.0;
+  }
+  void set_offset(std::size_t k, double bn) {
     SphereRow& r = q.rows[k];
-    const double g = info_[k].gap;
-    r.bn = projection::offset(g, beta, dt);
+    r.bn = bn;
     r.r = Vec3::Zero();
     r.mu = r.adh = 0.0;
   }
-  q.dofs = prob_.dofs;
-  for (CellDof3& d : q.dofs) d.v0 = d.v = 0.0;
-  nlgs_solve3(q, projection::solver_params(prm_.solver));
-  // The contact forces' work on the displacements: sum f_n (dt u_n), u_n
-  // the pseudo-velocity across the contact (bodies and cell lengths).
-  double work = 0.0;
-  for (std::size_t k = 0; k < nr; ++k) {
-    const SphereRow& r = prob_.rows[k];
-    if (r.r[0] <= 0.0) continue;
-    work += r.r[0] * r.n.dot(relative_velocity(q.rows[k], q.vel[r.b1], q.vel[r.b2]));
+  void solve() { nlgs_solve3(q, projection::solver_params(w.prm_.solver)); }
+  double impulse(std::size_t k) const { return w.prob_.rows[k].r[0]; }
+  double normal_velocity(std::size_t k) const {
+    const SphereRow& r = w.prob_.rows[k];
+    return r.n.dot(relative_velocity(q.rows[k], q.vel[r.b1], q.vel[r.b2]));
   }
-  for (const CellDof3& d : q.dofs)
-    for (std::size_t i = 0; i < d.rows.size(); ++i)
-      if (prob_.rows[d.rows[i]].r[0] > 0.0) work += prob_.rows[d.rows[i]].r[0] * d.a[i][0] * d.v;
-  for (std::size_t i = 0; i < bodies.size(); ++i) xm_[i] += dt * q.vel[i].v;
-  for (const CellDof3& d : q.dofs) cm_[d.axis] += dt * d.v;
-  last_.projection_work = work;
+  double add_dof_work(double work) const {
+    for (const CellDof3& d : q.dofs)
+      for (std::size_t i = 0; i < d.rows.size(); ++i)
+        if (w.prob_.rows[d.rows[i]].r[0] > 0.0) work += w.prob_.rows[d.rows[i]].r[0] * d.a[i][0] * d.v;
+    return work;
+  }
+  void move(double dt) {
+    for (std::size_t i = 0; i < w.bodies.size(); ++i) w.xm_[i] += dt * q.vel[i].v;
+    for (const CellDof3& d : q.dofs) w.cm_[d.axis] += dt * d.v;
+  }
+};
+
+void World3::project_overlaps() {
+  Projection e{*this};
+  const auto gap = [&](std::size_t k) { return info_[k].gap; };
+  last_.projection_work = projection::project(e, prob_.rows.size(), gap, prm_.overlap_projection, prm_.dt);
 }
 
 }  // namespace cd

@@ -198,6 +198,7 @@ class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
   void integrate();
   void observe();
   void project_overlaps();
+  struct Projection;  // its adaptor (projection3.cpp)
 
   template <class B>
   void build_rows(const B& b);

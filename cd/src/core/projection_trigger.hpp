@@ -1,8 +1,10 @@
-// When the overlap projection runs, and for how long: the rule 2D's
+// The overlap projection's rule and its steps, which 2D's
 // World::project_overlaps (2d/world.cpp) and 3D's World3::project_overlaps
-// (3d/projection3.cpp) share. Each dimension keeps its own rows and its own
-// notion of a pair's smaller diameter (a wall's or plane's grain's); the
-// numbers go through here, so that the two project on the same steps.
+// (3d/projection3.cpp) share: when it runs, for how long, the
+// pseudo-velocity each row asks for, and the order of the work (project()
+// below). Each dimension keeps its own rows, its own notion of a pair's
+// smaller diameter (a wall's or plane's grain's) and its own way of moving
+// the bodies and the cell, through an adaptor.
 #pragma once
 #include <algorithm>
 #include <cstddef>
@@ -49,6 +51,38 @@ inline SolverParams solver_params(SolverParams sp) {
   sp.anderson = 0;
   sp.subspace = 0;
   return sp;
+}
+
+// One projection of the n rows whose midpoint gaps are gap(k), given an
+// engine's adaptor E (a World's or World3's):
+//   smaller(k)             row k's pair's smaller diameter
+//   start()                the pseudo problem from the main one: its rows,
+//                          frictionless, bodies and cell lengths at rest
+//   set_offset(k, b)       row k's pseudo-velocity bound b, nothing else on it
+//   solve()                the pseudo problem's solve (solver_params above)
+//   impulse(k)             row k's normal impulse of the main solve
+//   normal_velocity(k)     its solved pseudo-velocity across the contact
+//   add_dof_work(work)     work plus the cell lengths' share of it
+//   move(dt)               dt times the pseudo-velocities into the midpoint
+//                          positions and the cell
+// Returns the contact forces' work on the displacements, sum f_n (dt u_n)
+// over the rows that carry a force (StepStats::projection_work), or 0 when
+// no overlap is due.
+template <class E, class Gap>
+double project(E& e, std::size_t n, Gap&& gap, double beta, double dt) {
+  if (!due(n, gap, [&](std::size_t k) { return e.smaller(k); })) return 0.0;
+  e.start();
+  for (std::size_t k = 0; k < n; ++k) e.set_offset(k, offset(gap(k), beta, dt));
+  e.solve();
+  double work = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double f = e.impulse(k);
+    if (f <= 0.0) continue;
+    work += f * e.normal_velocity(k);
+  }
+  work = e.add_dof_work(work);
+  e.move(dt);
+  return work;
 }
 
 }  // namespace cd::projection
