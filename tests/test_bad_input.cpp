@@ -110,6 +110,53 @@ TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
                  {"contact.cohesion_number = 1e+308", "between 1e-100 and 1e+100"}, shear);
 }
 
+// A setting that cannot act under the scene's law, shape or protocol is
+// refused by name: a reader of the scene would believe it does something.
+// Each is refused where it cannot act and runs where it can (the 3D pile
+// has walls and a floor; the shear cells have none).
+TEST(BadInput, SettingsThatCannotActAreRefused) {
+  std::ifstream f(std::string(CDLAB_SOURCE_DIR) + "/configs/pile3d.toml");
+  const std::string pile3d((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(pile3d.empty());
+  const std::string shear2 =
+      "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 20\n[time]\nduration = 0.01\n"
+      "[shear]\nmode = \"periodic\"\nwidth = 0.02\nheight = 0.02\npressure = 100.0\n";
+  const std::string shear3 = "name = \"s\"\ndimension = 3\n[gravity]\ng = [0.0, 0.0, 0.0]\n[particles]\nn = 20\n"
+                             "[shear]\nmode = \"periodic\"\npressure = 1e5\ninertial_number = 0.01\nstrain = 0.01\n"
+                             "dt_tp = 0.05\n";
+  // Wall friction in a cell without walls.
+  expect_refused("--set contact.mu_wall=0.3", {"contact.mu_wall = 0.3", "no walls"}, shear2);
+  expect_refused("--set contact.mu_wall=0.3", {"contact.mu_wall = 0.3", "no walls"}, shear3);
+  expect_refused("--set contact.mu_b=0.2 --set contact.mu_wall_b=0.3", {"contact.mu_wall_b = 0.3", "no walls"},
+                 shear3);
+  // The orthotropic direction without the orthotropic cone.
+  expect_refused("--set 'contact.axis_a=[0,1,0]'", {"contact.axis_a = [0, 1, 0]", "contact.mu_b"}, pile3d);
+  // A tangential restitution without friction, on grains and walls.
+  expect_refused("--set contact.mu=0 --set contact.mu_wall=0 --set contact.e_t=0.5",
+                 {"contact.e_t = 0.5", "without friction"}, pile3d);
+  expect_refused("--set contact.mu=0 --set contact.e_t=0.5", {"contact.e_t = 0.5", "without friction"});
+  // A debonding distance without adhesion.
+  expect_refused("--set contact.debond=0.02", {"contact.debond = 0.02", "adhesive"});
+  expect_refused("--set contact.debond=0.02", {"contact.debond = 0.02", "adhesive"}, pile3d);
+  // A cell mass for lengths held fixed.
+  expect_refused("--set shear.control=volume --set shear.rate=10 --set shear.cell_mass=0.5",
+                 {"shear.cell_mass = 0.5", "held fixed"}, shear2);
+
+  // Where they can act, the same settings run (a step of each).
+  const auto runs = [](const std::string& sets, const std::string& scene) {
+    const fs::path dir = cdtest::scratch_dir("bad_input", "acts");
+    fs::remove_all(dir / "out");
+    const fs::path sc = write(dir, "s.toml", scene);
+    const cdtest::CmdResult r = cdsim(sc.string() + " " + sets + " --set time.duration=3e-3 -q --out " +
+                                      (dir / "out").string());
+    EXPECT_EQ(r.code, 0) << sets << "\n" << r.out;
+  };
+  runs("--set contact.mu_wall=0.3 --set contact.mu_b=0.2 --set contact.mu_wall_b=0.3 "
+       "--set 'contact.axis_a=[0,1,0]' --set contact.e_t=0.5", pile3d);
+  runs("--set contact.mu=0 --set contact.mu_wall=0.3 --set contact.e_t=0.5", pile3d);
+  runs("--set contact.adhesion=1e-6 --set contact.debond=0.02", pile3d);
+}
+
 // Compliant contacts (contact.stiffness, contact.stiffness_number): 3D
 // only, one of the two, the number with an imposed pressure, not with
 // restitution, within the scene's number range, and, with cohesion, a pull-off

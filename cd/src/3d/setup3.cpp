@@ -96,7 +96,7 @@ void check_scene3(const Scene& s) {
   if (s.dimension != 3) fail(fmt::format("dimension = {}: not a 3D scene", s.dimension));
   if (s.gravity.size() != 3) fail("gravity.g: a 3D scene needs [gx, gy, gz]");
   // A setting that cannot act under the scene's law is refused, not ignored.
-  if (s.subspace > 0 && (s.mu_b >= 0 || s.mu_wall_b >= 0))
+  if (s.subspace > 0 && s.orthotropic())
     fail(fmt::format("solver.subspace = {}: the subspace correction acts on the round cone only, and "
                      "contact.{} = {} makes the cone orthotropic: give solver.subspace = 0 (solver.anderson "
                      "accelerates any cone)",
@@ -142,7 +142,7 @@ WorldParams3 world_params3(const Scene& s0) {
   p.mu = s.mu;
   p.mu_wall = s.mu_w();
   // Orthotropic Coulomb: on when mu_b or mu_wall_b is set (>= 0).
-  if (s.mu_b >= 0 || s.mu_wall_b >= 0) {
+  if (s.orthotropic()) {
     p.orthotropic = true;
     // Scaled first: a direction given as [1e-300, 0, 0] or [1e308, 1e308, 0]
     // is a direction (a plain norm under- or overflows and drops it).

@@ -130,16 +130,16 @@ const std::vector<Param<Scene>>& scene_params() {
       {"time", "duration", &Scene::duration, "s", ge(0), "simulated time"},
       {"gravity", "g", &Scene::gravity, "m/s^2", vector_of(2, 3), "gravity vector: [gx, gy] in 2D, [gx, gy, gz] in 3D (z up)"},
       {"contact", "mu", &Scene::mu, "", ge(0), "particle-particle friction coefficient"},
-      {"contact", "mu_wall", &Scene::mu_wall, "", any(), "particle-wall friction coefficient; < 0: same as mu"},
+      {"contact", "mu_wall", &Scene::mu_wall, "", any(), "particle-wall friction coefficient; < 0: same as mu; refused in a periodic cell (it has no walls)"},
       {"contact", "mu_b", &Scene::mu_b, "", any(), "3D only: orthotropic Coulomb friction, the elliptic cone |(r_a/mu, r_b/mu_b)| <= r_n: mu_b is the friction coefficient across contact.axis_a (mu along it); < 0: off (the round cone of mu)"},
-      {"contact", "mu_wall_b", &Scene::mu_wall_b, "", any(), "3D only: the orthotropic cone on walls, across axis_a (mu_wall along it); < 0: mu_b when mu_wall < 0 (walls as spheres), else mu_wall (walls isotropic)"},
-      {"contact", "axis_a", &Scene::axis_a, "", vector_of(3, 3), "3D only: the direction a of the orthotropic law, fixed in the world; each contact's t1 is its projection on the tangent plane (a contact whose normal is along axis_a keeps its default frame); any non-zero length"},
+      {"contact", "mu_wall_b", &Scene::mu_wall_b, "", any(), "3D only: the orthotropic cone on walls, across axis_a (mu_wall along it); < 0: mu_b when mu_wall < 0 (walls as spheres), else mu_wall (walls isotropic); refused in a periodic cell (it has no walls)"},
+      {"contact", "axis_a", &Scene::axis_a, "", vector_of(3, 3), "3D only: the direction a of the orthotropic law, fixed in the world; each contact's t1 is its projection on the tangent plane (a contact whose normal is along axis_a keeps its default frame); any non-zero length; refused without mu_b or mu_wall_b (the round cone has no direction)"},
       {"contact", "e_n", &Scene::e_n, "", in(0, 1), "normal restitution coefficient"},
-      {"contact", "e_t", &Scene::e_t, "", in(0, 1), "tangential restitution coefficient"},
+      {"contact", "e_t", &Scene::e_t, "", in(0, 1), "tangential restitution coefficient; refused without friction (contact.mu and mu_wall 0: no tangential impulse to act on)"},
       {"contact", "alert", &Scene::alert, "d_mean", ge(0), "alert distance of contact detection, in mean diameters"},
       {"contact", "rotation", &Scene::rotation, "", any(), "integrate particle rotations"},
       {"contact", "adhesion", &Scene::adhesion, "N", ge(0), "pull-off force f_a of the adhesion-shifted Signorini law, on contacts with gap <= debond; 0: no cohesion (no adhesion work at all)"},
-      {"contact", "debond", &Scene::debond, "d_mean", ge(0), "debonding distance delta_a, in mean diameters: a bond breaks beyond it"},
+      {"contact", "debond", &Scene::debond, "d_mean", ge(0), "debonding distance delta_a, in mean diameters: a bond breaks beyond it; refused without adhesion (contact.adhesion or cohesion_number)"},
       {"contact", "stiffness", &Scene::stiffness, "N/m", ge(0), "3D: compliant contacts, an implicit linear spring of this stiffness k on each contact's normal and tangential displacements over a step (the law acts on u + (r - r0)/(k dt^2), r0 the contact's impulse of the step before), Signorini and Coulomb kept (docs/accuracy.md, \"Compliant contacts\"); 0: rigid contacts (no cost)"},
       {"contact", "stiffness_number", &Scene::stiffness_number, "", ge(0), "3D: the stiffness number kappa = k / (p d) of compliant contacts at the imposed shear.pressure p (needs p > 0; instead of contact.stiffness), d = particles.d_mean as for contact.cohesion_number; 0: use contact.stiffness"},
       {"contact", "stiffness_ratio", &Scene::stiffness_ratio, "", gt(0), "3D, compliant contacts: the tangential stiffness k_t over the normal one k (linear DEM springs often take 2/7 to 1); 1: k_t = k"},
@@ -182,7 +182,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"shear", "volume_fraction", &Scene::volume_fraction, "", in(0, 1), "shear.control = \"volume\" from a sample (shear.start): its cell, positions and Lees-Edwards offset scaled about the cell's origin, the same factor on every axis, so that the grains fill this fraction of it (a compression is refused if it overlaps grains by more than the start check's 0.05 d); the grains keep their sizes, orientations and velocities; 0: the sample's cell as it is"},
       {"shear", "rate", &Scene::imposed_rate, "1/s", ge(0), "shear.control = \"volume\": the imposed shear rate gamma-dot (the inertial number is then measured: the series' inertial_number column); 0: no shear"},
       {"shear", "inertial_number", &Scene::inertial_number, "", ge(0), "imposed inertial number I: shear rate = I sqrt(p/rho)/d (walls: top wall speed = shear rate x current gap); 0: no shear"},
-      {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width; 3D: and depth) degree of freedom, in units of the particles' total mass; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
+      {"shear", "cell_mass", &Scene::cell_mass, "total mass", gt(0), "mass of the cell height (and width; 3D: and depth) degree of freedom, in units of the particles' total mass; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I); refused under shear.control = \"volume\" (the lengths are held)"},
       {"shear", "isotropic", &Scene::isotropic, "", any(), "compaction: the width (3D: and the depth) is a degree of freedom too, at sigma_xx (= sigma_zz) = pressure (periodic, inertial_number = 0)"},
       {"shear", "compaction_rate", &Scene::compaction_rate, "1/t_p", in(0, 1), "periodic cell at imposed pressure: its height (and, isotropic, width) shrinks at most at this strain rate, -(dL/dt)/L <= compaction_rate / t_p (a brake on the pressure-driven collapse; the inertial number of the compaction); 0: no bound on the rate. Whatever it is, a length shrinks by at most a quarter of the alert distance a step (so that the contacts it closes are detected first)"},
       {"shear", "settle_stress", &Scene::settle_stress, "p", in(0, 1), "stop rule of a compaction (periodic, shear.pressure > 0, shear.inertial_number 0): the run ends, with its checkpoint, at the first series row where over the last shear.settle_time every row's mean contact stress sigma_aa, on each axis at imposed stress, was within this fraction of p, and the packing fraction moved by at most shear.settle_phi; time.duration is then a limit (summary.toml status \"settled\" or, if never met, \"done\" with a warning); 0: off"},
@@ -530,13 +530,16 @@ Scene read_scene(const toml::value& root, const std::string& path) {
   // override is read, so that --set shear.inertial_number counts).
   const SceneKind kind{s.dimension, s.adhesion > 0 || s.cohesion_number > 0,
                        std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; }),
-                       s.dimension == 3 && (s.mu_b >= 0 || s.mu_wall_b >= 0)};
+                       s.orthotropic()};
   // Under volume control, the nominal I of shear.rate at the pressure scale
   // (scene/protocol.hpp); no "auto" key changes what it is made of.
   const double I = nominal_inertial_number(s);
   for (const bool acceleration : {true, false})
     for (const auto& [a, at] : out.autos) {
       if (a->acceleration() != acceleration) continue;
+      // Held lengths have no mass: "auto" leaves a volume-controlled cell's
+      // at its default (check_derived refuses another).
+      if (a->key == "shear.cell_mass" && s.shear_control == ShearControl::Volume) continue;
       if (!(I > 0)) {
         out.add(at, a->key.substr(a->key.find('.') + 1),
                 s.shear_control == ShearControl::Volume

@@ -151,9 +151,47 @@ static void check_grain_masses(const Scene& s) {
   }
 }
 
+// A setting that cannot act under the scene's law, shape or protocol is
+// refused by name, not ignored: a reader of the scene would believe it
+// does something. (Others live beside the rule they belong to: the
+// subspace correction under the orthotropic cone, check_scene3; the
+// compaction keys under volume control, check_protocol; stiffness_ratio,
+// below.) Keys at their defaults pass, whatever the scene.
+static void check_settings_act(const Scene& s) {
+  const auto fail = [](const std::string& m) { throw SceneError(m); };
+  const Scene d;
+  const bool walls = !(s.shear_mode == ShearMode::Periodic);  // a periodic cell has none
+  if (!walls && s.mu_wall >= 0)
+    fail(fmt::format("contact.mu_wall = {}: a periodic cell (shear.mode = \"periodic\") has no walls; leave "
+                     "it at -1 (contact.mu acts on every contact)",
+                     s.mu_wall));
+  if (!walls && s.mu_wall_b >= 0)
+    fail(fmt::format("contact.mu_wall_b = {}: a periodic cell (shear.mode = \"periodic\") has no walls; give "
+                     "the orthotropic cone of the grains, contact.mu_b",
+                     s.mu_wall_b));
+  if (s.dimension == 3 && !s.orthotropic() && s.axis_a != d.axis_a)
+    fail(fmt::format("contact.axis_a = [{}, {}, {}]: the direction of the orthotropic cone acts only with contact.mu_b "
+                     "or contact.mu_wall_b >= 0 (the round cone has no direction)",
+                     s.axis_a[0], s.axis_a[1], s.axis_a[2]));
+  const bool friction = s.mu > 0 || s.mu_w() > 0 || (s.orthotropic() && (s.mu_b > 0 || s.mu_wall_b > 0));
+  if (!friction && s.e_t > 0)
+    fail(fmt::format("contact.e_t = {}: without friction (contact.mu = 0{}) no contact carries a tangential "
+                     "impulse, so a tangential restitution cannot act; leave it at 0",
+                     s.e_t, walls ? ", and on walls" : ""));
+  if (!(s.adhesion > 0 || s.cohesion_number > 0) && s.debond != d.debond)
+    fail(fmt::format("contact.debond = {}: the debonding distance acts only on adhesive contacts "
+                     "(contact.adhesion or contact.cohesion_number > 0)",
+                     s.debond));
+  if (s.shear_mode != ShearMode::None && s.shear_control == ShearControl::Volume && s.cell_mass != d.cell_mass)
+    fail(fmt::format("shear.cell_mass = {}: under shear.control = \"volume\" the cell's lengths are held "
+                     "fixed, so they have no mass; leave it out",
+                     s.cell_mass));
+}
+
 void check_derived(const Scene& s) {
   auto fail = [](const std::string& m) { throw SceneError(m); };
   check_grain_masses(s);
+  check_settings_act(s);
   const double dt = time_step(s);
   const char* dt_from = s.dt_tp > 0 ? "shear.dt_tp x t_p" : "time.dt";
   if (!std::isfinite(dt) || dt <= 0) fail(fmt::format("the time step ({}) is {}: must be finite and > 0", dt_from, dt));

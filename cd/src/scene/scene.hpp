@@ -163,6 +163,8 @@ struct Scene {
   double stiffness_ratio = 1.0;
 
   double mu_w() const { return mu_wall < 0 ? mu : mu_wall; }
+  // The orthotropic (elliptic) cone: 3D, with mu_b or mu_wall_b given (>= 0).
+  bool orthotropic() const { return dimension == 3 && (mu_b >= 0 || mu_wall_b >= 0); }
 };
 
 }  // namespace cd
