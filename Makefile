@@ -135,7 +135,6 @@ help:
 	$(call help_var,FS_STRAIN,strain of its I = 1e-2 runs)
 	$(call help_var,FS_QS_STRAIN,strain of its I = 1e-3 runs)
 	$(call help_var,FS_GAP,steps between its two dumped problems)
-	$(call help_var,FS_PREP_SET,--set options of its preparations)
 	$(call help_var,FS3_N,spheres of make frozen-shear3)
 	$(call help_var,FS3_STRAIN,its strain at I = 1e-2 (the step dumped: the last))
 	$(call help_var,ACC,make accuracy-shear's folder)
@@ -565,24 +564,17 @@ FS_SHAPES ?= 0 6
 FS_STRAIN ?= 0.5
 FS_QS_STRAIN ?= 0.02
 FS_GAP ?= 50
-# The compaction only has to give a jammed sample to shear: at 1e-4 the
-# hexagons' prep sat at the 2000-sweep cap on most steps (1e-3 is now
-# configs/shear-prep.toml's own; kept explicit, as the problems were made).
-FS_PREP_SET ?= --set solver.tol=1e-3
 .PHONY: frozen-shear frozen-shear-runs
 frozen-shear: build
 	$(MAKE) --no-print-directory -j $(JOBS) CAMPAIGNS=$(FROZEN)/N_$(FS_N) N=$(FS_N) \
-	  PREP_SET="$(FS_PREP_SET)" frozen-shear-runs
+	  frozen-shear-runs
 	@ls -l $(FROZEN)/N_$(FS_N)/frozen/*/*/problem_*.cdp
 frozen-shear-runs: $(foreach s,$(FS_SHAPES),$(foreach i,0.01 0.001,$(CAMPAIGNS)/frozen/ns_$(s)/I_$(i)/.done))
-# steps of a strain at I with the campaign's dt: strain / (I dt_tp)
-fs_steps = $(shell awk 'BEGIN { printf "%d", $(2) / ($(1) * $(call resolved,$(1),dt_tp)) + 0.5 }')
 frozen_run = $(CDSIM) configs/shear-inertial.toml --out $(@D) $(CAMPAIGN_SET) --fresh \
 	  --set shear.start='"$(3)"' --set shear.pressure=$(P) --set particles.nsides=[$*] \
 	  --set shear.inertial_number=$(1) --set shear.strain=$(2) --set solver.tol=1e-4 --set solver.residual_tol=0 \
 	  --set solver.anderson=0 $(SERIES_BY_STRAIN) --set output.snapshot_interval=0 \
-	  --dump-problem $(shell echo $$(( $(call fs_steps,$(1),$(2)) - $(FS_GAP) ))) \
-	  --dump-problem $(call fs_steps,$(1),$(2))
+	  --dump-problem last-$(FS_GAP) --dump-problem last
 .PRECIOUS: $(CAMPAIGNS)/frozen/ns_%/I_0.01/.done
 $(CAMPAIGNS)/frozen/ns_%/I_0.01/.done: $(CAMPAIGNS)/prep/ns_%/.done
 	$(call frozen_run,0.01,$(FS_STRAIN),$(CAMPAIGNS)/prep/ns_$*/checkpoint.bin)
@@ -607,7 +599,7 @@ frozen-shear3:
 frozen-shear3-run: $(CAMPAIGNS)/frozen3/I_0.01/.done
 $(CAMPAIGNS)/frozen3/I_0.01/.done: $(CAMPAIGNS)/prep/ns_0/.done
 	$(call shear_cmd,0.01,$(CAMPAIGNS)/prep/ns_0,$(P),$(FS3_STRAIN)) --fresh --set output.snapshot_strain=0 --set output.snapshot_interval=0 \
-	  --set solver.subspace=0 --dump-problem $(call fs_steps,0.01,$(FS3_STRAIN))
+	  --set solver.subspace=0 --dump-problem last
 	touch $@
 
 # ---- Accuracy against cost in steady shear -----------------------------------

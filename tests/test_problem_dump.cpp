@@ -161,6 +161,31 @@ TEST(ProblemDump, CdsimDumpsAndCdproblemReplaysTheSameImpulses) {
   EXPECT_NE(bad.code, 0) << bad.out;
 }
 
+// "last" and "last-K" name steps from the run's end (0.02 s at dt = 2e-4 s:
+// 100 steps), so that a campaign need not compute its run's step count;
+// a step before the first is refused before anything is written.
+TEST(ProblemDump, LastAndLastKCountFromTheRunsEnd) {
+  const auto dir = cdtest::scratch_dir("problem_dump", "last");
+  const std::string cdsim = std::string(CDLAB_BINARY_DIR) + "/cd/cdsim " + CDLAB_SOURCE_DIR +
+                            "/configs/default.toml --set particles.n=150 --set box.width=0.012 "
+                            "--set box.height=0.03 --set time.duration=0.02 -q --fresh ";
+  const cdtest::CmdResult sim =
+      cdtest::run_command(cdsim + "--out " + dir.string() + " --dump-problem last --dump-problem last-10");
+  ASSERT_EQ(sim.code, 0) << sim.out;
+  for (const char* f : {"problem_100.cdp", "problem_90.cdp"}) EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  EXPECT_FALSE(std::filesystem::exists(dir / "problem_0.cdp"));
+  const auto none = dir / "none";
+  const cdtest::CmdResult past = cdtest::run_command(cdsim + "--out " + none.string() + " --dump-problem last-100");
+  EXPECT_EQ(past.code, 2) << past.out;
+  EXPECT_NE(past.out.find("--dump-problem last-100: the run has 100 steps"), std::string::npos) << past.out;
+  EXPECT_FALSE(std::filesystem::exists(none));
+  for (const char* word : {"last-0", "last-", "lastx", "last-x", "last+1"}) {
+    const cdtest::CmdResult r = cdtest::run_command(cdsim + "--out " + none.string() + " --dump-problem " + word);
+    EXPECT_EQ(r.code, 2) << word << "\n" << r.out;
+    EXPECT_NE(r.out.find("\"last\" or \"last-K\""), std::string::npos) << word << "\n" << r.out;
+  }
+}
+
 // A dump that cannot be written is a write failure (exit 4, "could not
 // write" naming the option and the file), not a divergence, although the
 // .cdp is written inside the step, before its solve, whose errors the run

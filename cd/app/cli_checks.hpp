@@ -6,8 +6,13 @@
 #pragma once
 #include <cerrno>
 #include <cmath>
+#include <cctype>
+#include <cstdint>
 #include <cstdlib>
+#include <optional>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -38,6 +43,50 @@ inline CLI::Validator positive_count() {
         return ok ? std::string() : "'" + v + "' is not a whole number >= 1";
       },
       "a whole number >= 1");
+}
+
+// A --dump-problem step: a whole number >= 1 (the step), or "last", or
+// "last-K" (K >= 1 steps before the run's last), which a campaign gives
+// without computing the run's step count. Returned as the step itself, or
+// <= 0 for the last (0) and last-K (-K); nullopt for any other word.
+inline std::optional<long long> dump_step(const std::string& v) {
+  const auto whole = [](const std::string& w) -> std::optional<long long> {
+    char* end = nullptr;
+    errno = 0;
+    const long long x = std::strtoll(w.c_str(), &end, 10);
+    if (w.empty() || !std::isdigit(static_cast<unsigned char>(w[0])) || *end != '\0' || errno != 0 || x < 1)
+      return std::nullopt;
+    return x;
+  };
+  if (v == "last") return 0;
+  if (v.rfind("last-", 0) == 0) {
+    const auto k = whole(v.substr(5));
+    return k ? std::optional<long long>(-*k) : std::nullopt;
+  }
+  return whole(v);
+}
+inline CLI::Validator dump_step_word() {
+  return CLI::Validator(
+      [](std::string& v) {
+        return dump_step(v) ? std::string()
+                            : "'" + v + "' is not a whole number >= 1, \"last\" or \"last-K\" (K >= 1)";
+      },
+      "STEP, last or last-K");
+}
+
+// The steps of the --dump-problem words (dump_step_word() checked them) in
+// a run of nsteps steps; throws std::invalid_argument for a last-K before
+// the run's first step. (One past the last is the run session's check.)
+inline std::vector<std::int64_t> dump_steps(const std::vector<std::string>& words, std::int64_t nsteps) {
+  std::vector<std::int64_t> steps;
+  for (const std::string& w : words) {
+    const long long k = *dump_step(w);
+    if (k <= 0 && nsteps + k < 1)
+      throw std::invalid_argument(fmt::format(
+          "--dump-problem {}: the run has {} steps, so it has no step {} before its last", w, nsteps, -k));
+    steps.push_back(k <= 0 ? nsteps + k : k);
+  }
+  return steps;
 }
 
 }  // namespace cd
