@@ -67,9 +67,11 @@ help:
 	@echo "  make campaign-inertial-ladder   the same values of I from the highest down, each from the point above"
 	@echo "  make campaign-cohesive          each eta of COHESIVE_ETA at each I of COHESIVE_I"
 	@echo "  make campaign-angularity        each shape of ANGULAR_NS (2D) at ANGULAR_I"
+	@echo "  make campaign-walls             the same shapes between rough walls (the walls protocol, 2D)"
 	@echo "  make campaign-pressure          steady shear at PRESSURE_I under each p of PRESSURE_P"
 	@echo "  make campaign-pressure-ladder   the same from the lowest p up, each from the point below"
 	@echo "  make validate-angularity        the polygon study's shapes at VAL_I in the bi-periodic cell into VALIDATE"
+	@echo "  make validate-angularity-walls  the same between rough walls (the study's protocol) into VALIDATE"
 	@echo "                                  (N = VAL_N, size ratio 4; hours a shape; docs/shear.md, Campaigns)"
 	@echo "  make campaign-status [CAMPAIGN=inertial]  each run: done / running / not started / failed / stopped,"
 	@echo "                       its progress, cost (CPU, steps) and ETA (every campaign in CAMPAIGNS unless CAMPAIGN)"
@@ -362,11 +364,13 @@ CAMPAIGN_SET = --progress $(PROGRESS) --set output.quiet=true --set output.check
 inertial_runs   := $(foreach i,$(INERTIAL_I),$(CAMPAIGNS)/inertial/I_$(i))
 cohesive_runs   := $(foreach e,$(COHESIVE_ETA),$(foreach i,$(COHESIVE_I),$(CAMPAIGNS)/cohesive/eta_$(e)_I_$(i)))
 angularity_runs := $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/angularity/ns_$(n))
+walls_runs      := $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/walls/ns_$(n))
 
-.PHONY: campaign-inertial campaign-cohesive campaign-angularity campaign-list campaign-status programs
+.PHONY: campaign-inertial campaign-cohesive campaign-angularity campaign-walls campaign-list campaign-status programs
 campaign-inertial: $(addsuffix /.done,$(inertial_runs))
 campaign-cohesive: $(addsuffix /.done,$(cohesive_runs))
 campaign-angularity: $(addsuffix /.done,$(angularity_runs))
+campaign-walls: $(addsuffix /.done,$(walls_runs))
 # The run folders of a campaign, one per line, and the sample a run starts
 # from (configs/cluster/job-array.sh).
 .PHONY: campaign-prep-of
@@ -376,7 +380,7 @@ campaign-list:
 # (cd/campaign/status.sh), of CAMPAIGN or of every campaign in CAMPAIGNS.
 inertial-ladder_runs = $(ladder_runs)
 pressure-ladder_runs = $(pressure_ladder_runs)
-status_campaigns = $(or $(CAMPAIGN),$(foreach c,inertial inertial-ladder cohesive angularity pressure pressure-ladder,\
+status_campaigns = $(or $(CAMPAIGN),$(foreach c,inertial inertial-ladder cohesive angularity walls pressure pressure-ladder,\
   $(if $(wildcard $(CAMPAIGNS)/$(c)),$(c))))
 prep_runs = $(CAMPAIGNS)/prep/ns_0 $(if $(filter angularity,$(status_campaigns)),$(filter-out %/ns_0,\
   $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/prep/ns_$(n))))
@@ -384,6 +388,7 @@ campaign-status:
 	@cd/campaign/status.sh $(CAMPAIGNS) $(foreach c,prep $(status_campaigns),$(call help_q,$(c)=$($(c)_runs)))
 campaign-prep-of:
 	@case "$(RUN)" in */angularity/ns_*) echo $(CAMPAIGNS)/prep/$(notdir $(RUN))/.done ;; \
+	  */walls/ns_*) echo programs ;; \
 	  *) echo $(CAMPAIGNS)/prep/ns_0/.done ;; esac
 
 # Products, never intermediates: make must not delete a sample when done.
@@ -411,6 +416,8 @@ manifest_keys_cohesive := STRAIN SHEAR_TOL SHEAR_SET COHESIVE_TOL
 manifest_record_cohesive := COHESIVE_ETA COHESIVE_I
 manifest_keys_angularity := STRAIN SHEAR_TOL SHEAR_SET ANGULAR_I
 manifest_record_angularity := ANGULAR_NS
+manifest_keys_walls := STRAIN SHEAR_TOL SHEAR_SET ANGULAR_I
+manifest_record_walls := ANGULAR_NS
 manifest_keys_pressure := STRAIN SHEAR_TOL SHEAR_SET PRESSURE_I
 manifest_record_pressure := PRESSURE_P
 manifest_keys_pressure-ladder := LADDER_STRAIN SHEAR_TOL SHEAR_SET PRESSURE_I PRESSURE_P
@@ -420,7 +427,7 @@ make_dry = $(if $(findstring n,$(firstword -$(MAKEFLAGS))),1,0)
 # `+`: checked under make -n too (which writes nothing). A static pattern
 # rule: an implicit rule's product would be an intermediate file, which make
 # does not make when the runs after it are done (so no refusal then).
-manifest_checks := $(foreach c,prep inertial inertial-ladder cohesive angularity pressure pressure-ladder,\
+manifest_checks := $(foreach c,prep inertial inertial-ladder cohesive angularity walls pressure pressure-ladder,\
   $(CAMPAIGNS)/$(c)/.manifest-check)
 $(manifest_checks): $(CAMPAIGNS)/%/.manifest-check:
 	+@cd/campaign/manifest.sh $(@D)/manifest.toml $(make_dry) \
@@ -518,6 +525,24 @@ $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done | $(CAMPAIGNS)/
 	$(call shear_run,$(ANGULAR_I),$*)
 	touch $@
 
+# The walls protocol (docs/shear.md): N grains of each shape placed loose
+# between two rough walls in a cell sized for them (shear.width = height =
+# 0: about as wide as tall once compacted), the top wall at P compacting
+# them as it starts to shear at ANGULAR_I; no sample to start from. The
+# solver settings are the shear policy's at I, as the periodic runs' (the
+# "auto" keys of configs/shear-inertial.toml; SHEAR_TOL overrides them).
+walls_policy = --set solver.tol=auto --set solver.residual_tol=auto --set contact.overlap_projection=auto \
+	  --set solver.anderson=auto --set shear.dt_tp=auto --set shear.cell_mass=auto
+$(CAMPAIGNS)/walls/ns_%/.done: | programs $(CAMPAIGNS)/walls/.manifest-check $(goal_manifests)
+	$(if $(dim3),@echo "campaign-walls is 2D only (the 3D cell has no walls protocol)"; exit 2)
+	$(CDSIM) configs/shear-walls.toml --out $(@D) $(CAMPAIGN_SET) $(walls_policy) $(shear_solver) \
+	  --set particles.n=$(N) --set particles.nsides=[$*] --set particles.size_ratio=$(SIZE_RATIO) \
+	  --set particles.size_dist=$(SIZE_DIST) --set shear.width=0 --set shear.height=0 \
+	  --set shear.pressure=$(P) --set shear.inertial_number=$(ANGULAR_I) --set shear.strain=$(STRAIN) \
+	  --set time.duration=0 --set output.snapshot_interval=0 \
+	  $(SERIES_BY_STRAIN) $(SNAPSHOTS_BY_STRAIN) $(SHEAR_SET)
+	touch $@
+
 # ---- Validation: the angularity study -----------------------------------------
 # The polygon study of Azema, Estrada & Radjai (PRE 86, 041301, 2012):
 # regular polygons of VAL_NS sides and disks (0), circumscribed diameters
@@ -536,9 +561,13 @@ VAL_I ?= 0.001
 VAL_STRAIN ?= 3
 val_vars = CAMPAIGNS=$(VALIDATE) DIM=2 N=$(VAL_N) SIZE_RATIO=4 SIZE_DIST=uniform_area STRAIN=$(VAL_STRAIN) \
   ANGULAR_NS="$(VAL_NS)" ANGULAR_I=$(VAL_I) SHEAR_TOL= SHEAR_SET= PREP_SET=
-.PHONY: validate-angularity
+.PHONY: validate-angularity validate-angularity-walls
 validate-angularity: programs
 	+$(MAKE) --no-print-directory $(val_vars) campaign-angularity
+# The same shapes, N, I and strain under the study's own protocol, between
+# rough walls (campaign-walls), into $(VALIDATE)/walls.
+validate-angularity-walls: programs
+	+$(MAKE) --no-print-directory $(val_vars) campaign-walls
 
 # ---- Frozen dense-shear problems (tests/data/frozen-shear) -------------------
 # Steady bi-periodic shear of N disks (ns_0) and hexagons (ns_6) at p = P,

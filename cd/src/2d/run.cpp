@@ -61,13 +61,63 @@ double packing_fraction(const Bodies& b, double V) {
   return obs::packing_fraction(area, weight, V);
 }
 
-// Protocol columns: stress averaged over the steps of the interval.
+// The walls protocol's bulk: the central half of the gap between the
+// walls' grain centres, [H/4, 3H/4], away from the layering the walls
+// impose on the first grains.
+struct Band {
+  double lo, hi;
+  explicit Band(const World& w) : lo(0.25 * w.cell.height), hi(0.75 * w.cell.height) {}
+  double area(const World& w) const { return w.cell.width * (hi - lo); }
+  bool holds(double y) const { return y >= lo && y < hi; }
+  // The share of a branch vector from height y to y + ly inside the band
+  // (a contact's share of the band's stress: the stress of a sub-volume by
+  // the cut branch vectors, whose average over the heights is the cell's).
+  double share(double y, double ly) const {
+    if (std::abs(ly) <= 1e-12 * (hi - lo)) return holds(y) ? 1.0 : 0.0;
+    const double a = std::min(y, y + ly), b = std::max(y, y + ly);
+    return std::max(0.0, std::min(b, hi) - std::max(a, lo)) / (b - a);
+  }
+};
+
+// What the walls protocol measures besides the cell's stress, on one step:
+// the force the sample exerts on the top wall's grains, and the band's
+// contact stress (Love-Weber over the band's share of each branch vector).
+struct WallsStep {
+  Vec2 top_force = Vec2::Zero();
+  Eigen::Matrix2d bulk = Eigen::Matrix2d::Zero();
+};
+WallsStep walls_step(const World& w) {
+  std::vector<char> top(w.bodies.size(), 0);
+  for (const std::int32_t i : w.top_wall) top[static_cast<std::size_t>(i)] = 1;
+  const Band band(w);
+  WallsStep m;
+  std::vector<obs::Contact<2>> cs = w.contact_forces();
+  for (obs::Contact<2>& c : cs) {
+    const obs::Vec<2> f = c.force();  // on body 2
+    if (top[static_cast<std::size_t>(c.b2)]) m.top_force += Vec2(f[0], f[1]);
+    if (top[static_cast<std::size_t>(c.b1)]) m.top_force -= Vec2(f[0], f[1]);
+    const double k = band.share(w.bodies.pos[c.b1].y(), c.l[1]);
+    c.fn *= k;
+    for (double& x : c.ft) x *= k;
+  }
+  const auto S = obs::contact_stress<2>(cs, band.area(w));
+  m.bulk << S[0][0], S[0][1], S[1][0], S[1][1];
+  return m;
+}
+
+// Protocol columns: stress averaged over the steps of the interval (and,
+// between walls, the top wall's traction and the bulk's stress).
 struct ShearInterval {
   int steps = 0;
   Eigen::Matrix2d sigma = Eigen::Matrix2d::Zero();
-  void add(const World& w) {
+  WallsStep walls;
+  void add(const World& w, bool between_walls) {
     ++steps;
     sigma += w.contact_stress();
+    if (!between_walls) return;
+    const WallsStep m = walls_step(w);
+    walls.top_force += m.top_force;
+    walls.bulk += m.bulk;
   }
 };
 
@@ -77,6 +127,7 @@ class Engine2 final : public RunEngine {
  public:
   Engine2(World& w, const Scene& s, const RunOptions& opt)
       : w_(w), s_(s), dir_(opt.out), dump_(opt.dump_steps), shear_(s.shear_mode != ShearMode::None),
+        walls_(s.shear_mode == ShearMode::Walls),
         d_mean_(mean_diameter(s)) {
     // --dump-problem: the hook sees the problem of the step being taken
     // (w.steps + 1) just before its solve. Each file is written whole under
@@ -126,7 +177,7 @@ class Engine2 final : public RunEngine {
       for (const ContactRow& r : w_.rows()) text += fmt::format("{:a} {:a}\n", r.pn, r.pt);
       write_file_atomic((dir_ / fmt::format("problem_{}.impulses", k)).string(), text);
     }
-    if (shear_) sh_.add(w_);
+    if (shear_) sh_.add(w_, walls_);
   }
   void add_columns(Columns& cols) override {
     if (!shear_) return;
@@ -166,19 +217,57 @@ class Engine2 final : public RunEngine {
                 {"kxx", K(0, 0)},
                 {"kxy", K(0, 1)},
                 {"kyy", K(1, 1)}});
+    if (walls_) add_walls_columns(cols);
     v_prev_ = V;
     t_prev_ = w_.time;
     sh_ = ShearInterval{};
   }
 
  private:
+  // The walls protocol (shear.mode = "walls", docs/shear.md): the traction
+  // the sample exerts on the top wall, per length, compression positive
+  // (wall_sigma = F_y / W, which the wall's control holds at p on average)
+  // and in the sense of the shear (wall_tau = -F_x / W: the sample drags the
+  // wall back), both means over the interval's steps; and the bulk, the
+  // central half of the gap: its contact stress (interval mean), and at the
+  // row's step its packing fraction (grains whose centre is in it) and z
+  // (their force-bearing contacts, rattlers out).
+  void add_walls_columns(Columns& cols) const {
+    const double W = w_.cell.width, n = sh_.steps;
+    const Vec2 F = sh_.walls.top_force / n;
+    const Eigen::Matrix2d B = sh_.walls.bulk / n;
+    const double tau = -F.x() / W, sigma = F.y() / W;
+    const double bxy = 0.5 * (B(0, 1) + B(1, 0));
+    const obs::Tensor<2> Bt = {{{B(0, 0), B(0, 1)}, {B(1, 0), B(1, 1)}}};
+    const double bp = obs::mean_2d(Bt), bq = obs::deviator_2d(Bt);
+    const Band band(w_);
+    std::vector<std::int32_t> inside;
+    double area = 0.0;
+    for (std::size_t i = 0; i < w_.bodies.size(); ++i)
+      if (w_.bodies.is_dynamic(i) && band.holds(w_.bodies.pos[i].y())) {
+        inside.push_back(static_cast<std::int32_t>(i));
+        area += obs::particle_area(w_.bodies.radius[i], w_.bodies.nsides[i]);
+      }
+    const obs::Coordination zc = obs::coordination<2>(w_.contact_forces(), inside);
+    cols.insert(cols.end(), {{"wall_tau", tau},
+                             {"wall_sigma", sigma},
+                             {"wall_mu", sigma > 0 ? tau / sigma : 0.0},
+                             {"bulk_sxx", B(0, 0)},
+                             {"bulk_sxy", bxy},
+                             {"bulk_syy", B(1, 1)},
+                             {"bulk_q_over_p", bp > 0 ? bq / bp : 0.0},
+                             {"bulk_mu", B(1, 1) > 0 ? -bxy / B(1, 1) : 0.0},
+                             {"bulk_packing_fraction", area / band.area(w_)},
+                             {"bulk_z", zc.z}});
+  }
+
   bool dumped(std::int64_t k) const { return std::find(dump_.begin(), dump_.end(), k) != dump_.end(); }
 
   World& w_;
   const Scene& s_;
   std::filesystem::path dir_;
   std::vector<std::int64_t> dump_;
-  bool shear_;
+  bool shear_, walls_;
   double d_mean_;
   Snapshots snaps_{""};
   ShearInterval sh_;

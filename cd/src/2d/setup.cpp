@@ -28,30 +28,50 @@ std::string body_name(const Scene& s, int i, int first_generated) {
 void check_shear(const Scene& s) {
   check_protocol(s);
   if (s.shear_mode == ShearMode::None) return;
-  // 0 x 0: a periodic cell sized for the generated particles (with_auto_cell)
-  // or the start sample's cell.
-  const bool auto_cell = s.shear_mode == ShearMode::Periodic && s.cell_width == 0 && s.cell_height == 0 &&
-                         (s.n > 0 || !s.start.empty());
+  // 0 x 0: a cell sized for the generated particles (with_auto_cell) or the
+  // start sample's cell.
+  const bool auto_cell = s.cell_width == 0 && s.cell_height == 0 &&
+                         (s.n > 0 || (s.shear_mode == ShearMode::Periodic && !s.start.empty()));
   if (!auto_cell && (s.cell_width <= 0 || s.cell_height <= 0))
-    throw SceneError(fmt::format("shear.mode = \"{}\" needs shear.width > 0 and shear.height > 0 (periodic: "
-                                 "or both 0, for a cell sized for the particles)",
+    throw SceneError(fmt::format("shear.mode = \"{}\" needs shear.width > 0 and shear.height > 0 (or both 0, "
+                                 "for a cell sized for the generated particles)",
                                  name_of(s.shear_mode)));
 }
 
 }  // namespace
 
-// A periodic cell given as 0 x 0 for generated particles: the smallest
-// square that holds them on the generator's loose lattice (pitch 1.02 d_max),
-// computed from the actual size law, whatever the size ratio.
+// A cell given as 0 x 0 for generated particles, computed from the actual
+// size law, whatever the size ratio:
+// - periodic: the smallest square that holds them on the generator's loose
+//   lattice (pitch 1.02 d_max);
+// - walls: a sample about as wide as tall once the top wall has compacted
+//   it, the width that of a square of the grains' area at the packing
+//   fraction kWallsPhi (sheared 2D packings lie within 0.75-0.85 of it, so
+//   the sample is square to within 7 %, the walls' looser first layers
+//   aside); the height holds the loose lattice's rows between the walls'
+//   grains, and the top wall's first fall compacts it.
+constexpr double kWallsPhi = 0.8;
 Scene with_auto_cell(const Scene& s) {
-  if (s.shear_mode != ShearMode::Periodic || s.cell_width != 0 || s.cell_height != 0 || !s.start.empty() ||
-      s.n <= 0)
+  if (s.shear_mode == ShearMode::None || s.cell_width != 0 || s.cell_height != 0 || !s.start.empty() || s.n <= 0)
     return s;
   const std::vector<double> d = generated_diameters(s);
   const double pitch = 1.02 * *std::max_element(d.begin(), d.end());
-  const double k = std::ceil(std::sqrt(static_cast<double>(s.n)));
   Scene c = s;
-  c.cell_width = c.cell_height = pitch * k * (1 + 1e-9);  // floor(side / pitch) = k
+  if (s.shear_mode == ShearMode::Periodic) {
+    const double k = std::ceil(std::sqrt(static_cast<double>(s.n)));
+    c.cell_width = c.cell_height = pitch * k * (1 + 1e-9);  // floor(side / pitch) = k
+    return c;
+  }
+  double area = 0.0;  // the grains', each the mean over the listed shapes it is drawn from
+  for (const double di : d) {
+    double a = 0.0;
+    for (const double n : s.nsides) a += obs::particle_area(0.5 * di, static_cast<int>(n));
+    area += a / static_cast<double>(s.nsides.size());
+  }
+  c.cell_width = std::max(std::sqrt(area / kWallsPhi), pitch * (1 + 1e-9));
+  const double rows = std::ceil(static_cast<double>(s.n) / std::floor(c.cell_width / pitch));
+  // place_generated's region: a wall grain's clearance (1.01 d_mean) from each wall.
+  c.cell_height = pitch * rows * (1 + 1e-9) + 2 * 1.01 * s.d_mean;
   return c;
 }
 

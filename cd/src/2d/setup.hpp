@@ -12,9 +12,11 @@ namespace cd {
 
 WorldParams world_params(const Scene& s);
 
-// The scene with a periodic cell given as 0 x 0 (for generated particles)
-// replaced by the smallest square that holds them on the generator's loose
-// lattice, from the actual size law; any other scene unchanged.
+// The scene with a shear cell given as 0 x 0 (for generated particles)
+// sized for them, from the actual size law: periodic, the smallest square
+// that holds them on the generator's loose lattice; walls, a sample about
+// as wide as tall once the top wall has compacted it (setup.cpp). Any other
+// scene unchanged.
 Scene with_auto_cell(const Scene& s);
 
 // Builds the world; throws SceneError naming the bodies at fault.
