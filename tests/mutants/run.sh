@@ -37,23 +37,8 @@ command -v ccache > /dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 cmake -S "$SRC" -B "$BLD" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" > "$OUT/cmake.log" 2>&1 ||
   { echo "mutants: cmake failed, see $OUT/cmake.log" >&2; exit 1; }
 
-field() { sed -n "s/^$1: //p" "$2" | head -n 1; }
-
-# The anchor's file: the hint if it holds the anchor once, else the one
-# file of the tree that does; empty if none or several.
-locate() {
-  local hint=$1 find=$2 n
-  if [ -f "$SRC/$hint" ]; then
-    n=$(grep -cF -- "$find" "$SRC/$hint")
-    if [ "$n" = 1 ] && [ "$(grep -oF -- "$find" "$SRC/$hint" | wc -l)" = 1 ]; then echo "$hint"; return; fi
-  fi
-  local hits
-  hits=$(cd "$SRC" && grep -rlF -- "$find" cd/src analysis/src 2> /dev/null)
-  if [ "$(printf '%s\n' "$hits" | grep -c .)" = 1 ] &&
-     [ "$(grep -oF -- "$find" "$SRC/$hits" | wc -l)" = 1 ]; then
-    echo "$hits"
-  fi
-}
+# field and locate (the anchor's file), shared with check_anchors.sh.
+. "$ROOT/tests/mutants/anchors.sh"
 
 # Replaces the one occurrence of $FIND by $REPL in the file (exact text).
 apply() {
