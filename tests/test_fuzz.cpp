@@ -346,6 +346,11 @@ struct Mutant {
 // range; the header's step count and time.
 std::vector<Mutant> mutants(const std::string& good) {
   std::vector<Mutant> m;
+  // The first grain (not driven): 2D lists the walls last, 3D the planes first.
+  std::uint64_t grain = 0;
+  for (const CkptArray& a : ckpt_arrays(good))
+    if (a.name == "driven" || a.name == "3d.driven")
+      while (grain + 1 < a.count && good[a.data + grain] != 0) ++grain;
   const auto add = [&](std::string what, std::string b, std::string field) {
     m.push_back({std::move(what), with_checksum(std::move(b)), std::move(field)});
   };
@@ -392,6 +397,12 @@ std::vector<Mutant> mutants(const std::string& good) {
             put_at<double>(b, a.data + e * a.size + slot * 8, x);
             add(a.name + "[" + std::to_string(e) + "] slot " + std::to_string(slot) + " = " + std::to_string(x), b, f);
           }
+      // Absurd but finite: beyond a scene number's bound (1e100).
+      for (std::size_t slot = 0; slot < a.size / 8; ++slot) {
+        b = good;
+        put_at<double>(b, a.data + slot * 8, 1e300);
+        add(a.name + "[0] slot " + std::to_string(slot) + " = 1e300", b, f);
+      }
     }
     const std::string base = a.name.substr(a.name.rfind('.') == 2 ? 3 : 0);  // without "3d."
     for (const std::uint64_t e : {std::uint64_t(0), a.count - 1}) {
@@ -401,6 +412,11 @@ std::vector<Mutant> mutants(const std::string& good) {
       if (base == "radius" || base == "mass" || base == "inertia") {
         put_at<double>(b, at, -1.0);
         add(el + " = -1", b, f);
+        if (e == 0) {  // a grain's size or mass that underflows
+          b = good;
+          put_at<double>(b, a.data + grain * a.size, 1e-300);
+          add(a.name + "[" + std::to_string(grain) + "] = 1e-300", b, f);
+        }
       } else if (base == "shape" || base == "driven") {
         b[at] = 7;
         add(el + " = 7", b, f);
@@ -413,6 +429,12 @@ std::vector<Mutant> mutants(const std::string& good) {
       } else if (base == "vel") {  // inv_m: after vx, vy, w (2D) or v, w (3D)
         put_at<double>(b, at + (a.size == 40 ? 24 : 48), -1.0);
         add(el + ".inv_m = -1", b, f);
+        if (e == 0) {  // a grain's inverse mass that is not 1/mass
+          b = good;
+          const std::size_t inv = a.data + grain * a.size + (a.size == 40 ? 24 : 48);
+          put_at<double>(b, inv, 2 * get_at<double>(good, inv));
+          add(a.name + "[" + std::to_string(grain) + "].inv_m doubled", b, f);
+        }
       } else if (base == "orient") {  // a quaternion of norm 2
         for (int c = 0; c < 4; ++c) put_at<double>(b, at + 8 * c, c == 3 ? 2.0 : 0.0);
         add(el + " of norm 2", b, f);
@@ -429,7 +451,8 @@ std::map<std::string, std::string> folder(const fs::path& d) {
   return f;
 }
 
-void corrupt_systematically(const std::string& label, const std::string& cmd, const fs::path& out) {
+void corrupt_systematically(const std::string& label, const std::string& cmd, const fs::path& out,
+                            const std::vector<Mutant>& more = {}, bool systematic = true) {
   const std::string good = slurp(out / "checkpoint.bin");
   ASSERT_GT(good.size(), kArraysAt + 8);
   ASSERT_EQ(with_checksum(good), good) << "the test's parser does not know the file's frame";
@@ -441,7 +464,8 @@ void corrupt_systematically(const std::string& label, const std::string& cmd, co
     }
   }
   const std::map<std::string, std::string> before = folder(out);
-  const std::vector<Mutant> ms = mutants(good);
+  std::vector<Mutant> ms = systematic ? mutants(good) : std::vector<Mutant>{};
+  ms.insert(ms.end(), more.begin(), more.end());
   for (const Mutant& mu : ms) {
     std::ofstream(out / "checkpoint.bin", std::ios::binary) << mu.bytes;
     const cdtest::CmdResult r = cdtest::run_command(cmd + " --max-steps 1");
@@ -485,6 +509,61 @@ TEST(Fuzz, CheckpointsWithAValidChecksumAreStillValidated3D) {
                           (dir / "out").string();
   ASSERT_EQ(cdtest::run_command(cmd + " --max-steps 20").code, 0);
   corrupt_systematically("3D pile", cmd, dir / "out");
+}
+
+// A periodic cell's state against its grains: lengths the detection cannot
+// grid, a Lees-Edwards offset outside the width (1e20 ran into a crash in
+// the 3D detection), a grain outside the periodic lengths. Each is a state
+// no run leaves; refused by name, nothing written.
+std::vector<Mutant> cell_mutants(const std::string& good, const std::string& cell, std::size_t x_at,
+                                 std::size_t offset_at, const std::string& pos, const std::string& cell_field) {
+  std::vector<Mutant> m;
+  CkptArray c{}, p{};
+  for (const CkptArray& a : ckpt_arrays(good)) {
+    if (a.name == cell) c = a;
+    if (a.name == pos) p = a;
+  }
+  if (c.name.empty() || p.name.empty()) return m;
+  const double L = get_at<double>(good, c.data + x_at);
+  const auto add = [&](std::string what, std::size_t at, double v, std::string field) {
+    std::string b = good;
+    put_at<double>(b, at, v);
+    m.push_back({std::move(what), with_checksum(std::move(b)), std::move(field)});
+  };
+  add("cell width 0", c.data + x_at, 0.0, cell_field);
+  add("cell width 1e-6 of itself", c.data + x_at, 1e-6 * L, cell_field);
+  add("offset 1e20", c.data + offset_at, 1e20, "offset");
+  add("offset -1", c.data + offset_at, -1.0, "offset");
+  add("offset 2 L_x", c.data + offset_at, 2 * L, "offset");
+  add("a grain at x = 3 L_x", p.data, 3 * L, pos);
+  return m;
+}
+
+TEST(Fuzz, CheckpointedCellsAreCheckedAgainstTheirGrains) {
+  const fs::path dir = cdtest::scratch_dir("fuzz", "cells");
+  std::ofstream(dir / "le2.toml") << "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 30\n"
+                                       "[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.1\n"
+                                       "strain = 0.5\ndt_tp = 0.05\n[output]\ncheckpoint_interval = 1e-4\n";
+  const std::string cmd2 = kTimeout + kBin + "/cd/cdsim " + (dir / "le2.toml").string() + " -q --threads 1 --out " +
+                           (dir / "out2").string();
+  ASSERT_EQ(cdtest::run_command(cmd2 + " --max-steps 20").code, 0);
+  const std::string good2 = slurp(dir / "out2" / "checkpoint.bin");
+  // 2D: CellState {width, height, offset, ...}; "cell" names the field.
+  const std::vector<Mutant> more2 = cell_mutants(good2, "cell", 0, 16, "pos", "width");
+  ASSERT_EQ(more2.size(), 6u);
+  corrupt_systematically("2D Lees-Edwards cell", cmd2, dir / "out2", more2, false);
+
+  std::ofstream(dir / "le3.toml") << "name = \"s\"\ndimension = 3\n[gravity]\ng = [0.0, 0.0, 0.0]\n[particles]\n"
+                                       "n = 30\n[shear]\nmode = \"periodic\"\npressure = 1e5\ninertial_number = 0.1\n"
+                                       "strain = 0.5\ndt_tp = 0.05\n[output]\ncheckpoint_interval = 1e-4\n";
+  const std::string cmd3 = kTimeout + kBin + "/cd/cdsim " + (dir / "le3.toml").string() + " -q --threads 1 --out " +
+                           (dir / "out3").string();
+  ASSERT_EQ(cdtest::run_command(cmd3 + " --max-steps 20").code, 0);
+  const std::string good3 = slurp(dir / "out3" / "checkpoint.bin");
+  // 3D: "3d.cell" {L_x, L_y, L_z, offset, ...}.
+  const std::vector<Mutant> more3 = cell_mutants(good3, "3d.cell", 0, 24, "3d.pos", "3d.cell");
+  ASSERT_EQ(more3.size(), 6u);
+  corrupt_systematically("3D Lees-Edwards cell", cmd3, dir / "out3", more3, false);
 }
 
 // cdanalysis on damaged series and snapshots; cdproblem on damaged problems.

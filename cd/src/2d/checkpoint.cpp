@@ -1,5 +1,6 @@
 #include "checkpoint.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cstring>
@@ -66,6 +67,10 @@ void check_bodies(const ckpt::Reader& in, const Bodies& b) {
     in.non_negative("vel", i, "inv_I", v.inv_I, !b.driven[i]);
     if (b.driven[i] && (v.inv_m != 0 || v.inv_I != 0))
       in.bad("vel", i, "inv_m", "is not 0 for a driven body");
+    if (!b.driven[i]) {
+      in.inverse("vel", i, "inv_m", v.inv_m, b.mass[i], "mass");
+      in.inverse("vel", i, "inv_I", v.inv_I, b.inertia[i], "inertia");
+    }
     in.finite("pos", i, "x", b.pos[i].x());
     in.finite("pos", i, "y", b.pos[i].y());
     in.finite("angle", i, "", b.angle[i]);
@@ -74,13 +79,45 @@ void check_bodies(const ckpt::Reader& in, const Bodies& b) {
   }
 }
 
-void check_cell(const ckpt::Reader& in, const CellState& c) {
+// The cell's numbers, and the cell against the grains it holds, as the
+// scene's cell is checked (the state a run left: lengths that the detection
+// can grid, the grains inside the periodic lengths, the Lees-Edwards offset
+// within the width).
+void check_cell(const ckpt::Reader& in, const CellState& c, const Bodies& b, const WorldParams& p) {
   in.non_negative("cell", 0, "width", c.width);
   in.non_negative("cell", 0, "height", c.height);
   in.finite("cell", 0, "offset", c.offset);
   in.finite("cell", 0, "hdot", c.hdot);
   in.finite("cell", 0, "wdot", c.wdot);
   in.finite("cell", 0, "strain", c.strain);
+  const CellParams::Mode mode = p.cell.mode;
+  if (mode == CellParams::Mode::None) return;
+  const bool le = mode == CellParams::Mode::LeesEdwards;
+  double r_max = 0.0;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    if (b.shape[i] != Shape::Segment) r_max = std::max(r_max, b.radius[i]);
+  // The detection's grid needs 4 (x) and 3 (y, Lees-Edwards) times 2 r_max
+  // plus the alert distance; without it (the least any scene asks):
+  const double h = 2 * r_max;
+  if (!(c.width >= 4 * h))
+    in.bad("cell", 0, "width", fmt::format("is {:.6g} m: the periodic width must be at least 4 x 2 r_max = {:.6g} m "
+                                          "for these grains", c.width, 4 * h));
+  if (le && !(c.height >= 3 * h))
+    in.bad("cell", 0, "height", fmt::format("is {:.6g} m: the periodic height must be at least 3 x 2 r_max = {:.6g} m "
+                                           "for these grains", c.height, 3 * h));
+  if (!(c.offset >= 0 && c.offset <= c.width))
+    in.bad("cell", 0, "offset", fmt::format("is {:.6g} m (the Lees-Edwards offset is within [0, width = {:.6g}])",
+                                           c.offset, c.width));
+  // A step ends with every grain wrapped into the periodic lengths.
+  const double tol = 1e-9 * std::max(c.width, c.height);
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.shape[i] == Shape::Segment || b.driven[i]) continue;
+    if (!(b.pos[i].x() >= -tol && b.pos[i].x() <= c.width + tol))
+      in.bad("pos", i, "x", fmt::format("is {:.6g} m, outside the periodic width [0, {:.6g}]", b.pos[i].x(), c.width));
+    if (le && !(b.pos[i].y() >= -tol && b.pos[i].y() <= c.height + tol))
+      in.bad("pos", i, "y",
+             fmt::format("is {:.6g} m, outside the periodic height [0, {:.6g}]", b.pos[i].y(), c.height));
+  }
 }
 
 constexpr ckpt::WorldFile kFile{2, "warm.keys", "warm.p"};
@@ -96,11 +133,11 @@ void save_checkpoint(const std::string& path, const World& w, std::uint64_t scen
 std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* totals) {
   return ckpt::load_world(
       path, w, kFile, kBodiesArrays, totals, check_bodies,
-      [](ckpt::Reader& in) {
+      [&](ckpt::Reader& in, const Bodies& b) {
         std::vector<CellState> cell;
         in.array("cell", cell);
         if (cell.size() != 1) in.fail(fmt::format("is corrupt: 'cell' holds {} elements (must be 1)", cell.size()));
-        check_cell(in, cell[0]);
+        check_cell(in, cell[0], b, w.params());
         return cell[0];
       },
       [](World& w, const CellState& c) { w.cell = c; });

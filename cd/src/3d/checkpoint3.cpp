@@ -1,5 +1,6 @@
 #include "checkpoint3.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <tuple>
@@ -61,6 +62,10 @@ void check_bodies3(const ckpt::Reader& in, const Bodies3& b) {
     in.non_negative("3d.vel", i, "inv_I", v.inv_I, !b.driven[i]);
     if (b.driven[i] && (v.inv_m != 0 || v.inv_I != 0))
       in.bad("3d.vel", i, "inv_m", "is not 0 for a driven body");
+    if (!b.driven[i]) {
+      in.inverse("3d.vel", i, "inv_m", v.inv_m, b.mass[i], "mass");
+      in.inverse("3d.vel", i, "inv_I", v.inv_I, b.inertia[i], "inertia");
+    }
     vec("3d.pos", i, b.pos[i]);
     const Quat& q = b.orient[i];
     for (int c = 0; c < 4; ++c) in.finite("3d.orient", i, std::string(1, "xyzw"[c]), q.coeffs()[c]);
@@ -68,6 +73,32 @@ void check_bodies3(const ckpt::Reader& in, const Bodies3& b) {
     if (!(std::abs(q.norm() - 1) < 1e-9))
       in.bad("3d.orient", i, "", fmt::format("has norm {:.6g} (an orientation is a unit quaternion)", q.norm()));
   }
+}
+
+// The cell against the spheres it holds, as the scene's cell is checked:
+// every periodic length at least 2 x 2 r_max (the detection's grid needs
+// the alert distance on top: the least any scene asks), the spheres inside the periodic lengths (a step ends with them
+// wrapped in), the Lees-Edwards offset within L_x.
+void check_cell3(const ckpt::Reader& in, const CellState3& c, const Bodies3& b, const WorldParams3& p) {
+  double r_max = 0.0;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    if (b.shape[i] == Shape3::Sphere) r_max = std::max(r_max, b.radius[i]);
+  const double lmin = 2 * (2 * r_max);
+  for (int a = 0; a < 3; ++a) {
+    if (!p.periodic[a]) continue;
+    if (!(c.size[a] >= lmin))
+      in.bad("3d.cell", a, std::string(1, "xyz"[a]),
+             fmt::format("is {:.6g} m: a periodic length must be at least 2 x 2 r_max = {:.6g} m for these spheres",
+                         c.size[a], lmin));
+    const double tol = 1e-9 * c.size[a];
+    for (std::size_t i = 0; i < b.size(); ++i)
+      if (b.shape[i] == Shape3::Sphere && !b.driven[i] && !(b.pos[i][a] >= -tol && b.pos[i][a] <= c.size[a] + tol))
+        in.bad("3d.pos", i, std::string(1, "xyz"[a]),
+               fmt::format("is {:.6g} m, outside the periodic length [0, {:.6g}]", b.pos[i][a], c.size[a]));
+  }
+  if (p.periodic[0] && !(c.le_offset >= 0 && c.le_offset <= c.size.x()))
+    in.bad("3d.cell", 3, "", fmt::format("is {:.6g} m (the Lees-Edwards offset is within [0, L_x = {:.6g}])",
+                                        c.le_offset, c.size.x()));
 }
 
 constexpr ckpt::WorldFile kFile{3, "3d.warm.keys", "3d.warm.p"};
@@ -88,7 +119,7 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
 std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals) {
   return ckpt::load_world(
       path, w, kFile, kBodies3Arrays, totals, check_bodies3,
-      [&](ckpt::Reader& in) {
+      [&](ckpt::Reader& in, const Bodies3& b) {
         std::vector<double> cell;
         in.array("3d.cell", cell);
         // 7 numbers: written before the cell had rates and a strain (both 0).
@@ -106,11 +137,12 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
         c.le_offset = cell[3];
         c.rate = cell.size() == 11 ? Vec3(cell[7], cell[8], cell[9]) : Vec3::Zero();
         c.strain = cell.size() == 11 ? cell[10] : 0.0;
+        check_cell3(in, c, b, p);
         try {
           World3 probe(p);  // checks the cell without touching w
           probe.set_cell(c);
         } catch (const std::invalid_argument& e) {
-          in.fail(fmt::format("holds a cell this scene cannot take ({})", e.what()));
+          in.fail(fmt::format("is corrupt: '3d.cell' holds a cell this scene cannot take ({})", e.what()));
         }
         return c;
       },

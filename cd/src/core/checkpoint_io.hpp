@@ -152,15 +152,29 @@ struct Reader {
                         const std::string& why) const {
     fail(fmt::format("is corrupt: '{}' element {}{}{} {}", array, i, field.empty() ? "" : " ", field, why));
   }
+  // Finite and at most kMaxMagnitude in magnitude, a scene number's bound
+  // (docs/errors.md): a state the scene rules would refuse is refused from
+  // a checkpoint too (an offset or a speed of 1e300 runs into overflow).
+  static constexpr double kMaxMagnitude = 1e100, kMinPositive = 1e-100;
   void finite(std::string_view array, std::size_t i, std::string_view field, double x) const {
     if (!std::isfinite(x)) bad(array, i, field, fmt::format("is {} (must be finite)", x));
+    if (!(std::abs(x) <= kMaxMagnitude))
+      bad(array, i, field, fmt::format("is {:.17g} (at most 1e+100 in magnitude, as a scene's numbers)", x));
   }
-  // Finite and >= 0 (> 0 if `positive`).
+  // Finite and >= 0 (if `positive`, at least kMinPositive: a size, mass or
+  // inertia that small makes a grain of zero mass or infinite inverse).
   void non_negative(std::string_view array, std::size_t i, std::string_view field, double x,
                     bool positive = false) const {
     finite(array, i, field, x);
-    if (positive ? !(x > 0) : !(x >= 0))
-      bad(array, i, field, fmt::format("is {:.6g} (must be {} 0)", x, positive ? ">" : ">="));
+    if (positive ? !(x >= kMinPositive) : !(x >= 0))
+      bad(array, i, field, fmt::format("is {:.6g} (must be {})", x, positive ? ">= 1e-100" : ">= 0"));
+  }
+  // A dynamic body's inverse mass (inertia) is 1 / its mass (inertia), as
+  // the bodies are made: to round-off.
+  void inverse(std::string_view array, std::size_t i, std::string_view field, double inv, double x,
+               std::string_view of) const {
+    if (!(std::abs(inv * x - 1.0) <= 1e-9))
+      bad(array, i, field, fmt::format("is {:.17g}, but 1/{} is {:.17g} (it must be the inverse)", inv, of, 1.0 / x));
   }
 };
 

@@ -36,8 +36,9 @@ void save_world(const std::string& path, const World& w, const WorldFile& f, con
 }
 
 // Reads a checkpoint into w: the bodies by `table`, checked by
-// check_bodies(in, bodies); the warm start, checked; read_own(in) reads
-// and checks the engine's own arrays and returns them; then the totals and
+// check_bodies(in, bodies); the warm start, checked; read_own(in, bodies)
+// reads and checks the engine's own arrays (against the bodies: the cell
+// holds them) and returns them; then the totals and
 // the body count. Only then is w changed: bodies, clock, timers, warm
 // start, and apply_own(w, own) (which must not throw). Returns the scene
 // key; with `totals`, also the run's totals.
@@ -55,7 +56,7 @@ std::uint64_t load_world(const std::string& path, World& w, const WorldFile& f, 
   in.array(f.warm_keys, warm.keys);
   in.array(f.warm_p, warm.p);
   check_warm(in, f.warm_keys, warm.keys, f.warm_p, warm.p);
-  auto own = read_own(in);
+  auto own = read_own(in, std::as_const(b));
   const RunTotals tot = close(in, h);
   check_count(in, b.size(), w.bodies.size());
 
