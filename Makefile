@@ -72,6 +72,7 @@ help:
 	@echo "  make campaign-pressure-ladder   the same from the lowest p up, each from the point below"
 	@echo "  make validate-angularity        the polygon study's shapes at VAL_I in the bi-periodic cell into VALIDATE"
 	@echo "  make validate-angularity-walls  the same between rough walls (the study's protocol) into VALIDATE"
+	@echo "  make validation-tables          their finished runs' rows into tests/data/validation/"
 	@echo "                                  (N = VAL_N, size ratio 4; hours a shape; docs/shear.md, Campaigns)"
 	@echo "  make campaign-status [CAMPAIGN=inertial]  each run: done / running / not started / failed / stopped,"
 	@echo "                       its progress, cost (CPU, steps) and ETA (every campaign in CAMPAIGNS unless CAMPAIGN)"
@@ -568,6 +569,14 @@ validate-angularity: programs
 # rough walls (campaign-walls), into $(VALIDATE)/walls.
 validate-angularity-walls: programs
 	+$(MAKE) --no-print-directory $(val_vars) campaign-walls
+# The committed tables of both (tests/data/validation/README.md): a row per
+# finished run, the same window for every shape (strain 1 to VAL_STRAIN).
+.PHONY: validation-tables
+validation-tables: programs
+	for p in periodic walls; do t=$(VALIDATION_DATA)/angularity-$$p.csv; \
+	  cd/campaign/validation_table.sh $(CDA) $$p $(VALIDATE) 1:$(VAL_STRAIN) > $$t.tmp && mv $$t.tmp $$t || \
+	  { rm -f $$t.tmp; exit 1; }; done
+VALIDATION_DATA := tests/data/validation
 
 # ---- Frozen dense-shear problems (tests/data/frozen-shear) -------------------
 # Steady bi-periodic shear of N disks (ns_0) and hexagons (ns_6) at p = P,

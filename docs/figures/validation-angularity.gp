@@ -8,7 +8,8 @@
 #   docs/figures/angularity.csv (`cdanalysis fit angularity`, docs/analysis.md):
 #     N = 300, d_max/d_min = 2, I = 0.01, solver.tol 1e-4, with the fit
 #     mu*(alpha) = mu0 + (mu1 - mu0)(1 - exp(-alpha/alpha_c)) given there;
-#   tests/data/validation/angularity-periodic.csv (`make validate-angularity`):
+#   tests/data/validation/angularity-periodic.csv (`make validate-angularity`,
+#     its columns those of `cdanalysis fit angularity`):
 #     N = 1000, d_max/d_min = 4, I = 1e-3, window 1-3; one row per finished
 #     shape, so the figure grows as the campaign's rows are added.
 if (!exists("study")) study = 'docs/figures/angularity.csv'
@@ -32,13 +33,13 @@ set key top left
 mu0 = 0.296; mu1 = 0.480; ac = 1.16
 plot mu0 + (mu1 - mu0)*(1 - exp(-x/ac)) with lines lw 2 lc rgb '#1f3b73' title 'fit, N = 300, I = 0.01', \
      study using (column("alpha")):(column("mu")):(column("mu_err")) with yerrorbars pt 7 ps 1.2 lc rgb 'black' title 'N = 300, r = 2, I = 0.01', \
-     val using (alpha(column("ns"))):(column("q_over_p")):(column("q_over_p_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}'
+     val using (column("alpha")):(column("mu")):(column("mu_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}'
 set ylabel "packing fraction φ"
 set yrange [0.77:0.83]
 set key top right
 plot study using (column("alpha")):(column("nu")):(column("nu_err")) with yerrorbars pt 7 ps 1.2 lc rgb 'black' title 'N = 300, r = 2, I = 0.01', \
-     val using (alpha(column("ns"))):(column("phi")):(column("phi_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}'
-set ylabel "anisotropy (N = 300, I = 0.01)"
+     val using (column("alpha")):(column("nu")):(column("nu_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}'
+set ylabel "anisotropy (black, blue, red: N = 300; open: N = 1000)"
 set yrange [0:0.6]
 set key top left
 plot study using (column("alpha")):(column("a_c")):(column("a_c_err")) with yerrorbars pt 7 ps 1.2 lc rgb 'black' title 'a_c', \
@@ -46,5 +47,8 @@ plot study using (column("alpha")):(column("a_c")):(column("a_c_err")) with yerr
      study using (column("alpha")):(column("a_fn")):(column("a_fn_err")) with yerrorbars pt 9 ps 1.2 lc rgb '#1f3b73' title 'a_{fn}', \
      study using (column("alpha")):(column("a_fn")) with lines lc rgb '#1f3b73' notitle, \
      study using (column("alpha")):(column("a_ft")):(column("a_ft_err")) with yerrorbars pt 5 ps 1.2 lc rgb '#b03a2e' title 'a_{ft}', \
-     study using (column("alpha")):(column("a_ft")) with lines lc rgb '#b03a2e' notitle
+     study using (column("alpha")):(column("a_ft")) with lines lc rgb '#b03a2e' notitle, \
+     val using (column("alpha")):(column("a_c")):(column("a_c_err")) with yerrorbars pt 6 ps 1.4 lc rgb 'black' title 'a_c, N = 1000', \
+     val using (column("alpha")):(column("a_fn")):(column("a_fn_err")) with yerrorbars pt 8 ps 1.4 lc rgb '#1f3b73' title 'a_{fn}, N = 1000', \
+     val using (column("alpha")):(column("a_ft")):(column("a_ft_err")) with yerrorbars pt 4 ps 1.4 lc rgb '#b03a2e' title 'a_{ft}, N = 1000'
 unset multiplot

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# The rows of a validation table (tests/data/validation/): one per finished
+# run (summary.toml status "done") of a validation campaign folder, each
+# value a steady mean over the same strain window for every shape, with its
+# standard error, and the run's cost from its summary.toml.
+#
+#   cd/campaign/validation_table.sh CDANALYSIS periodic|walls CAMPAIGN WINDOW > TABLE.csv
+#
+# periodic (CAMPAIGN/angularity/ns_*): `cdanalysis fit angularity --window
+#   WINDOW --snapshots 10` over the finished runs: mu (= mu* = q/p), nu, z,
+#   the anisotropies, the sliding and side-side shares, the partial
+#   strengths and the stress-fabric check (docs/analysis.md), every column
+#   of its angularity.csv but its run index;
+# walls (CAMPAIGN/walls/ns_*): the bulk's (the central half of the gap,
+#   docs/shear.md) q/p, mu = -sigma_xy/sigma_yy, packing fraction and z,
+#   and the top wall's mu, each `cdanalysis steady --window WINDOW`.
+# Both then give protocol, ns, N, I, strain (the run's end), window and, at
+# the end, cpu_s, sweeps_mean and build (cdlab_version) of each run.
+set -euo pipefail
+CDA=$1 PROTOCOL=$2 CAMPAIGN=$3 WINDOW=$4
+case "$PROTOCOL" in
+  periodic) DIR=$CAMPAIGN/angularity ;;
+  walls) DIR=$CAMPAIGN/walls ;;
+  *) echo "validation_table.sh: protocol '$PROTOCOL': periodic or walls" >&2; exit 2 ;;
+esac
+runs=()
+for r in $(ls -d "$DIR"/ns_* 2> /dev/null | sort -t_ -k2 -n); do
+  grep -qs '^status = "done"' "$r/summary.toml" && runs+=("$r")
+done
+[ ${#runs[@]} -gt 0 ] || { echo "validation_table.sh: no finished run in $DIR" >&2; exit 1; }
+
+value() { sed -n "s/^$1 *= *\"\{0,1\}\([^\" ]*\).*/\1/p" "$2" | head -n 1; }  # key = value of a TOML file
+# N: the scene's particles.n, or its sample's (a run started from prep/ns_<n>).
+grains() {
+  local n; n=$(value n "$1/scene.toml")
+  [ "$n" != 0 ] && { echo "$n"; return; }
+  value n "$CAMPAIGN/prep/$(basename "$1")/scene.toml"
+}
+provenance() {  # protocol,ns,N,I,strain,window
+  echo "$PROTOCOL,${1##*_},$(grains "$1"),$(value inertial_number "$1/scene.toml"),$(value strain "$1/scene.toml"),$WINDOW"
+}
+cost() { echo "$(value cpu_time "$1/summary.toml"),$(value sweeps_mean "$1/summary.toml"),$(value cdlab_version "$1/summary.toml")"; }
+
+if [ "$PROTOCOL" = periodic ]; then
+  out=$(mktemp -d)
+  trap 'rm -rf "$out"' EXIT
+  # The table is written before the fit of mu*(alpha), which needs 3 shapes.
+  "$CDA" fit angularity "${runs[@]}" --window "$WINDOW" --snapshots 10 --out "$out" > "$out/log" 2>&1 || true
+  [ -s "$out/angularity.csv" ] || { cat "$out/log" >&2; exit 1; }
+  head -n 1 "$out/angularity.csv" | sed 's/^run,nsides,/protocol,ns,N,I,strain,window,/; s/$/,cpu_s,sweeps_mean,build/'
+  i=0
+  tail -n +2 "$out/angularity.csv" | while IFS= read -r row; do
+    r=${runs[$i]}
+    echo "$(provenance "$r"),${row#*,*,},$(cost "$r")"
+    i=$((i + 1))
+  done
+else
+  cols="bulk_q_over_p bulk_mu bulk_packing_fraction bulk_z wall_mu"
+  head="protocol,ns,N,I,strain,window"
+  for c in $cols; do head="$head,$c,${c}_err"; done
+  echo "$head,cpu_s,sweeps_mean,build"
+  for r in "${runs[@]}"; do
+    line=$(provenance "$r")
+    for c in $cols; do
+      m=$("$CDA" steady "$r" --column "$c" --window "$WINDOW" | awk '$1 == "mean" { print $2 "," $4 }')
+      [ -n "$m" ] || { echo "validation_table.sh: no steady mean of $c in $r" >&2; exit 1; }
+      line="$line,$m"
+    done
+    echo "$line,$(cost "$r")"
+  done
+fi
