@@ -70,17 +70,19 @@ help:
 	@echo "  make campaign-walls             the same shapes between rough walls (the walls protocol, 2D)"
 	@echo "  make campaign-pressure          steady shear at PRESSURE_I under each p of PRESSURE_P"
 	@echo "  make campaign-pressure-ladder   the same from the lowest p up, each from the point below"
+	@echo "  make campaign-volume            steady shear at imposed volume at each packing fraction of VOLUME_PHI,"
+	@echo "                                  at the rate VOLUME_RATE_TP / t_p (p and I measured)"
 	@echo "  make validate-angularity        the polygon study's shapes at VAL_I in the bi-periodic cell into VALIDATE"
+	@echo "                                  (N = VAL_N, size ratio 4; hours a shape; docs/shear.md, Campaigns)"
 	@echo "  make validate-angularity-walls  the same between rough walls (the study's protocol) into VALIDATE"
 	@echo "  make validation-tables          their finished runs' rows into tests/data/validation/"
-	@echo "                                  (N = VAL_N, size ratio 4; hours a shape; docs/shear.md, Campaigns)"
 	@echo "  make campaign-status [CAMPAIGN=inertial]  each run: done / running / not started / failed / stopped,"
 	@echo "                       its progress, cost (CPU, steps) and ETA (every campaign in CAMPAIGNS unless CAMPAIGN)"
 	@echo "  (each campaign folder's manifest.toml holds what made it: make refuses to add runs made with another"
 	@echo "   N, STRAIN, P, ... to it, naming the difference; docs/shear.md, \"What made a campaign\")"
 	@echo "Analyses of CAMPAIGNS/<name> into outputs/analysis[3d]/<name>/ (docs/analysis.md)"
 	@echo "  make analyze-inertial, analyze-inertial-ladder, analyze-cohesive, analyze-angularity"
-	@echo "  make analyze-pressure, analyze-pressure-ladder   cdanalysis report and the campaign's fits"
+	@echo "  make analyze-pressure, analyze-pressure-ladder, analyze-volume   cdanalysis report and the campaign's fits"
 	@echo "Used by the targets above and by scripts"
 	@echo "  make programs        build cdsim, cdanalysis and cdproblem only (what the campaigns run)"
 	@echo "  make campaign-list CAMPAIGN=inertial      the run folders of a campaign (configs/cluster/job-array.sh)"
@@ -122,6 +124,8 @@ help:
 	$(call help_var,VAL_STRAIN,its strain)
 	$(call help_var,PRESSURE_P,pressures of campaign-pressure[-ladder])
 	$(call help_var,PRESSURE_I,their inertial number)
+	$(call help_var,VOLUME_PHI,packing fractions of campaign-volume (defaults below jamming: 2D or 3D))
+	$(call help_var,VOLUME_RATE_TP,its shear rate in units of 1/t_p at P (shear.rate_tp: the nominal I))
 	$(call help_var,CKPT_STRAIN,checkpoint every this much strain)
 	$(call help_var,CKPT_WALL,and every this many seconds of wall clock)
 	$(call help_var,PROGRESS,seconds of wall clock between the progress lines of a campaign run)
@@ -381,7 +385,7 @@ campaign-list:
 # (cd/campaign/status.sh), of CAMPAIGN or of every campaign in CAMPAIGNS.
 inertial-ladder_runs = $(ladder_runs)
 pressure-ladder_runs = $(pressure_ladder_runs)
-status_campaigns = $(or $(CAMPAIGN),$(foreach c,inertial inertial-ladder cohesive angularity walls pressure pressure-ladder,\
+status_campaigns = $(or $(CAMPAIGN),$(foreach c,inertial inertial-ladder cohesive angularity walls pressure pressure-ladder volume,\
   $(if $(wildcard $(CAMPAIGNS)/$(c)),$(c))))
 prep_runs = $(CAMPAIGNS)/prep/ns_0 $(if $(filter angularity,$(status_campaigns)),$(filter-out %/ns_0,\
   $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/prep/ns_$(n))))
@@ -422,13 +426,15 @@ manifest_record_walls := ANGULAR_NS
 manifest_keys_pressure := STRAIN SHEAR_TOL SHEAR_SET PRESSURE_I
 manifest_record_pressure := PRESSURE_P
 manifest_keys_pressure-ladder := LADDER_STRAIN SHEAR_TOL SHEAR_SET PRESSURE_I PRESSURE_P
+manifest_keys_volume := STRAIN SHEAR_TOL SHEAR_SET VOLUME_RATE_TP
+manifest_record_volume := VOLUME_PHI
 sample_keys := DIM N P SIZE_RATIO SIZE_DIST PREP_SET
 tolerance_policy = $(if $(SHEAR_TOL),solver.tol = $(SHEAR_TOL) and residual_tol = 0 for every run (SHEAR_TOL),by I: cdsim's shear policy (docs/shear.md, Settings by I))
 make_dry = $(if $(findstring n,$(firstword -$(MAKEFLAGS))),1,0)
 # `+`: checked under make -n too (which writes nothing). A static pattern
 # rule: an implicit rule's product would be an intermediate file, which make
 # does not make when the runs after it are done (so no refusal then).
-manifest_checks := $(foreach c,prep inertial inertial-ladder cohesive angularity walls pressure pressure-ladder,\
+manifest_checks := $(foreach c,prep inertial inertial-ladder cohesive angularity walls pressure pressure-ladder volume,\
   $(CAMPAIGNS)/$(c)/.manifest-check)
 $(manifest_checks): $(CAMPAIGNS)/%/.manifest-check:
 	+@cd/campaign/manifest.sh $(@D)/manifest.toml $(make_dry) \
@@ -513,6 +519,28 @@ $(CAMPAIGNS)/pressure/p_%/.done: $(CAMPAIGNS)/prep/ns_0/.done | $(CAMPAIGNS)/pre
 	touch $@
 $(CAMPAIGNS)/pressure-ladder/p_%/.done: $$(call pressure_start,$$*)/.done | $(CAMPAIGNS)/pressure-ladder/.manifest-check
 	$(call pressure_run,$*,$(call pressure_start,$*),$(LADDER_STRAIN))
+	touch $@
+
+# The volume series (make campaign-volume): steady shear at imposed volume
+# (shear.control = "volume": the cell's lengths held, p and I measured) at
+# each packing fraction of VOLUME_PHI, every run from the sample compacted at
+# P, its cell scaled to that fraction (shear.volume_fraction). The rate is
+# given in units of 1/t_p, t_p = d sqrt(rho/P) (shear.rate_tp): cdsim turns
+# it into 1/s and chooses the "auto" settings at the nominal I =
+# VOLUME_RATE_TP, so the campaign at another P takes the same steps and
+# settings. The defaults lie below jamming, where the measured phi(I) of
+# the reference campaigns put I at about 0.2 (2D; 3D 0.3) down to 0.04
+# (docs/shear.md, "Volume series"); VOLUME_RATE_TP is about the smallest of
+# those I, so that the step (0.05 t_p at P) stays within 0.05 of the t_p of
+# the pressure each run measures.
+VOLUME_PHI ?= $(if $(dim3),0.55 0.56 0.57 0.58 0.59,0.76 0.77 0.78 0.79 0.8)
+VOLUME_RATE_TP ?= 0.03
+volume_runs := $(foreach f,$(VOLUME_PHI),$(CAMPAIGNS)/volume/phi_$(f))
+.PHONY: campaign-volume
+campaign-volume: $(addsuffix /.done,$(volume_runs))
+$(CAMPAIGNS)/volume/phi_%/.done: $(CAMPAIGNS)/prep/ns_0/.done | $(CAMPAIGNS)/volume/.manifest-check
+	$(call shear_run,0,0) --set shear.control='"volume"' --set shear.rate_tp=$(VOLUME_RATE_TP) \
+	  --set shear.volume_fraction=$*
 	touch $@
 
 # eta_<eta>_I_<I>: f_a = eta p d (3D: eta p d^2); eta = 0 are the reference runs of the fit.
@@ -773,6 +801,14 @@ analyze-cohesive: build
 analyze-pressure analyze-pressure-ladder: analyze-%: build
 	@$(ANALYZE) "$(CDA) report $(CAMPAIGNS)/$* --out $(ANALYSIS)/$*" \
 	  "$(CDA) fit compaction $(CAMPAIGNS)/$* $(fit_window) --out $(ANALYSIS)/$*/compaction --toml $(ANALYSIS)/$*/compaction.toml"
+
+# Volume series: p and I measured at each phi; mu(I) and phi(I) as from the
+# pressure-controlled campaigns (fit nu-i fits phi = phi_c - a I with phi exact).
+.PHONY: analyze-volume
+analyze-volume: build
+	@$(ANALYZE) "$(CDA) report $(CAMPAIGNS)/volume --out $(ANALYSIS)/volume" \
+	  "$(CDA) fit mu-i $(CAMPAIGNS)/volume $(fit_window) --out $(ANALYSIS)/volume/mu_I --toml $(ANALYSIS)/volume/mu_i.toml" \
+	  "$(CDA) fit nu-i $(CAMPAIGNS)/volume $(fit_window) --out $(ANALYSIS)/volume/nu_i --toml $(ANALYSIS)/volume/nu_i.toml"
 
 analyze-inertial-ladder: build
 	@$(ANALYZE) "$(CDA) report $(CAMPAIGNS)/inertial-ladder --out $(ANALYSIS)/inertial-ladder" \

@@ -39,7 +39,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
                max_iter, residual_tol, anderson, subspace, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, region,
                box_width, box_height, box_depth, disks, walls, series_interval, snapshot_interval, series_strain, snapshot_strain,
                checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, cell_depth, shear_control, pressure,
-               imposed_rate, volume_fraction, inertial_number, cell_mass, isotropic, compaction_rate, settle_stress, settle_phi, settle_time, strain, dt_tp, start, cohesion_number, stiffness_number, stiffness_ratio] = x;
+               imposed_rate, rate_tp, volume_fraction, inertial_number, cell_mass, isotropic, compaction_rate, settle_stress, settle_phi, settle_time, strain, dt_tp, start, cohesion_number, stiffness_number, stiffness_ratio] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dimension); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(mu_b); CHECK_FIELD(mu_wall_b); CHECK_FIELD(axis_a); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
@@ -52,7 +52,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(checkpoint_interval); CHECK_FIELD(checkpoint_strain); CHECK_FIELD(checkpoint_wall);
   CHECK_FIELD(quiet);
   CHECK_FIELD(shear_mode); CHECK_FIELD(cell_width); CHECK_FIELD(cell_height); CHECK_FIELD(cell_depth); CHECK_FIELD(shear_control); CHECK_FIELD(pressure);
-  CHECK_FIELD(imposed_rate); CHECK_FIELD(volume_fraction);
+  CHECK_FIELD(imposed_rate); CHECK_FIELD(rate_tp); CHECK_FIELD(volume_fraction);
   CHECK_FIELD(inertial_number); CHECK_FIELD(cell_mass); CHECK_FIELD(isotropic); CHECK_FIELD(compaction_rate);
   CHECK_FIELD(settle_stress); CHECK_FIELD(settle_phi); CHECK_FIELD(settle_time); CHECK_FIELD(strain);
   CHECK_FIELD(dt_tp); CHECK_FIELD(start); CHECK_FIELD(cohesion_number); CHECK_FIELD(stiffness_number); CHECK_FIELD(stiffness_ratio);
@@ -122,6 +122,7 @@ Scene nondefault() {
   s.shear_control = cd::ShearControl::Volume;
   s.pressure = 100.0;
   s.imposed_rate = 12.5;
+  s.rate_tp = 0.02;
   s.volume_fraction = 0.7;
   s.inertial_number = 0.01;
   s.cell_mass = 2.0;
@@ -399,9 +400,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 67 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 68 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 67u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 68u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

@@ -22,7 +22,9 @@
 #include "checkpoint3.hpp"
 #include "cli_util.hpp"
 #include "config.hpp"
+#include "derived.hpp"
 #include "observables.hpp"
+#include "protocol.hpp"
 #include "run_plan.hpp"
 #include "setup.hpp"
 #include "setup3.hpp"
@@ -257,8 +259,13 @@ TEST(VolumeControl, KeysOfTheOtherControlAreRefusedByName) {
       {text(v + "isotropic = true\npressure = 100.0\n"), "shear.isotropic"},
       {text(v + "compaction_rate = 0.1\npressure = 100.0\n"), "shear.compaction_rate"},
       {text(v + "volume_fraction = 0.8\n"), "shear.start"},
-      {text(v + "strain = 1.0\n"), "shear.rate > 0"},
+      {text(v + "strain = 1.0\n"), "shear.rate or shear.rate_tp > 0"},
       {text(p + "rate = 10.0\n"), "shear.rate"},
+      {text(p + "rate_tp = 0.01\n"), "shear.rate_tp"},
+      {text(v + "rate = 10.0\nrate_tp = 0.01\npressure = 100.0\n"), "give one"},
+      {text(v + "rate_tp = 0.01\n"), "shear.rate_tp = 0.01 is the shear rate in units of 1/t_p"},
+      {text(v + "rate_tp = 0.01\n", 3), "shear.rate_tp = 0.01 is the shear rate in units of 1/t_p"},
+      {"[gravity]\ng = [0.0, -9.81]\n[particles]\nn = 10\n[shear]\nrate_tp = 0.01\n", "shear.rate_tp"},
       {text(p + "volume_fraction = 0.8\n"), "shear.control = \"volume\""},
       {text("control = \"volume\"\nwidth = 0.02\nheight = 0.02\n", 2, "", "walls"), "shear.mode = \"periodic\""},
       {text("control = \"volume\"\ninertial_number = 0.1\npressure = 1e5\n", 3), "shear.inertial_number"},
@@ -275,6 +282,36 @@ TEST(VolumeControl, KeysOfTheOtherControlAreRefusedByName) {
   const cd::Scene s = cd::parse_scene(text(v + "rate = 100.0\npressure = 100.0\n", 2, "[solver]\ntol = \"auto\"\n"), "a.toml");
   const double tp = 1e-3 * std::sqrt(2.6 / 100.0);
   EXPECT_EQ(s.tol, cd::shear_settings(100.0 * tp, cd::Acceleration::None, {2, false, false}).tol);
+}
+
+// shear.rate_tp gives the rate in units of 1/t_p at the pressure scale:
+// gamma-dot = rate_tp / t_p, t_p = d sqrt(rho/p) computed here from the
+// scene's d, rho and p, and the "auto" settings at the nominal I = rate_tp;
+// at another p the same rate_tp keeps the steps per unit strain (the step
+// and the rate both scale with t_p) and the settings.
+TEST(VolumeControl, RateInUnitsOfOneOverTp) {
+  const std::string v = "control = \"volume\"\nwidth = 0.02\nheight = 0.02\n";
+  const std::string autos = "[solver]\ntol = \"auto\"\n";
+  for (const double p : {100.0, 1e4}) {
+    const std::string shear = v + fmt::format("rate_tp = 0.2\npressure = {}\ndt_tp = \"auto\"\n", p);
+    const cd::Scene s = cd::parse_scene(text(shear, 2, autos), "r.toml");
+    const double tp = 1e-3 * std::sqrt(2.6 / p);
+    EXPECT_NEAR(cd::shear_rate(s), 0.2 / tp, 1e-12 * 0.2 / tp) << p;
+    EXPECT_NEAR(cd::nominal_inertial_number(s), 0.2, 1e-15) << p;
+    const cd::ShearSettings set = cd::shear_settings(0.2, cd::Acceleration::None, {2, false, false});
+    EXPECT_EQ(s.tol, set.tol) << p;
+    EXPECT_EQ(s.dt_tp, set.dt_tp) << p;
+    // strain per step = gamma-dot dt = rate_tp dt_tp, whatever p.
+    EXPECT_NEAR(cd::shear_rate(s) * cd::time_step(s), 0.2 * set.dt_tp, 1e-12) << p;
+    EXPECT_EQ(refusal(text(shear, 2, autos)), "") << p;
+    // The same rate given in 1/s resolves the same.
+    const cd::Scene r = cd::parse_scene(
+        text(v + fmt::format("rate = {:.17g}\npressure = {}\n", 0.2 / tp, p), 2,
+             autos),
+        "r.toml");
+    EXPECT_NEAR(cd::shear_rate(r), cd::shear_rate(s), 1e-12 * cd::shear_rate(s)) << p;
+    EXPECT_EQ(r.tol, s.tol) << p;
+  }
 }
 
 // Rows and snapshots by strain (output.series_strain, snapshot_strain): so

@@ -55,7 +55,9 @@ const Command kFits[] = {
      "from each run's shapes; also the table of nu*, z, anisotropies, sliding and side-side shares, partial "
      "strengths q_sv/p, q_ss/p and the check q/p ~ (sum a)/2 per run",
      cli::fit_angularity},
-    {"nu-i", "nu(I) = nu_max - a I over steady runs (packing_fraction against the measured inertial number)",
+    {"nu-i",
+     "nu(I) = nu_max - a I over steady runs (packing_fraction against the measured inertial number; runs at "
+     "imposed volume, nu exact: fitted as I = (nu_max - nu)/a, weighted by I's error bars)",
      cli::fit_nu_i},
     {"compaction",
      "e = e0 - lambda ln(p/p0) over steady (or compacted) runs at several p: e = 1/nu - 1 from the steady "

@@ -39,7 +39,9 @@ std::string what_would_determine(const std::string& model) {
                              "steady window";
   if (model == "mu_I")
     return "runs on both sides of I0, up to I = 0.3-0.5 where mu(I) bends over (INERTIAL_I=), " + common;
-  if (model == "nu_I") return "runs over a wider range of I (INERTIAL_I=), " + common;
+  if (model == "nu_I")
+    return "runs over a wider range of I (INERTIAL_I=; at imposed volume, of packing fractions: VOLUME_PHI=), " +
+           common;
   if (model == "void_ratio") return "runs at more pressures over a wider range (PRESSURE_P=), " + common;
   if (model == "cohesion") return "eta > 0 runs at several eta and I (COHESIVE_ETA=, COHESIVE_I=), " + common;
   if (model == "mu_alpha") return "more shapes (ANGULAR_NS=), " + common;
@@ -212,6 +214,10 @@ Model nu_of_I() {
   return {"nu_I", "nu = nu_max - a I", {"nu_max", "a"}, {"I"},
           [](const double* x, const double* p) { return p[0] - p[1] * x[0]; }};
 }
+Model nu_of_I_volume() {
+  return {"nu_I", "nu = nu_max - a I, fitted as I = (nu_max - nu)/a (nu imposed)", {"nu_max", "a"}, {"nu"},
+          [](const double* x, const double* p) { return (p[0] - x[0]) / p[1]; }};
+}
 Model void_ratio(double p0) {
   return {"void_ratio", fmt::format("e = e0 - lambda ln(p/p0), p0 = {}", p0), {"e0", "lambda"}, {"p"},
           [p0](const double* x, const double* p) { return p[0] - p[1] * std::log(x[0] / p0); }};
@@ -282,6 +288,21 @@ FitResult fit_nu_I(std::span<const double> I, std::span<const double> nu,
   auto d = data1(I, nu, sigma, "nu(I)");
   if (I.empty()) throw AnalysisError("fit nu(I): no data");
   return fit(nu_of_I(), d, {nu[argmin(I)], 0.0});
+}
+
+FitResult fit_nu_I_volume(std::span<const double> nu, std::span<const double> I,
+                          std::span<const double> sigma_I) {
+  auto d = data1(nu, I, sigma_I, "nu(I) at imposed volume");
+  if (nu.empty()) throw AnalysisError("fit nu(I): no data");
+  // The start: the least-squares line nu = c - s I (a = s, nu_max = c), a
+  // kept away from 0 where the model is undefined.
+  const double n = static_cast<double>(nu.size());
+  const double mI = std::accumulate(I.begin(), I.end(), 0.0) / n, mn = std::accumulate(nu.begin(), nu.end(), 0.0) / n;
+  double sII = 0, sIn = 0;
+  for (std::size_t i = 0; i < nu.size(); ++i) sII += (I[i] - mI) * (I[i] - mI), sIn += (I[i] - mI) * (nu[i] - mn);
+  double a = sII > 0 ? -sIn / sII : 0.0;
+  if (!(std::abs(a) > 1e-6)) a = 0.1;
+  return fit(nu_of_I_volume(), d, {mn + a * mI, a});
 }
 
 FitResult fit_void_ratio(std::span<const double> p, std::span<const double> e,

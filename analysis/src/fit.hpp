@@ -78,6 +78,10 @@ double predict_error(const Model& model, const FitResult& r, const double* x);
 // The models (method.md §11).
 Model mu_of_I();          // mu = mu1 + (mu2 - mu1)/(1 + I0/I)             x: I
 Model nu_of_I();          // nu = nu_max - a I                              x: I
+// The same law at imposed volume, where nu is exact and I is measured: fitted
+// as I = (nu_max - nu)/a, weighted by I's error bars. Same name and
+// parameters as nu_of_I (compare-fits compares the two campaigns' nu_I).
+Model nu_of_I_volume();   // I = (nu_max - nu)/a                            x: nu
 Model void_ratio(double p0);  // e = e0 - lambda ln(p/p0), p0 fixed         x: p
 Model cohesion();         // c/p = k0 eta/(1 - beta ln(1 - I_c)),
                           // I_c = I/(1 + alpha eta)^(1/2)                 x: eta, I
@@ -90,6 +94,9 @@ FitResult fit_mu_I(std::span<const double> I, std::span<const double> mu,
                    std::span<const double> sigma);
 FitResult fit_nu_I(std::span<const double> I, std::span<const double> nu,
                    std::span<const double> sigma);
+// nu(I) at imposed volume (nu_of_I_volume): nu exact, sigma the error bars of I.
+FitResult fit_nu_I_volume(std::span<const double> nu, std::span<const double> I,
+                          std::span<const double> sigma_I);
 FitResult fit_void_ratio(std::span<const double> p, std::span<const double> e,
                          std::span<const double> sigma, double p0);
 FitResult fit_cohesion(std::span<const double> eta, std::span<const double> I,

@@ -47,6 +47,8 @@ void read_scene(ReportRun& r, int dim) {
       if (scene->cohesion_number) r.eta = *scene->cohesion_number;
       if (scene->inertial_number) r.I_imposed = *scene->inertial_number;
       if (scene->pressure) r.pressure = *scene->pressure;
+      r.volume = scene->volume_control;
+      if (scene->volume_fraction && *scene->volume_fraction > 0) r.volume_fraction = *scene->volume_fraction;
     }
   } catch (const AnalysisError&) {
   }

@@ -31,6 +31,10 @@ struct ReportRun {
   // else scene.toml, -1 unknown or mixed.
   double eta = std::nan(""), I_imposed = std::nan(""), pressure = std::nan("");
   int nsides = -1;
+  // Imposed volume ([shear] control = "volume"): no I imposed, phi exact;
+  // its volume_fraction (nan: absent or 0, the sample's own).
+  bool volume = false;
+  double volume_fraction = std::nan("");
 
   std::optional<RunCost> cost;  // none without a summary.toml
 

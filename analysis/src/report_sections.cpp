@@ -46,6 +46,7 @@ InertialPoints inertial_points(const ReportScan& scan) {
       s.run = p.folder;
       s.I = {p.I.v, p.I.err};
       s.nu = {p.phi.v, p.phi.err};
+      s.volume = p.volume;
       pts.nu.push_back(s);
     }
   }
@@ -108,9 +109,10 @@ void nu_I_fit(const std::vector<StatePoint>& sp, const std::string& sel, ReportF
   std::optional<FitResult> r;
   std::string why;
   try {
+    const Model m = nu_model(sp);
     r = fit_nu_I_points(sp);
     out.fits.push_back(*r);
-    out.models.push_back(nu_of_I());
+    out.models.push_back(m);
     out.sum.plots_ok = plot_nu_I(out.out_dir, sp, *r, out.report_cmd) && out.sum.plots_ok;
     out.sum.fits.push_back("nu_I");
   } catch (const AnalysisError& e) {
@@ -159,18 +161,22 @@ std::vector<std::string> CampaignKind::names() const {
   if (cohesive) k.push_back("cohesive (cohesion_number varies)");
   if (angularity) k.push_back("angularity (nsides varies)");
   if (pressure) k.push_back("pressure series (pressure varies)");
+  if (volume) k.push_back("volume series (volume_fraction varies; p and I measured)");
   return k;
 }
 
 CampaignKind campaign_kind(const ReportScan& scan) {
-  std::vector<double> etas, Is, ps, ns;
+  std::vector<double> etas, Is, ps, ns, phis;
   for (const ReportRun& p : scan.runs) {
     etas.push_back(p.eta);
     Is.push_back(p.I_imposed);
-    ps.push_back(p.pressure);
+    // Under volume control p is the scale of t_p only, not a variable.
+    ps.push_back(p.volume ? std::nan("") : p.pressure);
     ns.push_back(p.nsides >= 0 ? p.nsides : std::nan(""));
+    phis.push_back(p.volume ? p.volume_fraction : std::nan(""));
   }
   CampaignKind k;
+  k.volume = distinct(phis).size() >= 2;
   k.angularity = distinct(ns).size() >= 2;
   k.cohesive = distinct(etas).size() >= 2;
   k.pressure = distinct(ps).size() >= 2;

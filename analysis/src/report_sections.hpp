@@ -3,7 +3,9 @@
 // Several kinds may hold at once; each has its section, which fits, draws
 // and writes its part of the page, in this order:
 //   inertial    I varies: mu(I) (4 runs or more) and nu(I) (3 or more),
-//               over the cohesionless runs of the first steady run's shape;
+//               over the cohesionless runs of the first steady run's shape
+//               (at imposed volume, where no scene imposes I, the measured
+//               I: the volume kind; nu(I) is then fitted in I);
 //   pressure    pressure varies: the compaction e(p);
 //   cohesive    cohesion_number varies: c/p against the eta = 0 runs;
 //   angularity  nsides varies: the table against alpha and mu*(alpha).
@@ -18,12 +20,14 @@
 namespace cda {
 
 struct CampaignKind {
-  bool inertial = false, cohesive = false, angularity = false, pressure = false;
+  bool inertial = false, cohesive = false, angularity = false, pressure = false, volume = false;
   // What the runs vary, as the summary and the page say it.
   std::vector<std::string> names() const;
 };
-// I varies when two scenes impose different I's; when no scene imposes one,
-// when the measured I's span a factor 1.5. The others when two scenes differ.
+// I varies when two scenes impose different I's; when no scene imposes one
+// (as at imposed volume), when the measured I's span a factor 1.5. Volume
+// when runs at imposed volume differ in volume_fraction. The others when two
+// scenes differ.
 CampaignKind campaign_kind(const ReportScan& scan);
 
 // What the sections write, in order: fits.toml's fits (with their models)

@@ -63,6 +63,16 @@ SceneInfo read_scene_info(const std::string& run_dir) {
     if (!m.is_string()) throw InputError(fmt::format("'{}': [shear] mode is not a string", s.file));
     s.shear_mode = m.as_string();
   }
+  if (root.is_table() && root.contains("shear") && root.at("shear").is_table() &&
+      root.at("shear").contains("control")) {
+    const auto& c = root.at("shear").at("control");
+    if (!c.is_string()) throw InputError(fmt::format("'{}': [shear] control is not a string", s.file));
+    s.volume_control = c.as_string() == "volume";
+  }
+  if (s.volume_control) {
+    s.inertial_number.reset();  // not imposed: measured
+    s.volume_fraction = number(root, "shear", "volume_fraction", s.file);
+  }
   if (root.is_table() && root.contains("particles") && root.at("particles").is_table() &&
       root.at("particles").contains("nsides")) {
     const auto& v = root.at("particles").at("nsides");

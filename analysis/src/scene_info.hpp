@@ -15,7 +15,9 @@ struct SceneInfo {
   // command reads it before it interprets series columns or snapshots.
   int dimension = 2;
   std::optional<double> cohesion_number;   // [contact] cohesion_number (eta; 0: cohesionless)
-  std::optional<double> inertial_number;   // [shear] inertial_number (imposed I)
+  // [shear] inertial_number (imposed I); empty under volume control, where
+  // no I is imposed (the series' inertial_number is the measured one).
+  std::optional<double> inertial_number;
   std::optional<double> pressure;          // [shear] pressure
   // [particles] nsides: sides of the polygons (0: disks). Set when the array
   // holds one value (or is a plain integer); a mixture of shapes leaves it
@@ -25,6 +27,10 @@ struct SceneInfo {
   std::optional<double> friction;          // [contact] mu (interparticle friction)
   std::optional<double> solver_tol;        // [solver] tol (NLGS convergence)
   std::optional<std::string> shear_mode;   // [shear] mode (none, periodic, walls)
+  // [shear] control = "volume": the cell's lengths held (the packing
+  // fraction imposed, exact), the shear rate imposed, p and I measured.
+  bool volume_control = false;
+  std::optional<double> volume_fraction;   // [shear] volume_fraction (0: the sample's as it was)
 };
 
 // The angularity of a shape with n sides, alpha = 2 pi/n (disks, n = 0: 0).

@@ -289,6 +289,7 @@ StatePoint state_point(const std::string& run_dir, const std::string& window) {
   } catch (const AnalysisError&) {
   }
   if (scene && scene->inertial_number) s.I_imposed = *scene->inertial_number;
+  s.volume = scene && scene->volume_control;
   if (r.series.has("p")) {
     s.p = series_val(r, "p");
   } else if (scene && scene->pressure) {
@@ -298,16 +299,31 @@ StatePoint state_point(const std::string& run_dir, const std::string& window) {
   return s;
 }
 
-FitResult fit_nu_I_points(const std::vector<StatePoint>& pts) {
+bool volume_points(const std::vector<StatePoint>& pts) {
+  const StatePoint* vol = nullptr;
+  const StatePoint* prs = nullptr;
+  for (const auto& p : pts) (p.volume ? vol : prs) = &p;
+  if (vol && prs)
+    throw AnalysisError(fmt::format("fit nu(I): run '{}' is at imposed volume (nu exact, I measured) and '{}' at "
+                                    "imposed pressure (I imposed, nu measured): fit them apart (compare-fits "
+                                    "compares the two nu_I)",
+                                    vol->run, prs->run));
+  return vol != nullptr;
+}
+
+Model nu_model(const std::vector<StatePoint>& pts) { return volume_points(pts) ? nu_of_I_volume() : nu_of_I(); }
+
+FitResult fit_nu_I_points(const std::vector<StatePoint>& pts, bool weighted) {
+  const bool volume = volume_points(pts);
   std::vector<double> I, nu, err;
   for (const auto& p : pts) {
     if (!std::isfinite(p.I.v))
       throw AnalysisError(fmt::format("fit nu(I): run '{}' has no inertial_number", p.run));
     I.push_back(p.I.v);
     nu.push_back(p.nu.v);
-    err.push_back(p.nu.err);
+    if (weighted) err.push_back(volume ? p.I.err : p.nu.err);
   }
-  return fit_nu_I(I, nu, err);
+  return volume ? fit_nu_I_volume(nu, I, err) : fit_nu_I(I, nu, err);
 }
 
 double default_p0(const std::vector<StatePoint>& pts) {

@@ -102,6 +102,7 @@ struct StatePoint {
   Val p;                 // measured p of the series, else scene [shear] pressure (err nan)
   bool p_from_scene = false;
   double I_imposed = std::numeric_limits<double>::quiet_NaN();
+  bool volume = false;   // imposed volume: nu exact, I measured (fit nu(I) in I)
   double e() const { return 1 / nu.v - 1; }
   double e_err() const { return nu.err / (nu.v * nu.v); }
 };
@@ -109,7 +110,14 @@ struct StatePoint {
 StatePoint state_point(const std::string& run_dir, const std::string& window = "");
 
 // nu(I) and its plot nu_I.{png,svg} (data nu_I_data.csv, nu_I_fit.csv).
-FitResult fit_nu_I_points(const std::vector<StatePoint>& pts);
+// Runs at imposed volume are fitted in I (fit_nu_I_volume, weighted by I's
+// errors), the others in nu; a mixture of the two is refused. weighted:
+// by the error bars (all finite and positive), else unweighted.
+FitResult fit_nu_I_points(const std::vector<StatePoint>& pts, bool weighted = true);
+// Whether the points are at imposed volume (all; a mixture: AnalysisError
+// naming a run of each), and the model that fit_nu_I_points fits to them.
+bool volume_points(const std::vector<StatePoint>& pts);
+Model nu_model(const std::vector<StatePoint>& pts);
 bool plot_nu_I(const std::string& dir, const std::vector<StatePoint>& pts, const FitResult& r,
                const std::string& command);
 // e(p) with p0 given (p0 <= 0: the geometric mean of the p's, which makes

@@ -1,6 +1,8 @@
 // What fit nu-i and fit compaction share: both fit a steady state (packing
 // fraction) against one variable (I or p) over runs or a table, weighted
-// when every point has an error bar.
+// when every point has an error bar. Runs at imposed volume (and a table with
+// I_err and no nu_err) have nu exact and I measured: nu(I) is fitted in I,
+// weighted by I's error bars.
 #include <fmt/core.h>
 
 #include <cmath>
@@ -18,13 +20,15 @@ int run_state_fit(const StateFitOptions& o, bool is_nu) {
     const auto xs = t.column(is_nu ? "I" : "p");
     const auto ys = t.column(is_nu ? "nu" : "e");
     const auto es = col_or_empty(t, is_nu ? "nu_err" : "e_err");
+    const auto Ies = is_nu && es.empty() ? col_or_empty(t, "I_err") : std::vector<double>{};
     for (std::size_t i = 0; i < xs.size(); ++i) {
       StatePoint s;
       s.run = fmt::format("row {}", i + 1);
       const double err = es.empty() ? std::nan("") : es[i];
       if (is_nu) {
-        s.I = {xs[i], std::nan("")};
+        s.I = {xs[i], Ies.empty() ? std::nan("") : Ies[i]};
         s.nu = {ys[i], err};
+        s.volume = !Ies.empty();
       } else {  // e given: store nu = 1/(1 + e) so that e() is e again
         s.p = {xs[i], std::nan("")};
         s.nu = {1 / (1 + ys[i]), err / ((1 + ys[i]) * (1 + ys[i]))};
@@ -55,21 +59,24 @@ int run_state_fit(const StateFitOptions& o, bool is_nu) {
       pts.push_back(s);
     }
   }
-  // Without error bars on every point the fit is unweighted.
-  bool all_err = true;
-  for (auto& s : pts) all_err = all_err && std::isfinite(s.nu.err) && s.nu.err > 0;
+  // Without error bars on every point the fit is unweighted: those of nu,
+  // or at imposed volume (nu exact) those of I.
   FitResult r;
   Model m = nu_of_I();
   double pref = o.p0;
+  bool all_err = true, volume = false;
   try {
+  volume = is_nu && volume_points(pts);
+  for (auto& s : pts) {
+    const Val& v = volume ? s.I : s.nu;
+    all_err = all_err && std::isfinite(v.err) && v.err > 0;
+  }
   if (is_nu) {
-    if (all_err) {
-      r = fit_nu_I_points(pts);
-    } else {
-      std::vector<double> I, nu;
-      for (const auto& s : pts) I.push_back(s.I.v), nu.push_back(s.nu.v);
-      r = fit_nu_I(I, nu, {});
+    if (volume) {
+      m = nu_of_I_volume();
+      fmt::print("imposed volume: nu exact, I measured: fitted as {}\n", m.formula);
     }
+    r = fit_nu_I_points(pts, all_err);
   } else {
     if (!(pref > 0)) pref = default_p0(pts);
     m = void_ratio(pref);
@@ -91,7 +98,7 @@ int run_state_fit(const StateFitOptions& o, bool is_nu) {
   write_toml(o.toml_out, {r}, {m});
   if (!o.out.empty()) {
     if (!all_err)
-      for (auto& s : pts) s.nu.err = 0;
+      for (auto& s : pts) (volume ? s.I.err : s.nu.err) = 0;
     const bool ok = is_nu ? plot_nu_I(o.out, pts, r, command_line())
                           : plot_compaction(o.out, pts, r, pref, command_line());
     if (!ok) fmt::print(stderr, "warning: gnuplot failed; the script is in {}\n", o.out);

@@ -87,8 +87,8 @@ double pressure_time(const Scene& s) {
 }
 
 double shear_rate(const Scene& s) {
-  if (s.shear_control == ShearControl::Volume) return s.imposed_rate;
   const double tp = pressure_time(s);
+  if (s.shear_control == ShearControl::Volume) return s.rate_tp > 0 ? (tp > 0 ? s.rate_tp / tp : 0.0) : s.imposed_rate;
   return tp > 0 ? s.inertial_number / tp : 0.0;
 }
 

@@ -38,7 +38,8 @@ std::pair<double, double> diameter_bounds(const Scene& s);
 std::vector<double> generated_diameters(const Scene& s);
 
 // Shear protocols: the imposed shear rate gamma-dot = I sqrt(p/rho)/d at
-// imposed pressure, shear.rate at imposed volume (scene/protocol.hpp); the
+// imposed pressure, shear.rate (or shear.rate_tp / t_p) at imposed volume
+// (scene/protocol.hpp); the
 // pressure time t_p = d sqrt(rho/p) at shear.pressure (imposed, or the
 // scale of a volume-controlled run); 0 without a pressure.
 double shear_rate(const Scene& s);

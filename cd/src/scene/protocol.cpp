@@ -13,7 +13,8 @@ double imposed_pressure(const Scene& s) {
 }
 
 double nominal_inertial_number(const Scene& s) {
-  if (s.shear_control == ShearControl::Volume) return s.imposed_rate * pressure_time(s);
+  if (s.shear_control == ShearControl::Volume)
+    return s.rate_tp > 0 ? (pressure_time(s) > 0 ? s.rate_tp : 0.0) : s.imposed_rate * pressure_time(s);
   return s.inertial_number;
 }
 
@@ -27,18 +28,18 @@ void check_no_protocol(const Scene& s, bool three, const auto& fail) {
     if (s.pressure != 0 || s.inertial_number != 0 || s.isotropic || s.strain != 0 || s.dt_tp != 0 ||
         !s.start.empty() || s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0 ||
         s.cohesion_number != 0 || s.checkpoint_strain != 0 || s.series_strain != 0 || s.snapshot_strain != 0 ||
-        s.imposed_rate != 0 || s.volume_fraction != 0 ||
+        s.imposed_rate != 0 || s.rate_tp != 0 || s.volume_fraction != 0 ||
         s.shear_control != ShearControl::Pressure)
       fail("shear.* (pressure, inertial_number, isotropic, strain, dt_tp, start, width, height, depth, control, "
-           "rate, volume_fraction), contact.cohesion_number and output.checkpoint_strain (series_strain, "
+           "rate, rate_tp, volume_fraction), contact.cohesion_number and output.checkpoint_strain (series_strain, "
            "snapshot_strain) need shear.mode = \"periodic\": leave them at their defaults");
     return;
   }
   if (s.inertial_number > 0 || s.isotropic || !s.start.empty() || s.strain > 0 || s.compaction_rate > 0 ||
-      s.imposed_rate > 0 || s.volume_fraction > 0 || s.series_strain > 0 || s.snapshot_strain > 0 ||
-      s.shear_control != ShearControl::Pressure)
+      s.imposed_rate > 0 || s.rate_tp > 0 || s.volume_fraction > 0 || s.series_strain > 0 ||
+      s.snapshot_strain > 0 || s.shear_control != ShearControl::Pressure)
     fail("shear.inertial_number, shear.isotropic, shear.strain, shear.start, shear.compaction_rate, "
-         "shear.control, shear.rate, shear.volume_fraction, output.series_strain and output.snapshot_strain need shear.mode \"periodic\" or \"walls\"");
+         "shear.control, shear.rate, shear.rate_tp, shear.volume_fraction, output.series_strain and output.snapshot_strain need shear.mode \"periodic\" or \"walls\"");
 }
 
 // What the cell imposes besides the shear: the keys of one control that the
@@ -49,18 +50,27 @@ void check_control(const Scene& s, const auto& fail) {
       fail(fmt::format("shear.volume_fraction = {} sets the volume of a cell whose lengths are held fixed: it "
                        "needs shear.control = \"volume\" (at imposed pressure the volume follows p)",
                        s.volume_fraction));
-    if (s.imposed_rate > 0)
-      fail(fmt::format("shear.rate = {} imposes the shear rate under shear.control = \"volume\"; at imposed "
-                       "pressure the rate is shear.inertial_number's (I sqrt(p/rho)/d)",
-                       s.imposed_rate));
+    for (const auto& [key, v] : {std::pair{"shear.rate", s.imposed_rate}, std::pair{"shear.rate_tp", s.rate_tp}})
+      if (v > 0)
+        fail(fmt::format("{} = {} imposes the shear rate under shear.control = \"volume\"; at imposed "
+                         "pressure the rate is shear.inertial_number's (I sqrt(p/rho)/d)",
+                         key, v));
     return;
   }
+  if (s.imposed_rate > 0 && s.rate_tp > 0)
+    fail(fmt::format("shear.rate = {} and shear.rate_tp = {} both give the shear rate: give one (shear.rate in "
+                     "1/s, or shear.rate_tp in units of 1/t_p, t_p = d sqrt(rho/p) at shear.pressure)",
+                     s.imposed_rate, s.rate_tp));
+  if (s.rate_tp > 0 && s.pressure <= 0)
+    fail(fmt::format("shear.rate_tp = {} is the shear rate in units of 1/t_p, t_p = d sqrt(rho/p): it needs "
+                     "shear.pressure > 0 (the pressure scale), or give shear.rate (1/s)",
+                     s.rate_tp));
   if (s.shear_mode != ShearMode::Periodic)
     fail("shear.control = \"volume\" needs shear.mode = \"periodic\" (a cell whose lengths are held fixed); the "
          "walls protocol holds its top wall at shear.pressure");
   if (s.inertial_number > 0)
     fail(fmt::format("shear.inertial_number = {}: shear.control = \"volume\" imposes the shear rate "
-                     "(shear.rate) and measures I (the series' inertial_number column): leave "
+                     "(shear.rate or shear.rate_tp) and measures I (the series' inertial_number column): leave "
                      "shear.inertial_number at 0",
                      s.inertial_number));
   if (s.volume_fraction > 0 && s.start.empty())
@@ -84,10 +94,10 @@ void check_protocol(const Scene& s) {
   };
   const bool shear = s.shear_mode != ShearMode::None;
   const bool volume = shear && s.shear_control == ShearControl::Volume;
-  // The shear rate's source: I (with p) at imposed pressure, shear.rate at
-  // imposed volume.
-  const char* rate_key = volume ? "shear.rate" : "shear.inertial_number";
-  const bool sheared = volume ? s.imposed_rate > 0 : s.inertial_number > 0;
+  // The shear rate's source: I (with p) at imposed pressure, shear.rate (or
+  // shear.rate_tp) at imposed volume.
+  const char* rate_key = volume ? "shear.rate or shear.rate_tp" : "shear.inertial_number";
+  const bool sheared = volume ? s.imposed_rate > 0 || s.rate_tp > 0 : s.inertial_number > 0;
 
   if (three && s.shear_mode == ShearMode::Walls)
     fail("shear.mode = \"walls\": a 3D scene is \"none\" (the box) or \"periodic\" (a tri-periodic cell)");

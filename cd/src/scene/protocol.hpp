@@ -22,7 +22,8 @@ double imposed_pressure(const Scene& s);
 // The inertial number the "auto" settings are chosen for (shear_policy.hpp):
 // shear.inertial_number under pressure control; under volume control the
 // nominal I = shear.rate x t_p at the pressure scale shear.pressure (0
-// without one, and "auto" is then refused).
+// without one, and "auto" is then refused), which is shear.rate_tp when the
+// rate is given in units of 1/t_p.
 double nominal_inertial_number(const Scene& s);
 
 // Every rule of the protocol keys, in both dimensions (3D's messages end

@@ -140,6 +140,7 @@ struct Scene {
   ShearControl shear_control = ShearControl::Pressure;
   double pressure = 0.0;            // imposed normal stress (N/m); volume control: the scale of t_p
   double imposed_rate = 0.0;        // shear.rate: the shear rate under volume control (1/s)
+  double rate_tp = 0.0;             // shear.rate_tp: the same in units of 1/t_p (t_p at shear.pressure)
   double volume_fraction = 0.0;     // volume control from a sample: scaled to this packing fraction; 0: as is
   double inertial_number = 0.0;     // imposed I: gamma-dot = I sqrt(p/rho) / d
   double cell_mass = 0.1;           // mass of the height (width) dof, in total particle mass
