@@ -56,6 +56,22 @@ inline std::map<std::string, std::string> summary_fields(const std::filesystem::
 }
 
 // An empty folder BUILD/<test>/<name> for a test's files (emptied first).
+// Every key of a resolved scene as cdsim --print-scene prints it (TOML
+// sections of `key = value # comment` lines), as section.key -> value.
+inline std::map<std::string, std::string> printed_keys(const std::string& printed) {
+  std::map<std::string, std::string> out;
+  std::istringstream in(printed);
+  std::string section;
+  for (std::string line; std::getline(in, line);) {
+    if (line.starts_with("[")) section = line.substr(1, line.find(']') - 1);
+    std::istringstream ls(line);
+    std::string key, eq, value;
+    ls >> key >> eq >> value;
+    if (eq == "=") out[section + "." + key] = value;
+  }
+  return out;
+}
+
 inline std::filesystem::path scratch_dir(const std::string& test, const std::string& name) {
   const std::filesystem::path p = std::filesystem::path(CDLAB_BINARY_DIR) / test / name;
   std::filesystem::remove_all(p);

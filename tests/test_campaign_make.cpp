@@ -135,17 +135,7 @@ std::string set_value(const std::string& cmd, const std::string& key) {
 std::map<std::string, std::string> printed_scene(const std::string& cmd) {
   const auto r = cdtest::run_command(std::string("cd ") + CDLAB_SOURCE_DIR + " && " + cmd + " --print-scene");
   EXPECT_EQ(r.code, 0) << cmd << "\n" << r.out;
-  std::map<std::string, std::string> out;
-  std::istringstream in(r.out);
-  std::string section;
-  for (std::string line; std::getline(in, line);) {
-    if (line.starts_with("[")) section = line.substr(1, line.find(']') - 1);
-    std::istringstream ls(line);
-    std::string key, eq, value;
-    ls >> key >> eq >> value;
-    if (eq == "=") out[section + "." + key] = value;
-  }
-  return out;
+  return cdtest::printed_keys(r.out);
 }
 
 // The mean packing fraction over the second half of a committed reference

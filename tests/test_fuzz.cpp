@@ -541,29 +541,24 @@ std::vector<Mutant> cell_mutants(const std::string& good, const std::string& cel
 
 TEST(Fuzz, CheckpointedCellsAreCheckedAgainstTheirGrains) {
   const fs::path dir = cdtest::scratch_dir("fuzz", "cells");
-  std::ofstream(dir / "le2.toml") << "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 30\n"
-                                       "[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.1\n"
-                                       "strain = 0.5\ndt_tp = 0.05\n[output]\ncheckpoint_interval = 1e-4\n";
-  const std::string cmd2 = kTimeout + kBin + "/cd/cdsim " + (dir / "le2.toml").string() + " -q --threads 1 --out " +
-                           (dir / "out2").string();
-  ASSERT_EQ(cdtest::run_command(cmd2 + " --max-steps 20").code, 0);
-  const std::string good2 = slurp(dir / "out2" / "checkpoint.bin");
-  // 2D: CellState {width, height, offset, ...}; "cell" names the field.
-  const std::vector<Mutant> more2 = cell_mutants(good2, "cell", 0, 16, "pos", "width");
-  ASSERT_EQ(more2.size(), 6u);
-  corrupt_systematically("2D Lees-Edwards cell", cmd2, dir / "out2", more2, false);
-
-  std::ofstream(dir / "le3.toml") << "name = \"s\"\ndimension = 3\n[gravity]\ng = [0.0, 0.0, 0.0]\n[particles]\n"
-                                       "n = 30\n[shear]\nmode = \"periodic\"\npressure = 1e5\ninertial_number = 0.1\n"
-                                       "strain = 0.5\ndt_tp = 0.05\n[output]\ncheckpoint_interval = 1e-4\n";
-  const std::string cmd3 = kTimeout + kBin + "/cd/cdsim " + (dir / "le3.toml").string() + " -q --threads 1 --out " +
-                           (dir / "out3").string();
-  ASSERT_EQ(cdtest::run_command(cmd3 + " --max-steps 20").code, 0);
-  const std::string good3 = slurp(dir / "out3" / "checkpoint.bin");
-  // 3D: "3d.cell" {L_x, L_y, L_z, offset, ...}.
-  const std::vector<Mutant> more3 = cell_mutants(good3, "3d.cell", 0, 24, "3d.pos", "3d.cell");
-  ASSERT_EQ(more3.size(), 6u);
-  corrupt_systematically("3D Lees-Edwards cell", cmd3, dir / "out3", more3, false);
+  // A short Lees-Edwards run's checkpoint, then each cell mutant of it.
+  const auto check = [&](const std::string& name, const std::string& scene, const std::string& pressure,
+                         const std::string& cell, std::size_t offset_at, const std::string& pos,
+                         const std::string& width_field) {
+    std::ofstream(dir / (name + ".toml")) << scene << "[particles]\nn = 30\n[shear]\nmode = \"periodic\"\npressure = "
+                                         << pressure << "\ninertial_number = 0.1\nstrain = 0.5\ndt_tp = 0.05\n"
+                                         << "[output]\ncheckpoint_interval = 1e-4\n";
+    const std::string cmd = kTimeout + kBin + "/cd/cdsim " + (dir / (name + ".toml")).string() +
+                            " -q --threads 1 --out " + (dir / name).string();
+    ASSERT_EQ(cdtest::run_command(cmd + " --max-steps 20").code, 0);
+    const std::vector<Mutant> more = cell_mutants(slurp(dir / name / "checkpoint.bin"), cell, 0, offset_at, pos,
+                                                  width_field);
+    ASSERT_EQ(more.size(), 6u);
+    corrupt_systematically(name, cmd, dir / name, more, false);
+  };
+  // 2D: CellState {width, height, offset, ...}; 3D: "3d.cell" {L_x, L_y, L_z, offset, ...}.
+  check("le2d", "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n", "100.0", "cell", 16, "pos", "width");
+  check("le3d", "name = \"s\"\ndimension = 3\n[gravity]\ng = [0.0, 0.0, 0.0]\n", "1e5", "3d.cell", 24, "3d.pos", "3d.cell");
 }
 
 // cdanalysis on damaged series and snapshots; cdproblem on damaged problems.

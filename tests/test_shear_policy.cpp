@@ -281,19 +281,10 @@ TEST(ShearPolicy, AutoAccelerationIsTheBandsAndDecidesTheTolerance) {
 // The policy's keys of a resolved scene printed by cdsim --print-scene.
 std::map<std::string, std::string> settings_of(const std::string& printed) {
   std::map<std::string, std::string> out;
-  std::istringstream in(printed);
-  std::string section;
-  for (std::string line; std::getline(in, line);) {
-    if (line.starts_with("[")) section = line.substr(1, line.find(']') - 1);
-    std::istringstream ls(line);
-    std::string key, eq, value;
-    ls >> key >> eq >> value;
-    const std::string name = section + "." + key;
-    if (eq == "=" && (name == "solver.tol" || name == "solver.residual_tol" || name == "shear.dt_tp" ||
-                      name == "shear.cell_mass" || name == "shear.inertial_number" ||
-                      name == "contact.overlap_projection"))
+  for (const auto& [name, value] : cdtest::printed_keys(printed))
+    if (name == "solver.tol" || name == "solver.residual_tol" || name == "shear.dt_tp" || name == "shear.cell_mass" ||
+        name == "shear.inertial_number" || name == "contact.overlap_projection")
       out[name] = value;
-  }
   return out;
 }
 
