@@ -114,6 +114,9 @@ TEST(AnalysisIo, SeriesCsvAndItsErrors) {
   write(d / "text.csv", "a,b\n1,x\n");
   EXPECT_NE(message([&] { Table::read_csv((d / "text.csv").string()); }).find("column 'b': 'x' is not a number"),
             std::string::npos);
+  // A NUL byte inside a number: the field is not a number (it read as 0.).
+  write(d / "nul.csv", std::string("a,b\n1,0.\0" "403\n", 13));
+  EXPECT_NE(message([&] { Table::read_csv((d / "nul.csv").string()); }).find("column 'b'"), std::string::npos);
   // Round trip at full precision.
   Table w({"x"});
   w.add_row({0.1 + 0.2});

@@ -84,7 +84,9 @@ Table Table::read_csv(const std::string& path, bool allow_nan) {
       char* end = nullptr;
       errno = 0;
       const double v = std::strtod(s, &end);
-      if (fields[j].empty() || *end != '\0')
+      // The whole field: a NUL byte inside it would end strtod's reading
+      // there, and "0.\0403" read as 0.
+      if (fields[j].empty() || end != s + fields[j].size())
         throw InputError(fmt::format("'{}' line {}, column '{}': '{}' is not a number", path,
                                         lineno, t.names_[j], printable(fields[j], 40)));
       if (!std::isfinite(v) && !(allow_nan && std::isnan(v)))
