@@ -764,7 +764,7 @@ TEST(CdsimRestart, AnySignalThenResumeGivesTheUninterruptedRun) {
 
 // One writer per output folder: a second cdsim on a folder that a running
 // one holds is refused (exit 6), naming the folder and the other's pid,
-// and writes nothing; once the first is killed with SIGKILL the lock is gone
+// and writes nothing, even once the lock file is removed under the run; once the first is killed with SIGKILL the lock is gone
 // with it, and the same command resumes.
 TEST(CdsimRestart, ASecondCdsimOnAHeldFolderIsRefused) {
   const fs::path d = temp_dir("lock");
@@ -777,6 +777,9 @@ TEST(CdsimRestart, ASecondCdsimOnAHeldFolderIsRefused) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   const Result second = cdsim(scene.string() + " --quiet --threads 1 --out " + B.string());
   const Result fresh = cdsim(scene.string() + " --quiet --threads 1 --fresh --out " + B.string());
+  // The lock file removed under the run: the folder's own lock still holds.
+  fs::remove(B / ".cdsim.lock");
+  const Result unlocked = cdsim(scene.string() + " --quiet --threads 1 --out " + B.string());
   int status = 0;
   const bool running = waitpid(pid, &status, WNOHANG) == 0;
   kill(pid, SIGKILL);
@@ -787,6 +790,8 @@ TEST(CdsimRestart, ASecondCdsimOnAHeldFolderIsRefused) {
     EXPECT_NE(r.out.find("output folder '" + B.string() + "' is being written by another cdsim (pid " +
                          std::to_string(pid) + ")"), std::string::npos) << r.out;
   }
+  EXPECT_EQ(unlocked.code, 6) << unlocked.out;
+  EXPECT_NE(unlocked.out.find("holds the folder's lock (its lock file"), std::string::npos) << unlocked.out;
   expect_whole_rows(B / "series.csv");
   EXPECT_EQ(slurp(B / "series.csv").find("step,", 1), std::string::npos) << "a second header";
   // No stale lock after a kill -9.

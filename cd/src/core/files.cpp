@@ -1,6 +1,7 @@
 #include "files.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -120,7 +121,10 @@ FolderLock::FolderLock(const std::string& dir) : dir_(dir) {
   struct flock l {};
   l.l_type = F_WRLCK;
   l.l_whence = SEEK_SET;  // the whole file (l_start = l_len = 0)
-  if (::fcntl(fd_, F_SETLK, &l) == 0) return;
+  if (::fcntl(fd_, F_SETLK, &l) == 0) {
+    lock_folder(dir, path);
+    return;
+  }
   const int err = errno;
   if (err == EACCES || err == EAGAIN) {
     struct flock q {};
@@ -139,7 +143,29 @@ FolderLock::FolderLock(const std::string& dir) : dir_(dir) {
                "into this folder\n", path.c_str(), std::strerror(err));
 }
 
+// The folder itself locked too (flock, a lock of its own kind): the lock
+// file can be removed while the run holds it, and a second cdsim would then
+// create and lock a new one; the folder cannot be replaced under the run
+// (check_unchanged), so its lock stays the one taken.
+void FolderLock::lock_folder(const std::string& dir, const std::string& path) {
+  folder_fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (folder_fd_ >= 0 && ::flock(folder_fd_, LOCK_EX | LOCK_NB) == 0) return;
+  const int err = errno;
+  if (folder_fd_ >= 0 && (err == EWOULDBLOCK || err == EAGAIN)) {
+    ::close(folder_fd_);
+    ::close(fd_);
+    ::close(dir_fd_);
+    folder_fd_ = fd_ = dir_fd_ = -1;
+    throw FolderBusy(fmt::format("output folder '{}' is being written by another cdsim, which holds the folder's "
+                                 "lock (its lock file '{}' was removed under it); wait for it to end, or choose "
+                                 "another --out", dir, path));
+  }
+  std::fprintf(stderr, "cdsim: warning: cannot lock the folder '%s' itself (%s): a second cdsim could write into "
+               "it if its lock file were removed\n", dir.c_str(), std::strerror(err));
+}
+
 FolderLock::~FolderLock() {
+  if (folder_fd_ >= 0) ::close(folder_fd_);
   if (fd_ >= 0) ::close(fd_);  // releases the lock
   if (dir_fd_ >= 0) ::close(dir_fd_);
 }

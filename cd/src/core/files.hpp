@@ -36,8 +36,9 @@ struct FolderGone : WriteError {
 };
 
 // One writer per output folder: an advisory write lock (fcntl) on
-// DIR/.cdsim.lock, an empty file created once and left in place, held while
-// this object lives. The kernel drops it when the process ends, however it
+// DIR/.cdsim.lock, an empty file created once and left in place, and a lock
+// (flock) on the folder itself, which holds if the lock file is removed,
+// both held while this object lives. The kernel drops it when the process ends, however it
 // ends (kill -9 too), so no stale lock survives a crash. A second cdsim on
 // the folder throws FolderBusy naming it and the holder's pid. On a file
 // system without locks (some network mounts) it warns and runs unguarded.
@@ -66,6 +67,8 @@ class FolderLock {
   int dir_fd_ = -1;  // the folder itself (O_PATH): its identity, pinned
   unsigned long long dev_ = 0, ino_ = 0;
   int fd_ = -1;      // DIR/.cdsim.lock, locked
+  int folder_fd_ = -1;  // the folder, flock-ed: holds even if the lock file is removed
+  void lock_folder(const std::string& dir, const std::string& path);
 };
 
 // Throws OutputError naming the folder if it cannot be created or written.
