@@ -48,12 +48,12 @@ if [ "$PROTOCOL" = periodic ]; then
   "$CDA" fit angularity "${runs[@]}" --window "$WINDOW" --snapshots 10 --out "$out" > "$out/log" 2>&1 || true
   [ -s "$out/angularity.csv" ] || { cat "$out/log" >&2; exit 1; }
   head -n 1 "$out/angularity.csv" | sed 's/^run,nsides,/protocol,ns,N,I,strain,window,/; s/$/,cpu_s,sweeps_mean,build/'
-  i=0
+  # Its rows are in the order of alpha: each joined to its run by nsides.
   tail -n +2 "$out/angularity.csv" | while IFS= read -r row; do
-    r=${runs[$i]}
+    ns=$(echo "$row" | cut -d, -f2)
+    r=$DIR/ns_$ns
     echo "$(provenance "$r"),${row#*,*,},$(cost "$r")"
-    i=$((i + 1))
-  done
+  done | sort -t, -k2,2n
 else
   cols="bulk_q_over_p bulk_mu bulk_packing_fraction bulk_z wall_mu"
   head="protocol,ns,N,I,strain,window"
