@@ -86,3 +86,27 @@ void run_pile3(double adhesion_mg, const char* name) {
 TEST(EnergyStep3, FrictionalPileLosesEnergyEveryStep) { run_pile3(0.0, "3D pile, mu 0.4"); }
 
 TEST(EnergyStep3, CohesivePileLosesEnergyEveryStep) { run_pile3(20.0, "3D cohesive pile, f_a = 20 m g"); }
+
+// Pure contact dynamics (overlap_correction = 0) leaves an overlap as it
+// is: two spheres overlapping by 1 % of a diameter, at rest, without
+// gravity, stay at rest to the bit (the law asks u_n >= 0 of a contact that
+// is not approaching, so no impulse). An overlap correction left on would
+// push them apart, putting in kinetic energy that no balance bound sees
+// when overlaps are small; here any speed at all is caught.
+TEST(EnergyStep3, PureContactDynamicsPutsNoEnergyIntoAnOverlap) {
+  WorldParams3 p;
+  p.dt = 1e-3;
+  p.gravity = Vec3::Zero();
+  p.mu = p.mu_wall = 0.4;
+  p.alert = 1e-3;
+  p.solver.tol = 1e-12;
+  ASSERT_EQ(p.overlap_correction, 0.0);
+  World3 w(p);
+  const double r = 0.01;
+  w.bodies.add_sphere(Vec3(0, 0, 0), r, 2600);
+  w.bodies.add_sphere(Vec3(2 * r - 0.02 * r, 0, 0), r, 2600);  // overlap 0.01 d
+  for (int k = 0; k < 20; ++k) w.step();
+  EXPECT_GT(w.last().max_overlap, 0.0) << "the contact was not seen";
+  EXPECT_EQ(w.kinetic_energy(), 0.0);
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) EXPECT_EQ(w.bodies.vel[i].v, Vec3::Zero()) << i;
+}

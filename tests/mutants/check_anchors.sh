@@ -12,8 +12,14 @@ SRC=${1:-$ROOT}
 stale=0 n=0
 for m in "$SRC"/tests/mutants/*.mut; do
   n=$((n + 1))
-  if [ -z "$(locate "$(field file "$m")" "$(field find "$m")")" ]; then
+  at=$(locate "$(field file "$m")" "$(field find "$m")")
+  if [ -z "$at" ]; then
     echo "stale mutant: $(basename "$m"): its anchor (find:) is not found exactly once in $(field file "$m") or in cd/src and analysis/src; refresh it"
+    stale=$((stale + 1))
+  elif [ "$at" != "$(field file "$m")" ]; then
+    # make mutants would edit another file than the one the mutant names
+    # (a 3D mutant whose anchor only the 2D code still holds, say).
+    echo "stale mutant: $(basename "$m"): its anchor is found in $at, not in its file: $(field file "$m"); refresh it"
     stale=$((stale + 1))
   fi
 done

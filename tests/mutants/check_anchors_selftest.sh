@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The anchor check fails on a tree with a stale mutant (its anchor found
-# nowhere, or twice) and passes on one whose anchor is found once.
+# nowhere, twice, or in another file than the one it names) and passes on
+# one whose anchor is found once in its file.
 #   tests/mutants/check_anchors_selftest.sh SCRATCH_DIR
 set -uo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
@@ -21,4 +22,9 @@ expect 1 "stale mutant: 02-nowhere.mut"
 rm "$T/tests/mutants/02-nowhere.mut"
 mut 03-twice 'return 2;'
 expect 1 "stale mutant: 03-twice.mut"
-echo "the anchor check catches a missing and a repeated anchor"
+rm "$T/tests/mutants/03-twice.mut"
+# Found once, but in another file than the one the mutant names.
+printf 'int k() { return 4; }\n' > "$T/cd/src/b.cpp"
+printf 'file: cd/src/a.cpp\nfind: return 4;\nreplace: x\ntests: test_x\nwhy: a test\n' > "$T/tests/mutants/04-elsewhere.mut"
+expect 1 "stale mutant: 04-elsewhere.mut: its anchor is found in cd/src/b.cpp"
+echo "the anchor check catches a missing, a repeated and a misplaced anchor"
