@@ -400,6 +400,35 @@ TEST(BadInput, CdproblemRefusesBadOptionsAndTrailingText) {
   }
 }
 
+// The .cdp3 reader bounds its counts by the file as the .cdp reader does:
+// "bodies 2000000000" is refused naming the file and the line before
+// anything is allocated (it was std::bad_alloc, no file, no line).
+TEST(BadInput, Cdp3CountsAreBoundedByTheFile) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "cdp3");
+  const cdtest::CmdResult run = cdsim(std::string(CDLAB_SOURCE_DIR) + "/configs/pile3d.toml -q --set particles.n=8 "
+                                      "--set time.duration=0.02 --dump-problem 5 --out " + (dir / "run").string());
+  ASSERT_EQ(run.code, 0) << run.out;
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(dir / "run" / "problem_5.cdp3");
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+  }
+  std::size_t bodies = lines.size();
+  for (std::size_t i = 0; i < lines.size() && bodies == lines.size(); ++i)
+    if (lines[i].rfind("bodies ", 0) == 0) bodies = i;
+  ASSERT_LT(bodies, lines.size());
+  lines[bodies] = "bodies 2000000000";
+  std::string text;
+  for (const std::string& l : lines) text += l + "\n";
+  const fs::path p = write(dir, "bad.cdp3", text);
+  const cdtest::CmdResult r = cdtest::run_command(kCdproblem + " solve " + p.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(p.string() + ":" + std::to_string(bodies + 1) +
+                       ": the number of bodies is 2000000000: unexpected end of file"),
+            std::string::npos)
+      << r.out;
+}
+
 // The .cdp reader refuses what no step can hold: a
 // negative mu, adhesion or inverse mass, a contact of a body with itself, a
 // tolerance outside (0, 1], a residual tolerance <= 0, and counts the rest

@@ -147,7 +147,7 @@ ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name,
   problem_file::read_solver(rd, prm, "after the law");
   if (!(prm.tol > 0)) rd.fail(fmt::format("the tolerance is {}, not positive", prm.tol));
   rd.expect("bodies", "after the solver's parameters");
-  const long long nb = rd.integer("the number of bodies", 0, INT_MAX);
+  const long long nb = rd.count("the number of bodies", INT_MAX, 8);  // v, w, inv_m, inv_I
   p.vel.resize(nb);
   for (long long i = 0; i < nb; ++i) {
     BodyVel3& v = p.vel[i];
