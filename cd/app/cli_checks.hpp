@@ -6,7 +6,6 @@
 #pragma once
 #include <cerrno>
 #include <cmath>
-#include <cctype>
 #include <cstdint>
 #include <cstdlib>
 #include <optional>
@@ -32,16 +31,20 @@ inline CLI::Validator finite_range(double lo, double hi, bool open_lo = false) {
       "in " + range);
 }
 
+// A whole number >= 1 that fits a 64-bit integer (a step count); nullopt
+// for anything else.
+inline std::optional<long long> count_of(const std::string& v) {
+  char* end = nullptr;
+  errno = 0;
+  const long long x = std::strtoll(v.c_str(), &end, 10);
+  if (v.empty() || *end != '\0' || errno != 0 || x < 1) return std::nullopt;
+  return x;
+}
+
 // A whole number >= 1 that fits a 64-bit integer (a step count).
 inline CLI::Validator positive_count() {
   return CLI::Validator(
-      [](std::string& v) {
-        char* end = nullptr;
-        errno = 0;
-        const long long x = std::strtoll(v.c_str(), &end, 10);
-        const bool ok = !v.empty() && *end == '\0' && errno == 0 && x >= 1;
-        return ok ? std::string() : "'" + v + "' is not a whole number >= 1";
-      },
+      [](std::string& v) { return count_of(v) ? std::string() : "'" + v + "' is not a whole number >= 1"; },
       "a whole number >= 1");
 }
 
@@ -50,20 +53,12 @@ inline CLI::Validator positive_count() {
 // without computing the run's step count. Returned as the step itself, or
 // <= 0 for the last (0) and last-K (-K); nullopt for any other word.
 inline std::optional<long long> dump_step(const std::string& v) {
-  const auto whole = [](const std::string& w) -> std::optional<long long> {
-    char* end = nullptr;
-    errno = 0;
-    const long long x = std::strtoll(w.c_str(), &end, 10);
-    if (w.empty() || !std::isdigit(static_cast<unsigned char>(w[0])) || *end != '\0' || errno != 0 || x < 1)
-      return std::nullopt;
-    return x;
-  };
   if (v == "last") return 0;
   if (v.rfind("last-", 0) == 0) {
-    const auto k = whole(v.substr(5));
+    const auto k = count_of(v.substr(5));
     return k ? std::optional<long long>(-*k) : std::nullopt;
   }
-  return whole(v);
+  return count_of(v);
 }
 inline CLI::Validator dump_step_word() {
   return CLI::Validator(

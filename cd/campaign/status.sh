@@ -20,11 +20,8 @@ set -u
 campaigns=$1
 shift
 
-# "key" of [section] in a TOML file (scene.toml, summary.toml: "" for the top).
-toml() {
-  awk -v s="$2" -v k="$3" '/^\[/ { sec = substr($0, 2, index($0, "]") - 2); next }
-    sec == s && $1 == k && $2 == "=" { v = $3; gsub(/"/, "", v); print v; exit }' "$1" 2>/dev/null
-}
+# toml FILE SECTION KEY (cd/campaign/toml.sh).
+. "$(dirname "$0")/toml.sh"
 # The last row's column $2 of a CSV file $1.
 last_col() {
   awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == c) j = i; next } j { v = $j } END { if (j && v != "") print v }' "$1" 2>/dev/null

@@ -29,17 +29,20 @@ for r in $(ls -d "$DIR"/ns_* 2> /dev/null | sort -t_ -k2 -n); do
 done
 [ ${#runs[@]} -gt 0 ] || { echo "validation_table.sh: no finished run in $DIR" >&2; exit 1; }
 
-value() { sed -n "s/^$1 *= *\"\{0,1\}\([^\" ]*\).*/\1/p" "$2" | head -n 1; }  # key = value of a TOML file
+. "$(dirname "$0")/toml.sh"  # toml FILE SECTION KEY
 # N: the scene's particles.n, or its sample's (a run started from prep/ns_<n>).
 grains() {
-  local n; n=$(value n "$1/scene.toml")
+  local n; n=$(toml "$1/scene.toml" particles n)
   [ "$n" != 0 ] && { echo "$n"; return; }
-  value n "$CAMPAIGN/prep/$(basename "$1")/scene.toml"
+  toml "$CAMPAIGN/prep/$(basename "$1")/scene.toml" particles n
 }
 provenance() {  # protocol,ns,N,I,strain,window
-  echo "$PROTOCOL,${1##*_},$(grains "$1"),$(value inertial_number "$1/scene.toml"),$(value strain "$1/scene.toml"),$WINDOW"
+  echo "$PROTOCOL,${1##*_},$(grains "$1"),$(toml "$1/scene.toml" shear inertial_number),$(toml "$1/scene.toml" shear strain),$WINDOW"
 }
-cost() { echo "$(value cpu_time "$1/summary.toml"),$(value sweeps_mean "$1/summary.toml"),$(value cdlab_version "$1/summary.toml")"; }
+cost() {
+  local s=$1/summary.toml
+  echo "$(toml "$s" "" cpu_time),$(toml "$s" "" sweeps_mean),$(toml "$s" "" cdlab_version)"
+}
 
 if [ "$PROTOCOL" = periodic ]; then
   out=$(mktemp -d)
