@@ -114,6 +114,19 @@ TEST(AnalysisIo, SeriesCsvAndItsErrors) {
   write(d / "text.csv", "a,b\n1,x\n");
   EXPECT_NE(message([&] { Table::read_csv((d / "text.csv").string()); }).find("column 'b': 'x' is not a number"),
             std::string::npos);
+  // Columns declared as words are skipped and left out; the others are still read and checked.
+  write(d / "words.csv", "protocol,x,build\nwalls,0.5,515852b\nperiodic,0.25,1d6d952-dirty\n");
+  const auto words = Table::read_csv((d / "words.csv").string(), false, {"protocol", "build"});
+  EXPECT_EQ(words.names(), std::vector<std::string>{"x"});
+  EXPECT_EQ(words.column("x")[1], 0.25);
+  EXPECT_EQ(words.line(1), 3u);
+  EXPECT_NE(message([&] { Table::read_csv((d / "words.csv").string(), false, {"protocol"}); })
+                .find("line 2, column 'build': '515852b' is not a number"),
+            std::string::npos);
+  write(d / "words-short.csv", "protocol,x\nwalls\n");
+  EXPECT_NE(message([&] { Table::read_csv((d / "words-short.csv").string(), false, {"protocol"}); })
+                .find("line 2: 1 fields, the header has 2"),
+            std::string::npos);
   // A NUL byte inside a number: the field is not a number (it read as 0.).
   write(d / "nul.csv", std::string("a,b\n1,0.\0" "403\n", 13));
   EXPECT_NE(message([&] { Table::read_csv((d / "nul.csv").string()); }).find("column 'b'"), std::string::npos);

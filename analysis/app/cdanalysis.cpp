@@ -51,9 +51,10 @@ const Command kFits[] = {
      "volume_strain_rate/sqrt(volume_strain_rate^2 + shear_rate^2); also the free slope b",
      cli::fit_dilatancy},
     {"angularity",
-     "mu*(alpha) = mu0 + (mu1 - mu0)(1 - exp(-alpha/alpha_c)) over steady shear runs, alpha = 2 pi/n_s (disks 0) "
-     "from each run's shapes; also the table of nu*, z, anisotropies, sliding and side-side shares, partial "
-     "strengths q_sv/p, q_ss/p and the check q/p ~ (sum a)/2 per run",
+     "mu*(alpha) = mu0 + (mu1 - mu0)(1 - exp(-alpha/alpha_c)) and nu*(alpha) of the same form over steady shear "
+     "runs, alpha = 2 pi/n_s (disks 0) from each run's shapes, or over a table (--table); also the table of z, "
+     "anisotropies, sliding and side-side shares, partial strengths q_sv/p, q_ss/p and the check q/p ~ (sum a)/2 "
+     "per run",
      cli::fit_angularity},
     {"nu-i",
      "nu(I) = nu_max - a I over steady runs (packing_fraction against the measured inertial number; runs at "

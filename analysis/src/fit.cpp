@@ -238,13 +238,20 @@ Model dilatancy_free() {
   return {"dilatancy_free", "sin phi = sin phi_c + b sin psi", {"sin_phi_c", "b"}, {"sin_psi"},
           [](const double* x, const double* p) { return p[0] + p[1] * x[0]; }};
 }
-Model mu_of_alpha() {
-  return {"mu_alpha", "mu = mu0 + (mu1 - mu0)(1 - exp(-alpha/alpha_c))", {"mu0", "mu1", "alpha_c"},
+// y = y0 + (y1 - y0)(1 - exp(-alpha/alpha_c)): the angularity study's law,
+// for mu* and for nu* alike.
+namespace {
+Model saturation_in_alpha(const std::string& y) {
+  return {y + "_alpha", fmt::format("{0} = {0}0 + ({0}1 - {0}0)(1 - exp(-alpha/alpha_c))", y),
+          {y + "0", y + "1", "alpha_c"},
           {"alpha"},
           [](const double* x, const double* p) {
             return p[0] + (p[1] - p[0]) * (1 - std::exp(-x[0] / p[2]));
           }};
 }
+}  // namespace
+Model mu_of_alpha() { return saturation_in_alpha("mu"); }
+Model nu_of_alpha() { return saturation_in_alpha("nu"); }
 
 namespace {
 
@@ -352,12 +359,16 @@ FitResult fit_dilatancy(std::span<const double> sin_psi, std::span<const double>
   return free_slope ? fit(dilatancy_free(), d, {m, 1.0}) : fit(dilatancy(), d, {m});
 }
 
+FitResult fit_of_alpha(const Model& m, std::span<const double> alpha, std::span<const double> y,
+                       std::span<const double> sigma) {
+  auto d = data1(alpha, y, sigma, m.name.c_str());
+  if (alpha.empty()) throw AnalysisError(fmt::format("fit {}: no data", m.name));
+  const double amax = alpha[argmax(alpha)];
+  return fit(m, d, {y[argmin(alpha)], y[argmax(alpha)], 0.3 * (amax > 0 ? amax : 1)});
+}
 FitResult fit_mu_alpha(std::span<const double> alpha, std::span<const double> mu,
                        std::span<const double> sigma) {
-  auto d = data1(alpha, mu, sigma, "mu(alpha)");
-  if (alpha.empty()) throw AnalysisError("fit mu*(alpha): no data");
-  const double amax = alpha[argmax(alpha)];
-  return fit(mu_of_alpha(), d, {mu[argmin(alpha)], mu[argmax(alpha)], 0.3 * (amax > 0 ? amax : 1)});
+  return fit_of_alpha(mu_of_alpha(), alpha, mu, sigma);
 }
 
 }  // namespace cda

@@ -88,6 +88,7 @@ Model cohesion();         // c/p = k0 eta/(1 - beta ln(1 - I_c)),
 Model dilatancy();        // sin phi = sin phi_c + sin psi (slope 1)        x: sin psi
 Model dilatancy_free();   // sin phi = sin phi_c + b sin psi (checks b = 1) x: sin psi
 Model mu_of_alpha();      // mu = mu0 + (mu1 - mu0)(1 - exp(-alpha/alpha_c)) x: alpha
+Model nu_of_alpha();      // nu = nu0 + (nu1 - nu0)(1 - exp(-alpha/alpha_c)) x: alpha
 
 // Fits with starting points guessed from the data. sigma may be empty.
 FitResult fit_mu_I(std::span<const double> I, std::span<const double> mu,
@@ -104,6 +105,10 @@ FitResult fit_cohesion(std::span<const double> eta, std::span<const double> I,
 FitResult fit_dilatancy(std::span<const double> sin_psi, std::span<const double> sin_phi,
                         std::span<const double> sigma, bool free_slope = false);
 FitResult fit_mu_alpha(std::span<const double> alpha, std::span<const double> mu,
+                       std::span<const double> sigma);
+// mu_of_alpha or nu_of_alpha (m) through (alpha, y): starts at y0, y1 = y at
+// the smallest and largest alpha, alpha_c = 0.3 max alpha.
+FitResult fit_of_alpha(const Model& m, std::span<const double> alpha, std::span<const double> y,
                        std::span<const double> sigma);
 
 }  // namespace cda

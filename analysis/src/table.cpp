@@ -55,7 +55,7 @@ std::string printable(const std::string& s, std::size_t max) {
   return o;
 }
 
-Table Table::read_csv(const std::string& path, bool allow_nan) {
+Table Table::read_csv(const std::string& path, bool allow_nan, const std::vector<std::string>& text) {
   refuse_folder(path);
   std::ifstream in(path);
   if (!in) throw InputError(fmt::format("cannot open '{}'", path));
@@ -68,18 +68,23 @@ Table Table::read_csv(const std::string& path, bool allow_nan) {
     if (!trim(line).empty()) break;
   }
   if (trim(line).empty()) throw InputError(fmt::format("'{}' is empty (no header row)", path));
-  t.names_ = split(line);
-  for (const auto& n : t.names_)
+  const auto header = split(line);
+  std::vector<bool> keep;
+  for (const auto& n : header) {
     if (n.empty()) throw InputError(fmt::format("'{}': empty column name in the header", path));
+    keep.push_back(std::find(text.begin(), text.end(), n) == text.end());
+    if (keep.back()) t.names_.push_back(n);
+  }
   t.cols_.assign(t.names_.size(), {});
   while (std::getline(in, line)) {
     ++lineno;
     if (trim(line).empty()) continue;
     const auto fields = split(line);
-    if (fields.size() != t.names_.size())
+    if (fields.size() != header.size())
       throw InputError(fmt::format("'{}' line {}: {} fields, the header has {}", path, lineno,
-                                      fields.size(), t.names_.size()));
-    for (std::size_t j = 0; j < fields.size(); ++j) {
+                                      fields.size(), header.size()));
+    for (std::size_t j = 0, k = 0; j < fields.size(); ++j) {
+      if (!keep[j]) continue;
       const char* s = fields[j].c_str();
       char* end = nullptr;
       errno = 0;
@@ -88,11 +93,11 @@ Table Table::read_csv(const std::string& path, bool allow_nan) {
       // there, and "0.\0403" read as 0.
       if (fields[j].empty() || end != s + fields[j].size())
         throw InputError(fmt::format("'{}' line {}, column '{}': '{}' is not a number", path,
-                                        lineno, t.names_[j], printable(fields[j], 40)));
+                                        lineno, header[j], printable(fields[j], 40)));
       if (!std::isfinite(v) && !(allow_nan && std::isnan(v)))
         throw InputError(fmt::format("'{}' line {}, column '{}': '{}' is not a finite number", path,
-                                     lineno, t.names_[j], printable(fields[j], 40)));
-      t.cols_[j].push_back(v);
+                                     lineno, header[j], printable(fields[j], 40)));
+      t.cols_[k++].push_back(v);
     }
     t.lines_.push_back(lineno);
   }

@@ -20,8 +20,10 @@ class Table {
   // missing value only in cdanalysis' own tables, read with allow_nan.
   // Throws InputError naming the file for: missing file, no header, no data
   // row, a short/long row, a non-numeric or non-finite field (with line and
-  // column).
-  static Table read_csv(const std::string& path, bool allow_nan = false);
+  // column). The columns named in `text` hold words (a protocol, a commit):
+  // their fields are not read and the table leaves them out.
+  static Table read_csv(const std::string& path, bool allow_nan = false,
+                        const std::vector<std::string>& text = {});
 
   bool has(const std::string& name) const;
   // Throws AnalysisError naming the column and the file it was read from.

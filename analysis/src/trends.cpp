@@ -175,17 +175,30 @@ Table angularity_table(const std::vector<AngularityPoint>& pts) {
   return t;
 }
 
-FitResult fit_angularity(const std::vector<AngularityPoint>& pts) {
-  std::vector<double> al, mu, err;
+namespace {
+
+// One steady quantity (mu or nu) of the points against alpha, weighted when
+// every point has an error bar.
+FitResult fit_against_alpha(const Model& m, const std::vector<AngularityPoint>& pts, Val AngularityPoint::*y) {
+  std::vector<double> al, v, err;
   bool all_err = true;
   for (const auto& a : pts) {
     al.push_back(a.alpha);
-    mu.push_back(a.mu.v);
-    err.push_back(a.mu.err);
-    all_err = all_err && std::isfinite(a.mu.err) && a.mu.err > 0;
+    v.push_back((a.*y).v);
+    err.push_back((a.*y).err);
+    all_err = all_err && std::isfinite((a.*y).err) && (a.*y).err > 0;
   }
   if (!all_err) err.clear();
-  return fit_mu_alpha(al, mu, err);
+  return fit_of_alpha(m, al, v, err);
+}
+
+}  // namespace
+
+FitResult fit_angularity(const std::vector<AngularityPoint>& pts) {
+  return fit_against_alpha(mu_of_alpha(), pts, &AngularityPoint::mu);
+}
+FitResult fit_angularity_nu(const std::vector<AngularityPoint>& pts) {
+  return fit_against_alpha(nu_of_alpha(), pts, &AngularityPoint::nu);
 }
 
 namespace {

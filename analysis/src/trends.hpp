@@ -85,6 +85,8 @@ Table angularity_table(const std::vector<AngularityPoint>& pts);
 // mu*(alpha) over the points (steady error bars as weights). Refused
 // (AnalysisError) with fewer than 3 distinct alpha, or a singular fit.
 FitResult fit_angularity(const std::vector<AngularityPoint>& pts);
+// nu*(alpha) of the same form (nu_of_alpha), refused likewise.
+FitResult fit_angularity_nu(const std::vector<AngularityPoint>& pts);
 
 // The plots against alpha into dir: angularity_{mu,nu,z,anisotropy,sliding,
 // partial}.{png,svg,gp} with angularity.csv and angularity_mu_fit.csv

@@ -11,9 +11,11 @@
 #   the anisotropies, the sliding and side-side shares, the partial
 #   strengths and the stress-fabric check (docs/analysis.md), every column
 #   of its angularity.csv but its run index;
-# walls (CAMPAIGN/walls/ns_*): the bulk's (the central half of the gap,
-#   docs/shear.md) q/p, mu = -sigma_xy/sigma_yy, packing fraction and z,
-#   and the top wall's mu, each `cdanalysis steady --window WINDOW`.
+# walls (CAMPAIGN/walls/ns_*): alpha, then the bulk's (the central half of
+#   the gap, docs/shear.md) q/p, packing fraction and z under the periodic
+#   table's names mu, nu and z, its mu = -sigma_xy/sigma_yy (bulk_mu), and
+#   the top wall's tau/sigma (wall_mu), each `cdanalysis steady --window
+#   WINDOW`.
 # Both then give protocol, ns, N, I, strain (the run's end), window and, at
 # the end, cpu_s, sweeps_mean and build (cdlab_version) of each run.
 set -euo pipefail
@@ -58,12 +60,15 @@ if [ "$PROTOCOL" = periodic ]; then
     echo "$(provenance "$r"),${row#*,*,},$(cost "$r")"
   done | sort -t, -k2,2n
 else
-  cols="bulk_q_over_p bulk_mu bulk_packing_fraction bulk_z wall_mu"
-  head="protocol,ns,N,I,strain,window"
-  for c in $cols; do head="$head,$c,${c}_err"; done
+  # Named as the periodic table's (mu, nu, z) where the quantity is the
+  # same, measured in the bulk: the two tables compare column by column.
+  cols="bulk_q_over_p bulk_packing_fraction bulk_z bulk_mu wall_mu"
+  head="protocol,ns,N,I,strain,window,alpha"
+  for c in mu nu z bulk_mu wall_mu; do head="$head,$c,${c}_err"; done
   echo "$head,cpu_s,sweeps_mean,build"
   for r in "${runs[@]}"; do
-    line=$(provenance "$r")
+    ns=${r##*_}
+    line="$(provenance "$r"),$(awk -v n="$ns" 'BEGIN { printf "%.17g", n == 0 ? 0 : 8 * atan2(1, 1) / n }')"
     for c in $cols; do
       m=$("$CDA" steady "$r" --column "$c" --window "$WINDOW" | awk '$1 == "mean" { print $2 "," $4 }')
       [ -n "$m" ] || { echo "validation_table.sh: no steady mean of $c in $r" >&2; exit 1; }

@@ -1,5 +1,7 @@
-// cdanalysis fit angularity: mu*(alpha) over steady shear runs of several
-// shapes, with the table of steady quantities against alpha (trends.hpp).
+// cdanalysis fit angularity: mu*(alpha) and nu*(alpha) over steady shear
+// runs of several shapes, with the table of steady quantities against alpha
+// (trends.hpp); or over a table of such points (--table: angularity.csv, or
+// the validation tables of tests/data/validation/).
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -10,15 +12,63 @@
 
 namespace cda::cli {
 
+namespace {
+
+// mu*(alpha), printed and written; nu*(alpha) beside it, or its refusal
+// (a nu fit that fails does not stop the mu fit). Returns the mu fit.
+FitResult fit_both(const std::vector<AngularityPoint>& pts, const std::string& toml_out) {
+  const FitResult mu = cda::fit_angularity(pts);
+  print_fit(mu, mu_of_alpha());
+  std::vector<FitResult> fits = {mu};
+  std::vector<Model> models = {mu_of_alpha()};
+  std::vector<RefusedFit> refused;
+  try {
+    fits.push_back(fit_angularity_nu(pts));
+    models.push_back(nu_of_alpha());
+    print_fit(fits.back(), nu_of_alpha());
+  } catch (const AnalysisError& e) {
+    fmt::print(stderr, "cdanalysis: nu*(alpha) refused: {}\n", e.what());
+    refused.push_back({"nu_alpha", nu_of_alpha().formula, e.what()});
+  }
+  write_toml(toml_out, fits, models, refused);
+  return mu;
+}
+
+// The points of a table (one row per shape): alpha, mu, nu with their
+// error bars when the table has them (nan where a row has none). The
+// validation tables' words (protocol, window, build) are left unread.
+int fit_table(const std::string& path, const std::string& toml_out) {
+  const auto t = Table::read_csv(path, true, {"protocol", "window", "build"});
+  const auto al = t.column("alpha"), mu = t.column("mu"), nu = t.column("nu");
+  const auto mu_e = col_or_empty(t, "mu_err"), nu_e = col_or_empty(t, "nu_err");
+  std::vector<AngularityPoint> pts;
+  fmt::print("{:>4} {:>8} {:>17} {:>17}\n", "row", "alpha", "mu*", "nu*");
+  for (std::size_t i = 0; i < t.rows(); ++i) {
+    AngularityPoint a;
+    a.run = fmt::format("{} line {}", path, t.line(i));
+    a.alpha = al[i];
+    a.mu = {mu[i], mu_e.empty() ? std::nan("") : mu_e[i]};
+    a.nu = {nu[i], nu_e.empty() ? std::nan("") : nu_e[i]};
+    fmt::print("{:>4} {:>8.4f} {:>8.5f}±{:<8.5f} {:>8.5f}±{:<8.5f}\n", i + 1, a.alpha, a.mu.v, a.mu.err, a.nu.v,
+               a.nu.err);
+    pts.push_back(a);
+  }
+  return with_reservations("fit angularity", {}, fit_both(pts, toml_out));
+}
+
+}  // namespace
+
 Handler fit_angularity(CLI::App& sub) {
   struct Opt {
     std::vector<std::string> runs;
     std::string toml_out, out;
-    std::string window;
+    std::string window, table;
     int snapshots = 5, bins = 36;
   };
   auto o = std::make_shared<Opt>();
-  sub.add_option("runs", o->runs, "run or campaign folders (series.csv, scene.toml, contact snapshots)")->required();
+  sub.add_option("runs", o->runs, "run or campaign folders (series.csv, scene.toml, contact snapshots)");
+  sub.add_option("--table", o->table, "CSV with columns alpha, mu, nu and optionally mu_err, nu_err (as "
+                                      "angularity.csv), instead of runs: the fits alone");
   sub.add_option("--snapshots", o->snapshots, "last contact snapshots averaged per run for the fabric")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
@@ -27,6 +77,13 @@ Handler fit_angularity(CLI::App& sub) {
   sub.add_option("--out", o->out, "folder for angularity.csv, the fit curve and the plots (png, svg)");
   add_toml_option(sub, o->toml_out);
   return [o] {
+    if (!o->table.empty()) {
+      if (!o->runs.empty()) throw AnalysisError("fit angularity: give run folders or --table, not both");
+      if (!o->out.empty()) throw AnalysisError("fit angularity: --out draws the runs' fabric: it needs run folders, "
+                                               "not --table");
+      return fit_table(o->table, o->toml_out);
+    }
+    if (o->runs.empty()) throw AnalysisError("fit angularity: give run folders or --table");
     AngularityOptions opt;
     opt.snapshots = o->snapshots;
     opt.bins = o->bins;
@@ -69,9 +126,7 @@ Handler fit_angularity(CLI::App& sub) {
                "tensor sum with directions (columns q/p, sum/2, tensor)\n");
     std::optional<FitResult> r;
     try {
-      r = cda::fit_angularity(pts);
-      print_fit(*r, mu_of_alpha());
-      write_toml(o->toml_out, {*r}, {mu_of_alpha()});
+      r = fit_both(pts, o->toml_out);
     } catch (const AnalysisError& e) {
       if (o->out.empty()) throw;
       fmt::print(stderr, "cdanalysis: refused: {}\n", e.what());

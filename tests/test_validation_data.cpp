@@ -1,0 +1,172 @@
+// The validation campaign's committed tables (tests/data/validation/): the
+// quick form of make validate-check (each table refitted by the cdanalysis
+// command reproduces its stored fits, and the stored fits pass through the
+// table's points), and the physics the tables must show whatever the shapes
+// they hold so far: the series and the contact snapshots give the same q/p,
+// the stress matches the fabric to the harmonic approximation's order, the
+// walls' bulk agrees with the periodic cell, and angular grains are
+// stronger than disks (Azéma, Estrada & Radjai, PRE 86, 041301, 2012).
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include "analysis/src/compare.hpp"
+#include "analysis/src/fit.hpp"
+#include "analysis/src/table.hpp"
+#include "cli_util.hpp"
+
+namespace fs = std::filesystem;
+using namespace cda;
+
+namespace {
+
+const fs::path data = fs::path(CDLAB_SOURCE_DIR) / "tests" / "data" / "validation";
+const fs::path exe = fs::path(CDLAB_BINARY_DIR) / "analysis" / "cdanalysis";
+const std::vector<std::string> words = {"protocol", "window", "build"};
+
+Table table(const std::string& protocol) {
+  return Table::read_csv((data / ("angularity-" + protocol + ".csv")).string(), true, words);
+}
+
+double combined(double a, double b) { return std::hypot(a, b); }
+
+// Row index by ns.
+std::map<int, std::size_t> by_ns(const Table& t) {
+  std::map<int, std::size_t> m;
+  for (std::size_t i = 0; i < t.rows(); ++i) m[static_cast<int>(t.column("ns")[i])] = i;
+  return m;
+}
+
+}  // namespace
+
+// Every row under the same protocol: N >= 1000, the imposed I, strain >= 3,
+// the same steady window (read as text: the window column), finite error bars.
+TEST(ValidationData, EveryRowFollowsTheStatedProtocol) {
+  for (const std::string p : {"periodic", "walls"}) {
+    SCOPED_TRACE(p);
+    const Table t = table(p);
+    const std::string text = cdtest::slurp(data / ("angularity-" + p + ".csv"));
+    for (std::size_t i = 0; i < t.rows(); ++i) {
+      EXPECT_GE(t.column("N")[i], 1000);
+      EXPECT_EQ(t.column("I")[i], 1e-3);
+      EXPECT_GE(t.column("strain")[i], 3);
+      const int ns = static_cast<int>(t.column("ns")[i]);
+      EXPECT_NEAR(t.column("alpha")[i], ns == 0 ? 0.0 : 2 * M_PI / ns, 1e-15);
+      for (const char* c : {"mu", "nu", "z"}) {
+        const double e = t.column(std::string(c) + "_err")[i];
+        EXPECT_TRUE(std::isfinite(e) && e > 0) << c << " row " << i;
+      }
+    }
+    std::size_t rows = 0;
+    for (std::size_t at = text.find(",1:3,"); at != std::string::npos; at = text.find(",1:3,", at + 1)) ++rows;
+    EXPECT_EQ(rows, t.rows()) << "every row's window is 1:3";
+  }
+}
+
+// make validate-check's quick form: each stored fit file is what the
+// command makes of its table now. The same data refitted: a parameter may
+// move by 1 % of its standard error (the optimiser's stopping rule), not
+// more. The stored fit is checked independently below (it passes through
+// the points it was fitted to).
+TEST(ValidationData, TheTablesRefitToTheirStoredFits) {
+  int files = 0;
+  for (const auto& f : fs::directory_iterator(data)) {
+    const std::string name = f.path().filename().string();
+    if (!name.ends_with("-fits.toml")) continue;
+    ++files;
+    const fs::path csv = data / (name.substr(0, name.size() - 10) + ".csv");
+    const fs::path out = cdtest::scratch_dir("test_validation_data", "refit") / name;
+    const auto fit = cdtest::run_command(fmt::format("'{}' fit angularity --table '{}' --toml '{}'", exe.string(),
+                                                     csv.string(), out.string()));
+    ASSERT_EQ(fit.code, 0) << fit.out;
+    const Comparison c = compare_fits(read_fit_toml(f.path().string()), read_fit_toml(out.string()), 0.01, 0);
+    EXPECT_TRUE(c.ok()) << name << ": " << c.failures() << " parameters moved";
+    EXPECT_EQ(c.rows.size(), 6u) << "mu_alpha and nu_alpha, three parameters each";
+  }
+  EXPECT_GE(files, 1) << "the periodic table has 3 shapes: its fits are stored";
+}
+
+// The stored curves pass through their points: each point within 3 of its
+// standard errors of the curve evaluated from the stored parameters, and
+// mu0 is the disks' mu* (the law at alpha = 0).
+TEST(ValidationData, StoredFitsPassThroughTheirPoints) {
+  for (const auto& f : fs::directory_iterator(data)) {
+    const std::string name = f.path().filename().string();
+    if (!name.ends_with("-fits.toml")) continue;
+    const Table t = Table::read_csv((data / (name.substr(0, name.size() - 10) + ".csv")).string(), true, words);
+    const FitFile ff = read_fit_toml(f.path().string());
+    for (const std::string y : {"mu", "nu"}) {
+      SCOPED_TRACE(name + " " + y);
+      const auto& params = ff.models.at(y + "_alpha").params;
+      const double y0 = params.at(y + "0").value, y1 = params.at(y + "1").value, ac = params.at("alpha_c").value;
+      for (std::size_t i = 0; i < t.rows(); ++i) {
+        const double a = t.column("alpha")[i];
+        const double law = y0 + (y1 - y0) * (1 - std::exp(-a / ac));
+        EXPECT_LE(std::abs(law - t.column(y)[i]), 3 * t.column(y + "_err")[i]) << "alpha " << a;
+        if (a == 0) {
+          EXPECT_NEAR(y0, t.column(y)[i], 3 * t.column(y + "_err")[i]);
+        }
+      }
+    }
+  }
+}
+
+// Two estimators of q/p over the same window: the series' mean of the
+// run's stress and the mean over the last contact snapshots recomputed from
+// the contact forces by cdanalysis. They must agree within 3 combined
+// standard errors. The stress-fabric relation q/p ~ (a_c + a_n + a_t)/2
+// drops products of anisotropies (of order a^2/2 ~ 0.1 for a ~ 0.4): the
+// tensor sum is held to 10 % of q/p.
+TEST(ValidationData, StressFromSeriesSnapshotsAndFabricAgree) {
+  const Table t = table("periodic");
+  for (std::size_t i = 0; i < t.rows(); ++i) {
+    SCOPED_TRACE("ns " + std::to_string(static_cast<int>(t.column("ns")[i])));
+    const double mu = t.column("mu")[i], snap = t.column("q_over_p_snap")[i];
+    EXPECT_LE(std::abs(mu - snap), 3 * combined(t.column("mu_err")[i], t.column("q_over_p_snap_err")[i]));
+    EXPECT_LE(std::abs(t.column("sum_half_tensor")[i] / snap - 1), 0.10);
+    // Disks have no sides: no side-side contact.
+    if (t.column("ns")[i] == 0) {
+      EXPECT_EQ(t.column("ss_share")[i], 0);
+    }
+  }
+}
+
+// The walls' bulk (the central half of the gap) and the bi-periodic cell
+// are the same material at the same p and I: mu*, nu* and z agree within
+// 3 combined standard errors for every shape both tables hold.
+TEST(ValidationData, WallsBulkAgreesWithThePeriodicCell) {
+  const Table per = table("periodic"), wal = table("walls");
+  const auto p = by_ns(per), w = by_ns(wal);
+  int both = 0;
+  for (const auto& [ns, iw] : w) {
+    if (!p.contains(ns)) continue;
+    ++both;
+    const std::size_t ip = p.at(ns);
+    for (const std::string c : {"mu", "nu", "z"}) {
+      const double d = wal.column(c)[iw] - per.column(c)[ip];
+      EXPECT_LE(std::abs(d), 3 * combined(wal.column(c + "_err")[iw], per.column(c + "_err")[ip]))
+          << "ns " << ns << " " << c;
+    }
+  }
+  EXPECT_GE(both, 1);
+}
+
+// Published behaviour: the shear strength grows with angularity (Azéma et
+// al. 2012: mu* rises with alpha from the disks' and saturates). Every polygon with alpha >= pi/3 beats the disks by 3 combined
+// standard errors in both protocols.
+TEST(ValidationData, AngularPolygonsAreStrongerThanDisks) {
+  for (const std::string proto : {"periodic", "walls"}) {
+    const Table t = table(proto);
+    const auto rows = by_ns(t);
+    if (!rows.contains(0)) continue;
+    const std::size_t d = rows.at(0);
+    for (const auto& [ns, i] : rows) {
+      if (ns == 0 || t.column("alpha")[i] < M_PI / 3 - 1e-12) continue;
+      EXPECT_GT(t.column("mu")[i] - t.column("mu")[d], 3 * combined(t.column("mu_err")[i], t.column("mu_err")[d]))
+          << proto << " ns " << ns;
+    }
+  }
+}
