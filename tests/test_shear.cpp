@@ -19,6 +19,7 @@
 #include "cli_util.hpp"
 #include "config.hpp"
 #include "detect.hpp"
+#include "le_wrap_util.hpp"
 #include "regress_ref.hpp"
 #include "setup.hpp"
 #include "world_util.hpp"
@@ -317,11 +318,12 @@ std::string common_keys() {
 
 // n disks (size ratio 2) on a loose lattice in a square periodic cell,
 // compacted isotropically at p (configs/shear-prep.toml, smaller).
-std::string prep_scene(int n, double side) {
+// (A width and a height: the same in a cell twice as tall as wide.)
+std::string prep_scene(int n, double side, double height = 0) {
   return "name = \"prep\"\n[time]\nduration = 1.0\n" + common_keys() +
          "[particles]\nn = " + std::to_string(n) + "\nd_mean = 1e-3\nsize_ratio = 2.0\ndensity = 2.6\n"
          "[shear]\nmode = \"periodic\"\nwidth = " + std::to_string(side) + "\nheight = " +
-         std::to_string(side) + "\npressure = 100.0\nisotropic = true\ndt_tp = 0.05\n";
+         std::to_string(height > 0 ? height : side) + "\npressure = 100.0\nisotropic = true\ndt_tp = 0.05\n";
 }
 
 // Shear at inertial number I from the prepared sample in `start`.
@@ -777,6 +779,40 @@ TEST(Scenes, CohesionNumberAndTimeStepFollowThePressure) {
   EXPECT_DOUBLE_EQ(w.params().dt, 0.02 * tp);
   EXPECT_DOUBLE_EQ(w.params().cell.shear_rate, 0.1 / tp);
   EXPECT_DOUBLE_EQ(cd::run_duration(s), 2.0 / (0.1 / tp));
+}
+
+// ---- Lees-Edwards wraps -------------------------------------------------------
+
+// 150 disks compacted in a cell twice as tall as wide, then sheared at
+// I = 0.1 to strain 2: the offset gamma L_y passes L_x every strain
+// L_x/L_y ~ 0.5, about four wraps. A wrap must look like any other step
+// (le_wrap_util.hpp): contacts, stress, kinetic energy and overlaps without
+// a jump. L_x != L_y, so a wrap by the wrong length (L_y) would show.
+TEST(LeesEdwardsWrap, WrapsOfTheOffsetAreContinuous2D) {
+  const fs::path dir = temp_dir("wrap");
+  const std::string ckpt = (dir / "prep.bin").string();
+  {
+    cd::World w = cd::build_world(cd::parse_scene(prep_scene(150, 0.0135, 0.027), "prep.toml"));
+    for (int k = 0; k < 800; ++k) w.step();
+    cd::save_checkpoint(ckpt, w, 1);
+  }
+  const cd::Scene s = cd::parse_scene(shear_scene(ckpt, 0.1, 2.0, 0.05), "shear.toml");
+  cd::World w = cd::build_world(s);
+  fs::remove_all(dir);
+  EXPECT_GT(w.cell.height / w.cell.width, 1.5);
+  const long n = std::llround(cd::run_duration(s) / w.params().dt);
+  std::vector<cdtest::WrapStep> steps;
+  std::size_t settle = 0;
+  for (long k = 0; k < n; ++k) {
+    w.step();
+    ASSERT_TRUE(cdtest::all_finite(w)) << "step " << k;
+    const Eigen::Matrix2d S = w.contact_stress();
+    steps.push_back({w.cell.offset, double(w.last().active), w.last().max_overlap_small, S(0, 1), S(1, 1),
+                     w.kinetic_energy()});
+    if (w.cell.strain < 0.3) settle = steps.size();  // the start-up transient left out
+  }
+  // max_overlap_small: of the smaller grain's diameter.
+  cdtest::expect_wraps_continuous(steps, settle, 3, 0.01, "2D, L_y/L_x = " + std::to_string(w.cell.height / w.cell.width));
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 
 #include <omp.h>
 
+#include "le_wrap_util.hpp"
 #include "shear3_util.hpp"
 
 using namespace cd;
@@ -187,8 +188,11 @@ Scene shear_scene(const std::string& start, double I) { return cdtest::shear3_sh
 
 // A compacted sample of n spheres in a checkpoint (the dofs' path of
 // shear.start: a preparation's checkpoint).
-std::string prepared(const std::string& name, int n, int steps) {
-  World3 w = build_world3(prep_scene(n));
+// (A given cell L_x x L_y x L_z instead of the automatic cube: L non-zero.)
+std::string prepared(const std::string& name, int n, int steps, const Vec3& L = Vec3::Zero()) {
+  Scene prep = prep_scene(n);
+  prep.cell_width = L.x(), prep.cell_height = L.y(), prep.cell_depth = L.z();
+  World3 w = build_world3(prep);
   for (int k = 0; k < steps; ++k) w.step();
   const auto dir = cdtest::scratch_dir("test_shear3", name);
   const std::string path = (dir / "checkpoint.bin").string();
@@ -477,4 +481,33 @@ TEST(Shear3Cell, CheckpointByStrain) {
   EXPECT_EQ(c.cell().rate, w.cell().rate);
   EXPECT_EQ(c.cell().le_offset, w.cell().le_offset);
   for (std::size_t i = 0; i < w.bodies.size(); ++i) ASSERT_EQ(c.bodies.pos[i], w.bodies.pos[i]) << i;
+}
+
+// ---------------------------------------------------------------- wraps
+
+// 150 spheres compacted in a cell about twice as tall (y) as long (x),
+// then sheared at I = 0.1 to strain 2: the offset gamma L_y passes L_x
+// every strain L_x/L_y ~ 0.5, about four wraps. A wrap must look like any
+// other step (le_wrap_util.hpp, as in 2D: test_shear.cpp).
+TEST(LeesEdwardsWrap, WrapsOfTheOffsetAreContinuous3D) {
+  const std::string start = prepared("wrap", 150, 450, Vec3(0.0052, 0.0104, 0.0064));
+  Scene s = shear_scene(start, 0.1);
+  s.strain = 2.0;
+  World3 w = build_world3(s);
+  const Vec3 L = w.cell().size;
+  EXPECT_GT(L.y() / L.x(), 1.5);
+  const int n = static_cast<int>(std::lround(s.strain / w.shear_rate() / w.params().dt));
+  std::vector<cdtest::WrapStep> steps;
+  std::size_t settle = 0;
+  for (int k = 0; k < n; ++k) {
+    w.step();
+    const Eigen::Matrix3d S = w.contact_stress();
+    steps.push_back({w.cell().le_offset, double(w.last().active), w.last().max_overlap, S(0, 1), S(1, 1),
+                     w.kinetic_energy()});
+    if (w.cell().strain < 0.3) settle = steps.size();  // the start-up transient left out
+  }
+  // max_overlap is of the mean diameter d_ref: 1 % of the smallest grain's.
+  double r_min = w.bodies.radius[0];
+  for (double r : w.bodies.radius) r_min = std::min(r_min, r);
+  cdtest::expect_wraps_continuous(steps, settle, 3, 0.01 * 2 * r_min / w.params().d_ref, "3D, L_y/L_x = " + std::to_string(L.y() / L.x()));
 }
