@@ -6,6 +6,7 @@
 // boundary with a checkpoint the same command resumes from; usage errors
 // exit 2 like every other bad input.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <sys/wait.h>
 
 #include <chrono>
@@ -18,9 +19,12 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "cli_util.hpp"
+#include "problem3.hpp"
 
 namespace fs = std::filesystem;
 
@@ -499,6 +503,226 @@ TEST(BadInput, CdpReaderRefusesWhatNoStepCanHold) {
     EXPECT_NE(r.out.find(p.string() + ":" + std::to_string(c.line + 1) + ": " + c.named), std::string::npos)
         << c.named << "\n" << r.out;
   }
+}
+
+// ---- FCLib .hdf5 problems -------------------------------------------------
+//
+// A small local problem written by write_fclib (what cdsim --dump-problem
+// writes: W in compressed columns), then damaged with the HDF5 API. The
+// reader checks every dataset's length against the header (W's m, n, nz,
+// nzmax; 3 values of q and 1 of mu a contact), W's structure, and that the
+// values are finite, before it allocates or uses anything: exit 2 with one
+// line naming the file and the dataset, never a crash (these files aborted
+// in malloc, segfaulted, read past W's arrays or were solved from memory the
+// reader never filled).
+
+namespace {
+
+// Two contacts coupled through W(0, 3): 8 entries (nzmax 8), W 6x6.
+fs::path write_hdf5_problem(const fs::path& dir) {
+  cd::Problem3 p;
+  p.nc = 2;
+  Eigen::MatrixXd W = Eigen::MatrixXd::Identity(6, 6);
+  W(0, 3) = W(3, 0) = 0.25;
+  p.W = W.sparseView();
+  p.W.makeCompressed();
+  p.q.resize(6);
+  p.q << -1, 0.2, 0.1, -0.5, 0, 0.3;
+  p.mu.resize(2);
+  p.mu << 0.5, 0.3;
+  const fs::path path = dir / "ok.hdf5";
+  cd::write_fclib(p, path.string(), "two contacts", "a test problem");
+  return path;
+}
+
+std::vector<double> h5_doubles(const fs::path& file, const std::string& name) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t d = H5Dopen2(f, name.c_str(), H5P_DEFAULT), s = H5Dget_space(d);
+  std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
+  H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Sclose(s);
+  H5Dclose(d);
+  H5Fclose(f);
+  return v;
+}
+
+std::vector<int> h5_ints(const fs::path& file, const std::string& name) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t d = H5Dopen2(f, name.c_str(), H5P_DEFAULT), s = H5Dget_space(d);
+  std::vector<int> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
+  H5Dread(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Sclose(s);
+  H5Dclose(d);
+  H5Fclose(f);
+  return v;
+}
+
+// A copy of `src` as `name` in dir, with dataset `ds` replaced by `values`
+// (1-D, of their length and type).
+template <class T>
+fs::path h5_with(const fs::path& src, const fs::path& dir, const std::string& name, const std::string& ds,
+                 const std::vector<T>& values) {
+  const fs::path out = dir / name;
+  fs::copy_file(src, out, fs::copy_options::overwrite_existing);
+  const hid_t type = std::is_same_v<T, double> ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT;
+  const hid_t f = H5Fopen(out.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  EXPECT_GE(f, 0) << out;
+  EXPECT_GE(H5Ldelete(f, ds.c_str(), H5P_DEFAULT), 0) << ds;
+  const hsize_t n = values.size();
+  const hid_t s = H5Screate_simple(1, &n, nullptr);
+  const hid_t d = H5Dcreate2(f, ds.c_str(), type, s, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  EXPECT_GE(H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0) << ds;
+  H5Dclose(d);
+  H5Sclose(s);
+  H5Fclose(f);
+  return out;
+}
+
+// A copy of `src` as `name` in dir whose dataset `ds` has n doubles declared
+// and none written (HDF5 would read its fill value).
+fs::path h5_unwritten(const fs::path& src, const fs::path& dir, const std::string& name, const std::string& ds,
+                      hsize_t n) {
+  const fs::path out = dir / name;
+  fs::copy_file(src, out, fs::copy_options::overwrite_existing);
+  const hid_t f = H5Fopen(out.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  EXPECT_GE(H5Ldelete(f, ds.c_str(), H5P_DEFAULT), 0) << ds;
+  const hid_t s = H5Screate_simple(1, &n, nullptr);
+  H5Dclose(H5Dcreate2(f, ds.c_str(), H5T_NATIVE_DOUBLE, s, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  H5Sclose(s);
+  H5Fclose(f);
+  return out;
+}
+
+// cdproblem on each file: exit 2 and one line "cdproblem: error: FILE:
+// MESSAGE". A crash shows as exit -1 (killed by a signal).
+void expect_hdf5_refused(const std::vector<std::pair<fs::path, std::string>>& cases) {
+  for (const auto& [file, message] : cases) {
+    const cdtest::CmdResult r = cdtest::run_command(kCdproblem + " solve " + file.string());
+    EXPECT_EQ(r.code, 2) << file << "\n" << r.out;
+    EXPECT_EQ(r.out, "cdproblem: error: " + file.string() + ": " + message + "\n") << file;
+  }
+}
+
+std::vector<double> one_more(std::vector<double> v, double x) {
+  v.push_back(x);
+  return v;
+}
+std::vector<double> one_less(std::vector<double> v) {
+  v.pop_back();
+  return v;
+}
+
+}  // namespace
+
+// The valid file solves (exit 0), in-process as through cdproblem.
+TEST(BadInputHdf5, TheValidFileSolves) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "hdf5_valid");
+  const fs::path ok = write_hdf5_problem(dir);
+  const cd::Fclib3 f = cd::read_fclib(ok.string());
+  EXPECT_EQ(f.problem.nc, 2);
+  EXPECT_EQ(f.problem.W.nonZeros(), 8);
+  EXPECT_EQ(f.problem.q.size(), 6);
+  const cdtest::CmdResult r = cdtest::run_command(kCdproblem + " solve " + ok.string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("dim 3, 2 contacts (local)"), std::string::npos) << r.out;
+}
+
+// Longer q or mu than the header says (they overran the buffers FCLib had
+// allocated from W/m: "malloc(): invalid size", exit 134); a longer x.
+TEST(BadInputHdf5, LongerDatasetsThanTheHeaderAreRefused) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "hdf5_longer");
+  const fs::path ok = write_hdf5_problem(dir);
+  const std::string q = "/fclib_local/vectors/q", mu = "/fclib_local/vectors/mu", x = "/fclib_local/W/x";
+  expect_hdf5_refused({
+      {h5_with(ok, dir, "q.hdf5", q, one_more(h5_doubles(ok, q), 1.0)),
+       "dataset /fclib_local/vectors/q has 7 values, the header says 6 (3 × 2 contacts)"},
+      {h5_with(ok, dir, "q2.hdf5", q, std::vector<double>(4000, 1.0)),
+       "dataset /fclib_local/vectors/q has 4000 values, the header says 6 (3 × 2 contacts)"},
+      {h5_with(ok, dir, "mu.hdf5", mu, one_more(h5_doubles(ok, mu), 0.1)),
+       "dataset /fclib_local/vectors/mu has 3 values, the header says 2 (2 contacts)"},
+      {h5_with(ok, dir, "x.hdf5", x, one_more(h5_doubles(ok, x), 1.0)),
+       "dataset /fclib_local/W/x has 9 values, the header says 8 (/fclib_local/W/nzmax)"},
+  });
+}
+
+// Counts of W that disagree with its arrays (nz = 5: triplets where there
+// are compressed columns; nzmax = 10; m = n = 0): they segfaulted.
+TEST(BadInputHdf5, CountsThatDisagreeWithTheArraysAreRefused) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "hdf5_counts");
+  const fs::path ok = write_hdf5_problem(dir);
+  const fs::path zero = h5_with(h5_with(ok, dir, "m0.hdf5", "/fclib_local/W/m", std::vector<int>{0}), dir,
+                                "mn0.hdf5", "/fclib_local/W/n", std::vector<int>{0});
+  expect_hdf5_refused({
+      {h5_with(ok, dir, "nz.hdf5", "/fclib_local/W/nz", std::vector<int>{5}),
+       "dataset /fclib_local/W/p has 7 values, the header says 5 (/fclib_local/W/nz)"},
+      {h5_with(ok, dir, "nzmax.hdf5", "/fclib_local/W/nzmax", std::vector<int>{10}),
+       "dataset /fclib_local/W/i has 8 values, the header says 10 (/fclib_local/W/nzmax)"},
+      {zero, "dataset /fclib_local/vectors/q has 6 values, the header says 0 (3 × 0 contacts)"},
+      {h5_with(ok, dir, "m.hdf5", "/fclib_local/W/m", std::vector<int>{7}),
+       "W is 7x6 (datasets /fclib_local/W/m and n): expected square, 3 rows a contact"},
+      {h5_with(ok, dir, "nz2.hdf5", "/fclib_local/W/nz", std::vector<int>{-3}),
+       "dataset /fclib_local/W/nz is -3: expected -1 (compressed columns), -2 (compressed rows) or a number of "
+       "triplets >= 0"},
+      {h5_with(ok, dir, "nz3.hdf5", "/fclib_local/W/nz", std::vector<int>{9}),
+       "dataset /fclib_local/W/nz is 9, more than /fclib_local/W/nzmax = 8"},
+      {h5_with(ok, dir, "nzmax2.hdf5", "/fclib_local/W/nzmax", std::vector<int>{2, 8}),
+       "dataset /fclib_local/W/nzmax has 2 values, expected 1 (a count)"},
+      {h5_with(ok, dir, "dim.hdf5", "/fclib_local/spacedim", std::vector<int>{2}),
+       "dataset /fclib_local/spacedim is 2: space dimension 2, expected 3"},
+  });
+}
+
+// W's structure: a column pointer past nzmax (the reader read past W's
+// arrays), pointers that decrease or do not start at 0, a row index outside
+// W.
+TEST(BadInputHdf5, PointersAndIndicesOutsideWAreRefused) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "hdf5_pointers");
+  const fs::path ok = write_hdf5_problem(dir);
+  const std::string p = "/fclib_local/W/p", i = "/fclib_local/W/i";
+  const std::vector<int> p0 = h5_ints(ok, p), i0 = h5_ints(ok, i);
+  ASSERT_EQ(p0, (std::vector<int>{0, 2, 3, 4, 6, 7, 8}));
+  std::vector<int> past = p0, down = p0, start = p0, row = i0;
+  past.back() = 1000;
+  down[2] = 1;
+  start[0] = 1;
+  row[3] = 6;
+  expect_hdf5_refused({
+      {h5_with(ok, dir, "past.hdf5", p, past),
+       "dataset /fclib_local/W/p: value 6 is 1000, past the 8 entries of /fclib_local/W/nzmax"},
+      {h5_with(ok, dir, "down.hdf5", p, down),
+       "dataset /fclib_local/W/p: value 2 is 1, less than value 1 (2): pointers never decrease"},
+      {h5_with(ok, dir, "start.hdf5", p, start), "dataset /fclib_local/W/p: value 0 is 1, expected 0"},
+      {h5_with(ok, dir, "row.hdf5", i, row),
+       "dataset /fclib_local/W/i: value 3 is 6, outside the 6 rows of W (6x6)"},
+  });
+}
+
+// Shorter q, mu or (global) f than the header says: they were solved from
+// memory the reader never filled. A q declared but never written (which
+// would read as zeros, and with a large header would have the reader
+// allocate for data the file does not hold) is refused too; a non-finite or
+// negative value is named.
+TEST(BadInputHdf5, ShorterDatasetsAndNonFiniteValuesAreRefused) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "hdf5_shorter");
+  const fs::path ok = write_hdf5_problem(dir);
+  const fs::path global = std::string(CDLAB_TEST_DATA) + "/contact-problems/Box_Stacks-i0122-82-5.hdf5";
+  const std::string q = "/fclib_local/vectors/q", mu = "/fclib_local/vectors/mu", f = "/fclib_global/vectors/f";
+  std::vector<double> nan = h5_doubles(ok, q), neg = h5_doubles(ok, mu);
+  nan[4] = std::nan("");
+  neg[1] = -0.5;
+  expect_hdf5_refused({
+      {h5_with(ok, dir, "q.hdf5", q, one_less(h5_doubles(ok, q))),
+       "dataset /fclib_local/vectors/q has 5 values, the header says 6 (3 × 2 contacts)"},
+      {h5_with(ok, dir, "mu.hdf5", mu, one_less(h5_doubles(ok, mu))),
+       "dataset /fclib_local/vectors/mu has 1 value, the header says 2 (2 contacts)"},
+      {h5_with(global, dir, "f.hdf5", f, one_less(h5_doubles(global, f))),
+       "dataset /fclib_global/vectors/f has 449 values, the header says 450 (/fclib_global/M/m, the body dofs)"},
+      {h5_unwritten(ok, dir, "unwritten.hdf5", q, 6),
+       "dataset /fclib_local/vectors/q has 6 values but the file stores only 0 bytes of them"},
+      {h5_with(ok, dir, "nan.hdf5", q, nan), "dataset /fclib_local/vectors/q: value 4 is nan, not a finite number"},
+      {h5_with(ok, dir, "neg.hdf5", mu, neg),
+       "dataset /fclib_local/vectors/mu: value 1 is -0.5, a friction coefficient is >= 0"},
+  });
 }
 
 // Options refused by name, NaN included (CLI11's ranges let NaN through, and

@@ -67,8 +67,10 @@ TEST(Frozen3, ReadsAndSolvesTheFclibProblems) {
 
 // Why the stored solutions of the FCLib global files give a Siconos error
 // of 0.6-0.9 (docs/accuracy.md asked): the files store r = 0 and v = 0, to
-// the last bit, as their "solution" (and the same as their one guess). So
-// the error is that of zero impulses, sqrt(sum_k |P_K(-u~_k(q))|^2) / |q|:
+// the last bit, as their "solution" (and the same as their one guess):
+// their /solution/r and /solution/v are declared and never written, so HDF5
+// reads its fill value, 0. So the error is that of zero impulses,
+// sqrt(sum_k |P_K(-u~_k(q))|^2) / |q|:
 // neither the condensation W = H^T M^-1 H, q = H^T M^-1 f + w nor the reading
 // is at fault, and the same (W, q) is solved to a Siconos error below 1e-6 by
 // NLGS (ReadsAndSolvesTheFclibProblems, Box_Stacks and Spheres). Checked

@@ -15,7 +15,8 @@
 // --lemke, the polyhedral-cone LCP with E face pairs (3d/lemke3.hpp).
 // Exit codes: 0 solved to the tolerance; 1 not converged (sweep cap) or
 // Lemke failed; 2 bad input (usage, option out of range, malformed file or
-// non-finite number: one message naming the file, line and what was wrong).
+// non-finite number: one message naming the file, line (.hdf5: dataset) and
+// what was wrong).
 #include <chrono>
 #include <fstream>
 #include <limits>

@@ -5,8 +5,8 @@
 #include <climits>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <stdexcept>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -30,39 +30,217 @@ namespace {
 
 using SpMat = Eigen::SparseMatrix<double>;
 
-// An fclib_matrix as an Eigen matrix. Triplet storage (nz >= 0): the data
-// and Siconos' reader use p for column indices and i for row indices (the
-// header's comment says the opposite); nz = -1 compressed columns, nz = -2
-// compressed rows. Indices are checked against the size.
-SpMat to_eigen(const fclib_matrix* m, const std::string& what, const std::string& path) {
-  if (!m) throw std::runtime_error(fmt::format("{}: {} is missing", path, what));
-  matrix_form::Triplets t;
-  auto add = [&](long long i, long long j, double v) {
-    if (i < 0 || i >= m->m || j < 0 || j >= m->n)
-      throw std::runtime_error(fmt::format("{}: {} ({}x{}) has an entry at ({}, {})", path, what,
-                                           m->m, m->n, i, j));
-    if (!std::isfinite(v))
-      throw std::runtime_error(fmt::format("{}: {} has a non-finite entry at ({}, {})", path, what, i, j));
-    t.emplace_back(static_cast<int>(i), static_cast<int>(j), v);
-  };
-  if (m->nz >= 0) {
-    for (int k = 0; k < m->nz; ++k) add(m->i[k], m->p[k], m->x[k]);
-  } else if (m->nz == -1 || m->nz == -2) {
-    const int outer = m->nz == -1 ? m->n : m->m;
-    for (int o = 0; o < outer; ++o)
-      for (int k = m->p[o]; k < m->p[o + 1]; ++k)
-        if (m->nz == -1) add(m->i[k], o, m->x[k]);
-        else add(o, m->i[k], m->x[k]);
-  } else {
-    throw std::runtime_error(fmt::format("{}: {} has unknown storage nz = {}", path, what, m->nz));
-  }
-  SpMat A(m->m, m->n);
-  A.setFromTriplets(t.begin(), t.end());
-  A.makeCompressed();
-  return A;
-}
+// ---- reading FCLib files ----------------------------------------------------
+//
+// The file is read here with the HDF5 C API, not with fclib_read_local or
+// fclib_read_global: those allocate every array from the counts the file
+// states (W/m, W/nzmax, ...) and read each dataset whole into it without
+// looking at its extent, so a dataset longer than its count overruns the heap
+// and a shorter one leaves values never written (and a failed read goes on
+// regardless). Here every dataset's extent, type and storage is checked
+// before anything is allocated for it, every count against the others, every
+// sparse structure before it is used, and every value is finite. The layout
+// is FCLib's: /fclib_local/{spacedim, W/{m, n, nz, nzmax, p, i, x},
+// vectors/{q, mu}}, /fclib_global/{spacedim, M/..., H/..., vectors/{f, w, mu}},
+// /solution/{r, v}.
 
-bool has_group(hid_t f, const char* name) { return H5Lexists(f, name, H5P_DEFAULT) > 0; }
+// An HDF5 identifier, closed with its scope.
+class H5Handle {
+ public:
+  H5Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  ~H5Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  H5Handle(const H5Handle&) = delete;
+  H5Handle& operator=(const H5Handle&) = delete;
+  hid_t get() const { return id_; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+// A sparse matrix's counts as the file states them (FCLib's fclib_matrix):
+// nz >= 0 triplets, -1 compressed columns, -2 compressed rows.
+struct SparseHeader {
+  std::string group, name;  // "/fclib_local/W", "W"
+  long long m = 0, n = 0, nz = 0, nzmax = 0;
+};
+
+class FclibFile {
+ public:
+  explicit FclibFile(std::string path)
+      : path_(std::move(path)), file_(H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose) {
+    if (file_.get() < 0) fail("cannot open as HDF5");
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw std::runtime_error(fmt::format("{}: {}", path_, what));
+  }
+
+  // Whether the object `name` (an absolute path) exists: each link on the
+  // way is looked up in turn, as H5Lexists wants.
+  bool has(const std::string& name) const {
+    for (std::size_t k = name.find('/', 1);; k = name.find('/', k + 1)) {
+      if (H5Lexists(file_.get(), name.substr(0, k).c_str(), H5P_DEFAULT) <= 0) return false;
+      if (k == std::string::npos) return true;
+    }
+  }
+
+  // A count of the header: one integer that fits an int.
+  long long count(const std::string& name) const {
+    const std::vector<long long> v = read_ints(name, 1, "expected 1 (a count)");
+    if (v[0] < INT_MIN || v[0] > INT_MAX) fail(fmt::format("dataset {} is {}, out of range", name, v[0]));
+    return v[0];
+  }
+
+  // Exactly n integers (what the header says, `says`).
+  std::vector<long long> read_ints(const std::string& name, long long n, const std::string& says) const {
+    return read<long long>(name, n, n, says, H5T_INTEGER, H5T_NATIVE_LLONG);
+  }
+
+  // n_min to n_max finite numbers.
+  std::vector<double> read_doubles(const std::string& name, long long n_min, long long n_max, const std::string& says,
+                                   bool fill_allowed = false) const {
+    std::vector<double> v = read<double>(name, n_min, n_max, says, H5T_FLOAT, H5T_NATIVE_DOUBLE, fill_allowed);
+    for (std::size_t k = 0; k < v.size(); ++k)
+      if (!std::isfinite(v[k])) fail(fmt::format("dataset {}: value {} is {}, not a finite number", name, k, v[k]));
+    return v;
+  }
+
+  Eigen::VectorXd read_vector(const std::string& name, long long n, const std::string& says,
+                              bool fill_allowed = false) const {
+    const std::vector<double> v = read_doubles(name, n, n, says, fill_allowed);
+    return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+  }
+
+  SparseHeader sparse_header(const std::string& group, const std::string& name) const {
+    if (!has(group)) fail(fmt::format("group {} ({}) is missing", group, name));
+    SparseHeader h{group, name, count(group + "/m"), count(group + "/n"), count(group + "/nz"),
+                   count(group + "/nzmax")};
+    for (const auto& [key, v] : {std::pair{"m", h.m}, std::pair{"n", h.n}, std::pair{"nzmax", h.nzmax}})
+      if (v < 0) fail(fmt::format("dataset {}/{} is {}: a size must be >= 0", group, key, v));
+    if (h.nz < -2)
+      fail(fmt::format("dataset {}/nz is {}: expected -1 (compressed columns), -2 (compressed rows) or a "
+                       "number of triplets >= 0", group, h.nz));
+    if (h.nz > h.nzmax)
+      fail(fmt::format("dataset {}/nz is {}, more than {}/nzmax = {}", group, h.nz, group, h.nzmax));
+    return h;
+  }
+
+  // The matrix a checked header describes: its arrays' lengths, the
+  // pointers (from 0, never decreasing, at most nzmax) and indices (within
+  // the matrix) are checked before any is used. Triplets: p holds column
+  // indices and i row indices (as the data and Siconos' reader have it; the
+  // header's comment says the opposite); duplicates are summed.
+  SpMat sparse(const SparseHeader& h) const {
+    const std::string& g = h.group;
+    matrix_form::Triplets t;
+    auto add = [&](long long i, long long j, double v) {
+      t.emplace_back(static_cast<int>(i), static_cast<int>(j), v);
+    };
+    auto check_index = [&](const std::string& what, std::size_t k, long long v, long long size,
+                           const char* of) {
+      if (v < 0 || v >= size)
+        fail(fmt::format("dataset {}/{}: value {} is {}, outside the {} {} of {} ({}x{})", g, what, k, v, size, of,
+                         h.name, h.m, h.n));
+    };
+    if (h.nz >= 0) {
+      const std::string says = fmt::format("the header says {} ({}/nz)", h.nz, g);
+      const std::vector<long long> col = read_ints(g + "/p", h.nz, says), row = read_ints(g + "/i", h.nz, says);
+      const std::vector<double> x =
+          read_doubles(g + "/x", h.nz, h.nzmax,
+                       fmt::format("the header says {} to {} ({}/nz to {}/nzmax)", h.nz, h.nzmax, g, g));
+      t.reserve(col.size());
+      for (std::size_t k = 0; k < col.size(); ++k) {
+        check_index("p", k, col[k], h.n, "columns");
+        check_index("i", k, row[k], h.m, "rows");
+        add(row[k], col[k], x[k]);
+      }
+    } else {
+      const bool cols = h.nz == -1;
+      const long long outer = cols ? h.n : h.m, inner = cols ? h.m : h.n;
+      const std::vector<long long> p = read_ints(
+          g + "/p", outer + 1,
+          fmt::format("the header says {} ({}/{} + 1, compressed {})", outer + 1, g, cols ? "n" : "m",
+                      cols ? "columns" : "rows"));
+      const std::string says = fmt::format("the header says {} ({}/nzmax)", h.nzmax, g);
+      const std::vector<long long> idx = read_ints(g + "/i", h.nzmax, says);
+      const std::vector<double> x = read_doubles(g + "/x", h.nzmax, h.nzmax, says);
+      if (p[0] != 0) fail(fmt::format("dataset {}/p: value 0 is {}, expected 0", g, p[0]));
+      for (std::size_t o = 1; o < p.size(); ++o) {
+        if (p[o] < p[o - 1])
+          fail(fmt::format("dataset {}/p: value {} is {}, less than value {} ({}): pointers never decrease", g, o,
+                           p[o], o - 1, p[o - 1]));
+        if (p[o] > h.nzmax)
+          fail(fmt::format("dataset {}/p: value {} is {}, past the {} entries of {}/nzmax", g, o, p[o], h.nzmax, g));
+      }
+      t.reserve(static_cast<std::size_t>(p.back()));
+      for (long long o = 0; o < outer; ++o)
+        for (long long k = p[o]; k < p[o + 1]; ++k) {
+          check_index("i", k, idx[k], inner, cols ? "rows" : "columns");
+          if (cols) add(idx[k], o, x[k]);
+          else add(o, idx[k], x[k]);
+        }
+    }
+    SpMat A(h.m, h.n);
+    A.setFromTriplets(t.begin(), t.end());
+    A.makeCompressed();
+    return A;
+  }
+
+ private:
+  // A 1-D (or scalar) dataset of class `cls`, of n_min to n_max values,
+  // which the file really holds: its extent is checked before anything is
+  // allocated, and its storage is in this file (not external or virtual)
+  // and holds them (an unfiltered dataset stores at least its size in
+  // bytes), so that no count the file states makes a large allocation
+  // without the data to fill it. A dataset never written, or written in
+  // part, reads as its fill value where it was not: refused, unless
+  // `fill_allowed` and a fill value is defined (the stored solution: its
+  // size is that of q, which is stored).
+  template <class T>
+  std::vector<T> read(const std::string& name, long long n_min, long long n_max, const std::string& says,
+                      H5T_class_t cls, hid_t memtype, bool fill_allowed = false) const {
+    if (!has(name)) fail(fmt::format("dataset {} is missing", name));
+    const H5Handle ds(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    if (ds.get() < 0) fail(fmt::format("{} is not a dataset (or cannot be opened)", name));
+    const H5Handle type(H5Dget_type(ds.get()), H5Tclose), space(H5Dget_space(ds.get()), H5Sclose),
+        dcpl(H5Dget_create_plist(ds.get()), H5Pclose);
+    if (type.get() < 0 || space.get() < 0 || dcpl.get() < 0) fail(fmt::format("dataset {} cannot be read", name));
+    if (H5Tget_class(type.get()) != cls)
+      fail(fmt::format("dataset {} does not hold {}", name,
+                       cls == H5T_INTEGER ? "integers" : "floating-point numbers"));
+    const int rank = H5Sget_simple_extent_ndims(space.get());
+    if (rank < 0 || rank > 1)
+      fail(fmt::format("dataset {} has rank {}, expected a list of values (rank 1)", name, rank));
+    hsize_t n = 1;
+    if (H5Sget_simple_extent_type(space.get()) == H5S_NULL) n = 0;
+    else if (rank == 1 && H5Sget_simple_extent_dims(space.get(), &n, nullptr) != 1)
+      fail(fmt::format("dataset {} cannot be read", name));
+    if (n < static_cast<hsize_t>(n_min) || n > static_cast<hsize_t>(n_max))
+      fail(fmt::format("dataset {} has {} value{}, {}", name, n, n == 1 ? "" : "s", says));
+    if (n == 0) return {};
+    const H5D_layout_t layout = H5Pget_layout(dcpl.get());
+    if (layout == H5D_VIRTUAL || H5Pget_external_count(dcpl.get()) != 0)
+      fail(fmt::format("dataset {} keeps its values in another file", name));
+    H5D_space_status_t status;
+    H5D_fill_value_t fill;
+    const hsize_t bytes = H5Dget_storage_size(ds.get());
+    const bool stored = H5Dget_space_status(ds.get(), &status) >= 0 && status == H5D_SPACE_STATUS_ALLOCATED &&
+                        (H5Pget_nfilters(dcpl.get()) != 0 || bytes / n >= H5Tget_size(type.get()));
+    if (!stored && (!fill_allowed || H5Pfill_value_defined(dcpl.get(), &fill) < 0 || fill == H5D_FILL_VALUE_UNDEFINED))
+      fail(fmt::format("dataset {} has {} value{} but the file stores only {} bytes of them", name, n,
+                       n == 1 ? "" : "s", bytes));
+    std::vector<T> v(n);
+    if (H5Dread(ds.get(), memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
+      fail(fmt::format("HDF5 cannot read dataset {} (damaged, or a filter it lacks)", name));
+    return v;
+  }
+
+  std::string path_;
+  H5Handle file_;
+};
 
 void check_shape(const Problem3& p) {
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(p.nc);
@@ -249,65 +427,79 @@ Fclib3 read_fclib(const std::string& path) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported here, not printed by HDF5
   if (H5Fis_hdf5(path.c_str()) <= 0)
     throw std::runtime_error(fmt::format("{}: not an HDF5 file (or cannot be opened)", path));
-  bool local = false, global = false, solution = false;
-  {
-    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-    if (f < 0) throw std::runtime_error(fmt::format("{}: cannot open as HDF5", path));
-    local = has_group(f, "/fclib_local");
-    global = has_group(f, "/fclib_global");
-    solution = has_group(f, "/solution");
-    H5Fclose(f);
-  }
+  const FclibFile file(path);
   Fclib3 out;
   Problem3& p = out.problem;
-  if (local) {
-    std::unique_ptr<fclib_local, void (*)(fclib_local*)> L(fclib_read_local(path.c_str()),
-                                                           fclib_delete_local);
-    if (!L) throw std::runtime_error(fmt::format("{}: fclib_read_local failed", path));
-    if (L->spacedim != 3)
-      throw std::runtime_error(fmt::format("{}: space dimension {}, expected 3", path, L->spacedim));
-    if (L->V || L->R) throw std::runtime_error(fmt::format("{}: mixed problem (V, R): not supported", path));
-    p.W = to_eigen(L->W, "W", path);
-    if (p.W.rows() != p.W.cols() || p.W.rows() % 3)
-      throw std::runtime_error(fmt::format("{}: W is {}x{}", path, p.W.rows(), p.W.cols()));
-    p.nc = static_cast<int>(p.W.rows() / 3);
-    p.q = Eigen::Map<const Eigen::VectorXd>(L->q, 3 * p.nc);
-    p.mu = Eigen::Map<const Eigen::VectorXd>(L->mu, p.nc);
-  } else if (global) {
-    std::unique_ptr<fclib_global, void (*)(fclib_global*)> G(fclib_read_global(path.c_str()),
-                                                             fclib_delete_global);
-    if (!G) throw std::runtime_error(fmt::format("{}: fclib_read_global failed", path));
-    if (G->spacedim != 3)
-      throw std::runtime_error(fmt::format("{}: space dimension {}, expected 3", path, G->spacedim));
-    if (G->G) throw std::runtime_error(fmt::format("{}: equality constraints (G): not supported", path));
-    const SpMat M = to_eigen(G->M, "M", path), H = to_eigen(G->H, "H", path);
-    if (M.rows() != M.cols() || H.rows() != M.rows() || H.cols() % 3)
-      throw std::runtime_error(fmt::format("{}: M {}x{}, H {}x{}", path, M.rows(), M.cols(), H.rows(), H.cols()));
-    p.nc = static_cast<int>(H.cols() / 3);
+  // "the header says N (3 × nc contacts)"
+  const auto per_contact = [&](int k) {
+    return fmt::format("the header says {} ({}{} contacts)", static_cast<long long>(k) * p.nc,
+                       k == 1 ? "" : fmt::format("{} × ", k), p.nc);
+  };
+  const auto spacedim = [&](const std::string& name) {
+    const long long d = file.count(name);
+    if (d != 3) file.fail(fmt::format("dataset {} is {}: space dimension {}, expected 3", name, d, d));
+  };
+  if (file.has("/fclib_local")) {
+    spacedim("/fclib_local/spacedim");
+    if (file.has("/fclib_local/V") || file.has("/fclib_local/R"))
+      file.fail("mixed problem (V, R): not supported");
+    const SparseHeader W = file.sparse_header("/fclib_local/W", "W");
+    if (W.m != W.n || W.m % 3)
+      file.fail(fmt::format("W is {}x{} (datasets /fclib_local/W/m and n): expected square, 3 rows a contact",
+                            W.m, W.n));
+    p.nc = static_cast<int>(W.m / 3);
+    // q first: the file holds its 3nc values, which bounds what W's size
+    // makes the matrix allocate (its column pointers).
+    p.q = file.read_vector("/fclib_local/vectors/q", 3LL * p.nc, per_contact(3));
+    p.mu = file.read_vector("/fclib_local/vectors/mu", p.nc, per_contact(1));
+    p.W = file.sparse(W);
+  } else if (file.has("/fclib_global")) {
+    spacedim("/fclib_global/spacedim");
+    if (file.has("/fclib_global/G")) file.fail("equality constraints (G): not supported");
+    const SparseHeader Mh = file.sparse_header("/fclib_global/M", "M"),
+                       Hh = file.sparse_header("/fclib_global/H", "H");
+    if (Mh.m != Mh.n || Mh.m == 0)
+      file.fail(fmt::format("M is {}x{} (datasets /fclib_global/M/m and n): expected square, one row a body dof",
+                            Mh.m, Mh.n));
+    if (Hh.m != Mh.m || Hh.n % 3)
+      file.fail(fmt::format("H is {}x{} and M {}x{} (datasets /fclib_global/H/m and n): expected a row a body dof "
+                            "and 3 columns a contact", Hh.m, Hh.n, Mh.m, Mh.n));
+    p.nc = static_cast<int>(Hh.n / 3);
     out.global = true;
-    out.bodies_dofs = static_cast<int>(M.rows());
+    out.bodies_dofs = static_cast<int>(Mh.m);
+    // The vectors first: the file holds them, which bounds what the sizes
+    // of M and H make the matrices allocate.
+    const Eigen::VectorXd f = file.read_vector(
+        "/fclib_global/vectors/f", Mh.m, fmt::format("the header says {} (/fclib_global/M/m, the body dofs)", Mh.m));
+    const Eigen::VectorXd w = file.read_vector("/fclib_global/vectors/w", 3LL * p.nc, per_contact(3));
+    p.mu = file.read_vector("/fclib_global/vectors/mu", p.nc, per_contact(1));
+    const SpMat M = file.sparse(Mh), H = file.sparse(Hh);
     // W = H^T M^-1 H, q = H^T M^-1 f + w (FCLib: M v = H r + f, u = H^T v + w).
     Eigen::SimplicialLDLT<SpMat> chol(M);
     if (chol.info() != Eigen::Success || chol.vectorD().minCoeff() <= 0)
-      throw std::runtime_error(fmt::format("{}: M is not symmetric positive definite", path));
+      file.fail("M is not symmetric positive definite");
     const SpMat X = chol.solve(H);
     p.W = SpMat(H.transpose() * X);
     p.W.prune(0.0);
     p.W.makeCompressed();
-    const Eigen::VectorXd f = Eigen::Map<const Eigen::VectorXd>(G->f, M.rows());
-    p.q = H.transpose() * chol.solve(f) + Eigen::Map<const Eigen::VectorXd>(G->w, 3 * p.nc);
-    p.mu = Eigen::Map<const Eigen::VectorXd>(G->mu, p.nc);
+    p.q = H.transpose() * chol.solve(f) + w;
+    if (!p.W.coeffs().allFinite() || !p.q.allFinite())
+      file.fail("W or q, condensed from M, H, f and w, is not finite");
   } else {
-    throw std::runtime_error(fmt::format("{}: no fclib_local or fclib_global group", path));
+    file.fail("no fclib_local or fclib_global group");
   }
-  if (!p.q.allFinite() || !p.mu.allFinite() || (p.nc && p.mu.minCoeff() < 0))
-    throw std::runtime_error(fmt::format("{}: q or mu not finite, or mu < 0", path));
-  if (solution) {
-    fclib_solution* s = fclib_read_solution(path.c_str());
-    if (s && s->r) out.r_ref = Eigen::Map<const Eigen::VectorXd>(s->r, 3 * p.nc);
-    if (s && s->v && out.global) out.v_ref = Eigen::Map<const Eigen::VectorXd>(s->v, out.bodies_dofs);
-    if (s) fclib_delete_solutions(s, 1);
-  }
+  for (Eigen::Index k = 0; k < p.mu.size(); ++k)
+    if (p.mu[k] < 0)
+      file.fail(fmt::format("dataset /fclib_{}/vectors/mu: value {} is {}, a friction coefficient is >= 0",
+                            out.global ? "global" : "local", k, p.mu[k]));
+  // The stored solution, if any: r (3 a contact) and, global, v. Siconos'
+  // global files declare both and never write them: they read as HDF5's fill
+  // value, 0 (GlobalFilesStoreZeroAsSolution).
+  if (file.has("/solution/r")) out.r_ref = file.read_vector("/solution/r", 3LL * p.nc, per_contact(3), true);
+  if (out.global && file.has("/solution/v"))
+    out.v_ref = file.read_vector("/solution/v", out.bodies_dofs,
+                                 fmt::format("the header says {} (/fclib_global/M/m, the body dofs)", out.bodies_dofs),
+                                 true);
   return out;
 }
 

@@ -60,10 +60,16 @@ void write_fclib(const Problem3& p, const std::string& path, const std::string& 
                  const std::string& description, const Eigen::VectorXd* solution = nullptr,
                  const Eigen::VectorXd* guess = nullptr);
 
-// Reads an FCLib .hdf5 problem of space dimension 3. Throws
-// std::runtime_error naming the file and what was wrong (not HDF5, no
-// fclib_local/fclib_global group, dimension 2, equality constraints G, bad
-// matrix indices, M not positive definite).
+// Reads an FCLib .hdf5 problem of space dimension 3 with the HDF5 C API
+// (not FCLib's reader, which trusts the file's counts). Every dataset's
+// length is checked against the header (W's m, n, nz, nzmax; 3 values of q
+// and 1 of mu a contact, nc = m / 3; global: f of M's size, w and mu of H's
+// columns) before anything is allocated for it, and must be stored in the
+// file; W's (M's, H's) pointers start at 0, never decrease and stay within
+// nzmax, their indices within the matrix; every value is finite and mu >= 0.
+// Throws std::runtime_error naming the file and the dataset or what was
+// wrong (not HDF5, no fclib_local/fclib_global group, dimension 2, equality
+// constraints G, M not positive definite).
 Fclib3 read_fclib(const std::string& path);
 
 // Reads a 3D problem in Siconos' text form (.dat; core/siconos_dat.hpp:
