@@ -127,6 +127,10 @@ TEST(AnalysisIo, SeriesCsvAndItsErrors) {
   EXPECT_NE(message([&] { Table::read_csv((d / "words-short.csv").string(), false, {"protocol"}); })
                 .find("line 2: 1 fields, the header has 2"),
             std::string::npos);
+  // A column named twice: which of the two a reader meant is unknown.
+  write(d / "twice.csv", "step,q,q\n0,1,2\n");
+  EXPECT_NE(message([&] { Table::read_csv((d / "twice.csv").string()); }).find("column 'q' appears twice"),
+            std::string::npos);
   // A NUL byte inside a number: the field is not a number (it read as 0.).
   write(d / "nul.csv", std::string("a,b\n1,0.\0" "403\n", 13));
   EXPECT_NE(message([&] { Table::read_csv((d / "nul.csv").string()); }).find("column 'b'"), std::string::npos);
@@ -491,6 +495,17 @@ TEST(AnalysisIo, BadInputExitsTwoWithAClearMessage) {
   for (const char c : f.out)
     EXPECT_TRUE(c == '\n' || (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f)) << "byte " << int(c);
   EXPECT_NE(f.out.find("\\x1B[2J\\x07\\xFF\\xFE"), std::string::npos) << f.out;
+  // An empty text value is refused, not taken for the default (--column '' was q_over_p).
+  f = run_cda(fmt::format("steady {} --column ''", (d / "a").string()));
+  EXPECT_EQ(f.code, 2) << f.out;
+  EXPECT_NE(f.out.find("--column: an empty value"), std::string::npos) << f.out;
+  f = run_cda(fmt::format("fit mu-i --table {} --toml ''", t.string()));
+  EXPECT_EQ(f.code, 2) << f.out;
+  EXPECT_NE(f.out.find("--toml: an empty value"), std::string::npos) << f.out;
+  // A volume so small that the stress is inf: refused, as the scenes' +-1e100 rule refuses it.
+  f = run_cda(fmt::format("fabric {} --volume 4.9e-324", (d / "a").string()));
+  EXPECT_EQ(f.code, 2) << f.out;
+  EXPECT_NE(f.out.find("--volume"), std::string::npos) << f.out;
 }
 
 // A series whose last row is cut, which repeats a step or whose time runs

@@ -24,6 +24,8 @@
 #include <vector>
 
 #include "cli_util.hpp"
+#include "config.hpp"
+#include "derived.hpp"
 #include "problem3.hpp"
 
 namespace fs = std::filesystem;
@@ -88,7 +90,7 @@ void expect_refused(const std::string& sets, const std::vector<std::string>& wor
 
 TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
   // Cases that would otherwise exit 0 with nothing simulated.
-  expect_refused("--set time.duration=1e90", {"1e+09", "time.duration"});
+  expect_refused("--set time.duration=1e90", {"limit of 1000000000", "time.duration"});
   expect_refused("--set time.dt=1", {"less than one step", "time.dt"});
   expect_refused("--set time.duration=0", {"less than one step", "time.duration"});
   expect_refused("--set time.duration=inf", {"time.duration = inf", "finite"});
@@ -108,7 +110,8 @@ TEST(BadInput, RunsOfNoStepOrOfTooManyStepsAreRefused) {
       "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 20\n[time]\nduration = 0.01\n"
       "[shear]\nmode = \"periodic\"\nwidth = 0.02\nheight = 0.02\npressure = 100.0\n";
   expect_refused("--set shear.dt_tp=100", {"less than one step", "shear.dt_tp"}, shear);
-  expect_refused("--set shear.inertial_number=0.1 --set shear.strain=1e90", {"shear.strain", "1e+09"}, shear);
+  expect_refused("--set shear.inertial_number=0.1 --set shear.strain=1e90", {"shear.strain", "limit of 1000000000"},
+                 shear);
   // An enormous cohesion number, which would give an infinite pull-off force.
   expect_refused("--set contact.cohesion_number=1e308 --set shear.pressure=1e10",
                  {"contact.cohesion_number = 1e+308", "between 1e-100 and 1e+100"}, shear);
@@ -866,4 +869,45 @@ TEST(Continuation, AShearRunStartsFromAnotherAtANewRate) {
   // The cell continues: b's first height is a's last (within one step's change).
   const double ha = col(ra, "cell_height").back(), hb = col(rb, "cell_height").front();
   EXPECT_NEAR(hb, ha, 1e-3 * ha);
+}
+
+// The limit of 1e9 steps includes 1e9 (the run plan's count, the nearest
+// integer of duration/dt), and a count just past it is printed whole, not
+// as "1e+09" beside "more than the limit of 1e+09".
+TEST(BadInput, TheStepLimitIsInclusiveAndItsMessageExact) {
+  const std::string base = "name = \"s\"\n[particles]\nn = 20\n[time]\ndt = 1e-3\n";
+  EXPECT_NO_THROW(cd::check_derived(cd::parse_scene(base + "duration = 1e6\n", "s.toml")));
+  try {
+    cd::check_derived(cd::parse_scene(base + "duration = 1000000.001\n", "s.toml"));
+    ADD_FAILURE() << "1000000001 steps were accepted";
+  } catch (const cd::SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("would take 1000000001 steps"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("limit of 1000000000"), std::string::npos) << e.what();
+  }
+}
+
+// Messages that showed another value than the one given, or echoed bytes
+// that are not text: a seed past 64 bits (the TOML reader holds it at
+// 2^63 - 1), a folder given as a checkpoint (read as a truncated file), a
+// byte 0xFF in a scene (quoted raw by the TOML reader), and an output
+// folder whose name holds a newline (accepted, and then in every log line).
+TEST(BadInput, MessagesShowWhatWasGivenAndOnlyText) {
+  expect_refused("--set particles.seed=9223372036854775808", {"particles.seed = > 2^63 - 1", "[0, 4294967295]"});
+  const fs::path dir = cdtest::scratch_dir("bad_input", "messages");
+  const fs::path run = dir / "run";
+  fs::create_directories(run);
+  const std::string shear = "name = \"s\"\n[gravity]\ng = [0.0, 0.0]\n[particles]\nn = 0\n"
+                            "[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.1\nstrain = 1.0\n"
+                            "start = \"" + run.string() + "\"\n";
+  expect_refused("", {"shear.start", "is a folder, not a checkpoint file"}, shear);
+  const fs::path ff = write(dir, "ff.toml", "name = \"\xff\"\n");
+  const cdtest::CmdResult r = cdsim(ff.string() + " -q --out " + (dir / "out").string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("\\xFF"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find('\xff'), std::string::npos) << "the raw byte reached the message";
+  const cdtest::CmdResult nl = cdsim(std::string(CDLAB_SOURCE_DIR) + "/configs/default.toml -q --out '" +
+                                     (dir / "a\nb").string() + "'");
+  EXPECT_EQ(nl.code, 2) << nl.out;
+  EXPECT_NE(nl.out.find("control character (\\x0A)"), std::string::npos) << nl.out;
+  EXPECT_FALSE(fs::exists(dir / "a\nb"));
 }

@@ -53,7 +53,7 @@ Handler draw(CLI::App& sub);
 // to every floating-point option of every command (declare_all), so a range
 // below only has to say its range.
 CLI::Validator finite_number();
-CLI::Validator positive_number();      // > 0 (and finite)
+CLI::Validator positive_number();      // in [1e-100, 1e100]
 CLI::Validator non_negative_number();  // >= 0 (and finite)
 // A file the command will write: its folder exists and is writable, and the
 // path is not a folder; checked before any work is done.
@@ -65,7 +65,7 @@ CLI::Validator window_spec();
 CLI::Option* add_window_option(CLI::App& sub, std::string& window);
 CLI::Option* add_toml_option(CLI::App& sub, std::string& path);
 // Adds finite_number() to every floating-point option of app and of its
-// subcommands, recursively.
+// subcommands, recursively, and refuses an empty value of a text option.
 void require_finite_numbers(CLI::App& app);
 
 // The command as typed, for the plots' "made by" line (set once by main).

@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "cd/src/scene/printable.hpp"
+
 namespace cda {
 
 // Exit codes of cdanalysis (and of cdsim and cdproblem, where they apply):
@@ -40,9 +42,8 @@ inline void refuse_folder(const std::string& path) {
     throw InputError(fmt::format("'{}' is a folder, not a file", path));
 }
 
-// Text from a file or the command line, safe to print in a message: control
-// characters and bytes that are not UTF-8 shown as \xNN, and at most `max`
-// bytes (then "..."), so that binary junk never reaches the terminal.
-std::string printable(const std::string& s, std::size_t max = 4000);
+// Text from a file or the command line, safe to print in a message
+// (cd/src/scene/printable.hpp: the rule cdsim's scene errors follow too).
+using cd::printable;
 
 }  // namespace cda

@@ -32,29 +32,6 @@ std::vector<std::string> split(const std::string& line) {
 
 Table::Table(std::vector<std::string> names) : names_(std::move(names)), cols_(names_.size()) {}
 
-std::string printable(const std::string& s, std::size_t max) {
-  std::string o;
-  const auto* b = reinterpret_cast<const unsigned char*>(s.data());
-  const std::size_t n = s.size();
-  for (std::size_t i = 0; i < n;) {
-    if (o.size() >= max) return o + "...";
-    const unsigned char c = b[i];
-    // Length of the UTF-8 sequence starting here (0: not a valid lead byte).
-    const std::size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
-    bool ok = len > 0 && i + len <= n;
-    for (std::size_t k = 1; ok && k < len; ++k) ok = (b[i + k] & 0xC0) == 0x80;
-    if (ok && len == 1 && (c < 0x20 || c == 0x7F) && c != '\n' && c != '\t') ok = false;
-    if (!ok) {
-      o += fmt::format("\\x{:02X}", c);
-      ++i;
-      continue;
-    }
-    o.append(s, i, len);
-    i += len;
-  }
-  return o;
-}
-
 Table Table::read_csv(const std::string& path, bool allow_nan, const std::vector<std::string>& text) {
   refuse_folder(path);
   std::ifstream in(path);
@@ -72,6 +49,8 @@ Table Table::read_csv(const std::string& path, bool allow_nan, const std::vector
   std::vector<bool> keep;
   for (const auto& n : header) {
     if (n.empty()) throw InputError(fmt::format("'{}': empty column name in the header", path));
+    if (std::find(header.begin(), header.begin() + keep.size(), n) != header.begin() + keep.size())
+      throw InputError(fmt::format("'{}': column '{}' appears twice in the header", path, printable(n, 40)));
     keep.push_back(std::find(text.begin(), text.end(), n) == text.end());
     if (keep.back()) t.names_.push_back(n);
   }

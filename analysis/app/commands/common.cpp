@@ -55,8 +55,11 @@ CLI::Validator number_check(const char* name, bool (*ok)(double), const char* ru
 CLI::Validator finite_number() {
   return number_check("FINITE", [](double) { return true; }, "finite");
 }
+// A positive quantity of a physical size: the scenes' rule (magnitudes in
+// [1e-100, 1e100]), so that a quotient by it stays finite (a volume of
+// 4.9e-324 made the stress inf).
 CLI::Validator positive_number() {
-  return number_check("POSITIVE", [](double v) { return v > 0; }, "> 0");
+  return number_check("POSITIVE", [](double v) { return v >= 1e-100 && v <= 1e100; }, "> 0 (in [1e-100, 1e100])");
 }
 CLI::Validator non_negative_number() {
   return number_check("NONNEGATIVE", [](double v) { return v >= 0; }, ">= 0");
@@ -67,6 +70,7 @@ CLI::Validator writable_file() {
       [](std::string& path) -> std::string {
         namespace fs = std::filesystem;
         std::error_code ec;
+        if (path.empty()) return "an empty value";
         if (fs::is_directory(path, ec)) return fmt::format("'{}' is a folder, not a file", printable(path, 200));
         fs::path dir = fs::path(path).parent_path();
         if (dir.empty()) dir = ".";
@@ -107,8 +111,14 @@ CLI::Option* add_toml_option(CLI::App& sub, std::string& path) {
 }
 
 void require_finite_numbers(CLI::App& app) {
-  for (CLI::Option* o : app.get_options())
+  for (CLI::Option* o : app.get_options()) {
     if (o->get_type_name() == "FLOAT") o->check(finite_number());
+    // An empty text (--column '') is refused: it meant the option's
+    // default without a word (files: writable_file()).
+    if (o->get_type_name() == "TEXT")
+      o->check(CLI::Validator([](std::string& t) { return t.empty() ? std::string("an empty value") : ""; },
+                              "NONEMPTY"));
+  }
   for (CLI::App* sub : app.get_subcommands({})) require_finite_numbers(*sub);
 }
 

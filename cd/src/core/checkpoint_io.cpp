@@ -4,6 +4,7 @@
 #include <bit>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -103,6 +104,10 @@ void finish(Writer& o, const RunTotals& totals, const std::string& path) {
 
 Header open(const std::string& path, std::string& data, Reader& in, int dimension, bool resume) {
   {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+      throw CheckpointError(fmt::format("checkpoint '{}' is a folder, not a checkpoint file (a run folder's is "
+                                        "its checkpoint.bin)", path));
     std::ifstream f(path, std::ios::binary);
     std::ostringstream text;
     if (f) text << f.rdbuf();

@@ -1,4 +1,5 @@
 #include "files.hpp"
+#include "printable.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -59,9 +60,18 @@ void rename_into_place(const std::string& tmp, const std::string& path) {
 
 void check_output_dir(const std::string& dir) {
   const fs::path p = fs::absolute(fs::path(dir.empty() ? "." : dir)).lexically_normal();
+  // The name on one line: printable() keeps newlines and tabs, a name shows them too.
+  std::string shown;
+  for (const char c : printable(dir)) shown += c == '\n' ? "\\x0A" : c == '\t' ? "\\x09" : std::string(1, c);
   auto fail = [&](const std::string& why) {
-    throw OutputError(fmt::format("output folder '{}' {}", dir, why));
+    throw OutputError(fmt::format("output folder '{}' {}", shown, why));
   };
+  // A newline or another control character in the name would break the
+  // run's log lines and the campaign scripts that list folders.
+  for (const char c : dir)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F)
+      fail(fmt::format("has a control character (\\x{:02X}) in its name: give a name without one",
+                       static_cast<unsigned char>(c)));
   std::error_code ec;
   // status() reports not_found for ENOENT and ENOTDIR alike, so a path below
   // a regular file walks up to that file and fails there.

@@ -3,6 +3,7 @@
 // resolved scene.toml and the Markdown table are all generated from them.
 // Defaults are never written here: they are the initialisers in scene.hpp.
 #include "config.hpp"
+#include "printable.hpp"
 #include "protocol.hpp"
 
 #include <algorithm>
@@ -315,9 +316,17 @@ std::string get(const toml::value& v, double& x) {
 template <class I>
 std::string get_integer(const toml::value& v, I& x) {
   if (!v.is_integer()) return ": expected an integer, got " + type_name(v);
-  if (!std::in_range<I>(v.as_integer()))
-    return fmt::format(" = {}: must be an integer in [{}, {}]", v.as_integer(),
+  if (!std::in_range<I>(v.as_integer())) {
+    // The TOML reader holds integers past 64 bits at the 64-bit bounds:
+    // the value written is not the one it gives.
+    const auto x64 = v.as_integer();
+    const bool clamped = x64 == std::numeric_limits<decltype(x64)>::max() ||
+                         x64 == std::numeric_limits<decltype(x64)>::min();
+    return fmt::format(" = {}: must be an integer in [{}, {}]",
+                       clamped ? fmt::format("{}{}", x64 < 0 ? "< " : "> ", x64 < 0 ? "-2^63" : "2^63 - 1")
+                               : std::to_string(x64),
                        std::numeric_limits<I>::min(), std::numeric_limits<I>::max());
+  }
   x = static_cast<I>(v.as_integer());
   return "";
 }
@@ -715,7 +724,8 @@ Scene parse_scene(const std::string& text, const std::string& path,
   } catch (const toml::syntax_error& e) {
     std::string what = e.what();
     if (what.rfind("[error] ", 0) == 0) what.erase(0, 8);
-    throw ConfigError(fmt::format("{}:{}: TOML syntax error: {}", path, e.location().line(), what));
+    // The reader quotes the line: bytes that are not text shown as \xNN.
+    throw ConfigError(fmt::format("{}:{}: TOML syntax error: {}", path, e.location().line(), printable(what)));
   } catch (const std::exception& e) {
     throw ConfigError(fmt::format("{}: {}", path, e.what()));
   }

@@ -259,10 +259,15 @@ void check_derived(const Scene& s) {
   const double T = run_duration(s);
   const char* T_from = s.strain > 0 ? "shear.strain / shear rate" : "time.duration";
   const double steps = T / dt;
-  if (!std::isfinite(T) || !(steps < kMaxSteps))
-    fail(fmt::format("the run would take {:.3g} steps ({} = {:.4g} s, time step {:.4g} s), more "
-                     "than the limit of {:.0e}: shorten the run or lengthen the step",
-                     steps, T_from, T, dt, kMaxSteps));
+  // The run plan's count (run_plan.cpp: the nearest integer), the limit
+  // included; printed whole, so that a count just past it does not read as
+  // the limit itself.
+  if (!std::isfinite(steps) || std::round(steps) > kMaxSteps)
+    fail(fmt::format("the run would take {} steps ({} = {:.4g} s, time step {:.4g} s), more "
+                     "than the limit of {:.0f}: shorten the run or lengthen the step",
+                     std::isfinite(steps) && steps < 1e15 ? fmt::format("{:.0f}", std::round(steps))
+                                                          : fmt::format("{:.3g}", steps),
+                     T_from, T, dt, kMaxSteps));
   if (!(steps >= 1 - 1e-9))
     fail(fmt::format("the run would take less than one step: its duration ({} = {:.4g} s) is "
                      "shorter than the time step ({} = {:.4g} s)", T_from, T, dt_from, dt));
