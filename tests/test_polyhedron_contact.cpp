@@ -12,8 +12,8 @@
 //    nothing.
 //  - collide(B, A) mirrors collide(A, B).
 //  - Stability: a 1e-12 perturbation keeps the reference face, kind and
-//    keys; a configuration exactly between two faces switches without the
-//    hint and holds with it.
+//    keys; a configuration exactly between two faces, or two edge pairs,
+//    switches without the hint and holds with it.
 //  - An octagon of 8 points reduced to 4: the deepest kept, the largest
 //    area of 4 of them (all subsets tried).
 //  - Random shapes: the separation equals the support gap along the normal
@@ -430,6 +430,34 @@ TEST(PolyhedronContact, HintHoldsAFaceExactlyTiedWithAnother) {
     for (double dz : {eps, -eps, 0.0}) EXPECT_EQ(ref(dz, hint), hint);
   // A face better by more than the margin takes over from the hint.
   EXPECT_EQ(ref(0.005 * h, down), up);
+}
+
+TEST(PolyhedronContact, HintHoldsAnEdgePairExactlyTiedWithAnother) {
+  // A's top edge along x (A turned 45 degrees about x); B's body diagonal
+  // vertical, a vertex down, turned about z so that one of its three lower
+  // edges lies in the xz plane: the other two are mirror images through it,
+  // and with the vertex sunk into A's edge the two pairs (A's edge, each of
+  // them) tie exactly. Moved by +-1e-12 along y, the pair follows the
+  // round-off without the hint and stays with it.
+  const Quat qa = about(Vec3::UnitX(), std::numbers::pi / 4);
+  const Quat q0 = Quat::FromTwoVectors(Vec3(1, 1, 1), -Vec3::UnitZ());
+  const Vec3 e = q0 * Vec3(0, 0, -1);
+  const Quat qb = about(Vec3::UnitZ(), -std::atan2(e.y(), e.x())) * q0;
+  const Vec3 x(0.1, 0, h * kS2 + h * std::sqrt(3.0) - 0.01);
+  const double eps = 1e-12;
+  auto axis = [&](double dy, std::optional<PolyAxis> hint) {
+    const auto c = collide(cube(), pose(Vec3::Zero(), qa), cube(), pose(x + Vec3(0, dy, 0), qb), 0.02, hint);
+    EXPECT_TRUE(c);
+    EXPECT_EQ(c->kind, PolyContactKind::EdgeEdge);
+    return c ? c->axis : PolyAxis{};
+  };
+  const PolyAxis plus = axis(eps, std::nullopt), minus = axis(-eps, std::nullopt);
+  EXPECT_EQ(plus.kind, PolyAxisKind::EdgePair);
+  EXPECT_EQ(minus.kind, PolyAxisKind::EdgePair);
+  EXPECT_EQ(plus.a, minus.a);  // A's top edge
+  EXPECT_NE(plus.b, minus.b);  // B's two mirror edges
+  for (const PolyAxis& hint : {plus, minus})
+    for (double dy : {eps, -eps, 0.0}) EXPECT_EQ(axis(dy, hint), hint);
 }
 
 TEST(PolyhedronContact, OctagonIsReducedToTheDeepestAndTheLargestArea) {
