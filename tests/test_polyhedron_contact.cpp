@@ -465,7 +465,8 @@ TEST(PolyhedronContact, OctagonIsReducedToTheDeepestAndTheLargestArea) {
   // 0.8 degrees: its top is a diamond reaching past the upper cube B's
   // square bottom on every side, so clipping B's bottom against A's top's
   // side planes gives an octagon. (Tilted more, the diamond's corners
-  // outside B dip and an edge pair beats the face: 1 degree at H = h.)
+  // outside B dip and an edge pair beats the face: at H = h from 0.5 to 1
+  // degree on, by the tilt's direction.)
   // Expected: the octagon by brute force (all intersections of the 8 lines
   // in B's bottom plane z = H inside all 8 half planes), its gaps from A's
   // top plane n_A . x = H, and the best 4 of them containing the deepest.
