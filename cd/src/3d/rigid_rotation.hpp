@@ -22,16 +22,16 @@
 // equations), and the two half rotations about w- and w+ leave them as they
 // are, so the energy and |L| at the ends of the steps stay those of the
 // first step to round-off at any step. Rejected: one linearised step of
-// backward Euler (Bullet's integrateGyroscopicImplicit), unconditionally
-// stable but dissipative: a free body spun near its intermediate axis at
-// dt |w| = 0.3 lost 2/3 of its angular momentum in 10^4 steps and ended
-// spinning about its major axis, a torque where there is none; one
-// linearised step of the midpoint rule keeps the second order but neither
-// invariant (its energy moves by O((dt |w|)^3) a step, both ways: up to
-// 1e-3 E in one step at dt |w| = 0.3). Newton, from that linearised step,
-// takes at most 4 solves of 3x3 systems at dt |w| <= 0.5 (2 for a
-// symmetric top, whose equation is linear), 7 at dt |w| = 3, and may not
-// converge beyond; only bodies that are not spheres pay for it.
+// backward Euler (Bullet's integrateGyroscopicImplicit), stable but
+// dissipative: a free body spun near its intermediate axis at dt |w| = 0.3
+// kept 0.31 of its angular momentum after 10^4 steps and ended spinning
+// about its major axis, a torque where there is none (test_rigid_rotation);
+// one linearised step of the midpoint rule keeps the second order but
+// neither invariant (its energy moves by O((dt |w|)^3) E a step, both
+// ways). Newton, from that linearised step, takes at most 4 solves of 3x3
+// systems at dt |w| <= 0.5 (2 for a symmetric top, whose equation is
+// linear), 7 at dt |w| = 3, and may not converge beyond; only bodies that
+// are not spheres pay for it.
 #pragma once
 #include <cstdint>
 
@@ -79,9 +79,9 @@ inline Vec3 free_angular_velocity(const Vec3& moments, const Quat& q_m, const Ve
 }
 
 // The explicit variant, w + dt I_m^-1 (tau - w x I_m w): it adds the energy
-// dt^2 |g|^2 / (2 I) to a free body at every step (g the gyroscopic torque)
-// and blows up a fast asymmetric spin. For the tests, which show the
-// difference; not for the engine.
+// dt^2 sum_k g_k^2 / (2 I_k) to a free body at every step (g the gyroscopic
+// torque, principal frame) and blows up a fast asymmetric spin. For the
+// tests, which show the difference; not for the engine.
 Vec3 free_angular_velocity_explicit(const Vec3& moments, const Quat& q_m, const Vec3& w, const Vec3& tau,
                                     double dt);
 
