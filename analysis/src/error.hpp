@@ -45,4 +45,10 @@ inline void refuse_folder(const std::string& path) {
 // bytes (then "..."), so that binary junk never reaches the terminal.
 std::string printable(const std::string& s, std::size_t max = 4000);
 
+// The text of a TOML file the analysis reads, checked to be UTF-8 first
+// (TOML's rule; toml11 3.7 reads outside its buffer when it reports a
+// string that is not). Throws InputError naming the file, the line and the
+// byte, or that it cannot be opened.
+std::string toml_text(const std::string& path);
+
 }  // namespace cda

@@ -55,6 +55,41 @@ std::string printable(const std::string& s, std::size_t max) {
   return o;
 }
 
+std::string toml_text(const std::string& path) {
+  refuse_folder(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("cannot open '{}'", path));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  std::string s = std::move(ss).str();
+  // Each sequence as RFC 3629's table allows it (no overlong forms,
+  // surrogates or code points past U+10FFFF), as toml11's lexer does.
+  const auto* b = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  const auto in_range = [&](std::size_t k, unsigned lo, unsigned hi) { return k < n && b[k] >= lo && b[k] <= hi; };
+  for (std::size_t i = 0, line = 1; i < n;) {
+    const unsigned c = b[i];
+    std::size_t len = 0;
+    if (c < 0x80)
+      len = 1;
+    else if (c >= 0xC2 && c <= 0xDF)
+      len = in_range(i + 1, 0x80, 0xBF) ? 2 : 0;
+    else if (c >= 0xE0 && c <= 0xEF)
+      len = in_range(i + 1, c == 0xE0 ? 0xA0 : 0x80, c == 0xED ? 0x9F : 0xBF) && in_range(i + 2, 0x80, 0xBF) ? 3 : 0;
+    else if (c >= 0xF0 && c <= 0xF4)
+      len = in_range(i + 1, c == 0xF0 ? 0x90 : 0x80, c == 0xF4 ? 0x8F : 0xBF) && in_range(i + 2, 0x80, 0xBF) &&
+                    in_range(i + 3, 0x80, 0xBF)
+                ? 4
+                : 0;
+    if (len == 0)
+      throw InputError(fmt::format("'{}' is not TOML text: invalid UTF-8 byte 0x{:02x} at line {}, byte {}", path, c,
+                                   line, i + 1));
+    if (c == '\n') ++line;
+    i += len;
+  }
+  return s;
+}
+
 Table Table::read_csv(const std::string& path, bool allow_nan, const std::vector<std::string>& text) {
   refuse_folder(path);
   std::ifstream in(path);

@@ -655,6 +655,42 @@ Scene read_scene(const toml::value& root, const std::string& path) {
 }
 
 // ---- overrides -----------------------------------------------------------------
+// Length of the well-formed UTF-8 sequence that starts at s[i] (RFC 3629's
+// table: no overlong forms, surrogates or code points past U+10FFFF), 0 if
+// none does. TOML text is UTF-8, and toml11 3.7 reads outside its buffer when
+// it reports a string that is not (its error path counts lines between
+// iterators of two different buffers): no text reaches it unchecked.
+std::size_t utf8_at(std::string_view s, std::size_t i) {
+  const auto at = [&](std::size_t k) { return i + k < s.size() ? static_cast<unsigned char>(s[i + k]) : 0u; };
+  const unsigned c = at(0);
+  const auto tail = [&](std::size_t k, unsigned lo = 0x80, unsigned hi = 0xBF) { return at(k) >= lo && at(k) <= hi; };
+  if (i >= s.size()) return 0;
+  if (c < 0x80) return 1;
+  if (c >= 0xC2 && c <= 0xDF) return tail(1) ? 2 : 0;
+  if (c >= 0xE0 && c <= 0xEF) {
+    const bool second = c == 0xE0 ? tail(1, 0xA0) : c == 0xED ? tail(1, 0x80, 0x9F) : tail(1);
+    return second && tail(2) ? 3 : 0;
+  }
+  if (c >= 0xF0 && c <= 0xF4) {
+    const bool second = c == 0xF0 ? tail(1, 0x90) : c == 0xF4 ? tail(1, 0x80, 0x8F) : tail(1);
+    return second && tail(2) && tail(3) ? 4 : 0;
+  }
+  return 0;
+}
+
+// Throws ConfigError "WHAT: invalid UTF-8 byte 0xNN at line L, byte B" for
+// the first byte of `text` that does not start a UTF-8 sequence.
+void check_utf8(std::string_view text, const std::string& what) {
+  for (std::size_t i = 0, line = 1; i < text.size();) {
+    if (text[i] == '\n') ++line;
+    const std::size_t len = utf8_at(text, i);
+    if (len == 0)
+      throw ConfigError(fmt::format("{}: invalid UTF-8 byte 0x{:02x} at line {}, byte {}", what,
+                                    static_cast<unsigned char>(text[i]), line, i + 1));
+    i += len;
+  }
+}
+
 std::string trim(std::string_view s) {
   const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
   return b == std::string_view::npos ? "" : std::string(s.substr(b, e - b + 1));
@@ -674,6 +710,7 @@ void apply_override(toml::value& root, const std::string& set) {
   if (!p)
     throw ConfigError(fmt::format("{}: unknown key '{}'{}", src, key, did_you_mean(key, labels(scene_params()))));
 
+  check_utf8(value, src);
   const auto parse = [&](const std::string& v) {
     std::istringstream in("v = " + v);
     return toml::value(toml::parse(in, src).at("v"));
@@ -708,6 +745,7 @@ void apply_override(toml::value& root, const std::string& set) {
 // ---- public API -------------------------------------------------------------------
 Scene parse_scene(const std::string& text, const std::string& path,
                   const std::vector<std::string>& overrides) {
+  check_utf8(text, fmt::format("'{}' is not a scene file (TOML text)", path));
   toml::value root;
   try {
     std::istringstream in(text);
