@@ -710,7 +710,7 @@ void apply_override(toml::value& root, const std::string& set) {
   if (!p)
     throw ConfigError(fmt::format("{}: unknown key '{}'{}", src, key, did_you_mean(key, labels(scene_params()))));
 
-  check_utf8(value, src);
+  check_utf8(value, fmt::format("--set {}: the value", key));  // not echoed: it is not text
   const auto parse = [&](const std::string& v) {
     std::istringstream in("v = " + v);
     return toml::value(toml::parse(in, src).at("v"));
