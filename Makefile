@@ -45,6 +45,8 @@ help:
 	@echo "  make clean           remove the build folder"
 	@echo "  make scene-doc       regenerate docs/scene-parameters.md from cdsim --help-scene=md (test_help_scene checks it)"
 	@echo "  make figures         regenerate docs/figures/ (installs ParaView's pvbatch and xvfb if missing; not part of make test)"
+	@echo "  make fuzz            libFuzzer on every reader under ASan and UBSan, FUZZ_SECONDS each (clang, FUZZ_BUILD;"
+	@echo "                       with -j2 two targets at once; not part of the test suite; docs/errors.md, Fuzzing)"
 	@echo "  make help            this list"
 	@echo "Measurements (docs/accuracy.md)"
 	@echo "  make bench           the benchmarks (outputs/bench/: bench.json, runs/summary/machine.csv;"
@@ -167,6 +169,10 @@ help:
 	$(call help_var,ACC_REF_CAP,sweep cap of the reference)
 	$(call help_var,REGRESS_DIR,make regress's 2D campaign)
 	$(call help_var,REGRESS3_DIR,its 3D campaign)
+	$(call help_var,FUZZ_BUILD,make fuzz's build folder (clang, sanitizers))
+	$(call help_var,FUZZ_SECONDS,how long make fuzz runs each target)
+	$(call help_var,FUZZ_TARGETS,its targets (one per reader))
+	$(call help_var,FUZZ_RSS_MB,memory limit of each target (libFuzzer -rss_limit_mb))
 	$(call help_var,MUTANTS,the mutants of make mutants (empty: all of tests/mutants/))
 
 # Idempotent: asks dpkg which packages are missing and installs only those.
@@ -876,6 +882,80 @@ mutants: deps
 
 clean:
 	rm -rf $(BUILD)
+
+# ---- Fuzzing (docs/errors.md, "Fuzzing"; not part of make test) ------------
+# Coverage-guided fuzzing of every reader under AddressSanitizer and
+# UndefinedBehaviorSanitizer: libFuzzer from Debian's clang, in its own build
+# folder (CDLAB_FUZZ, tests/fuzz/). Each target runs FUZZ_SECONDS on its
+# corpus ($(FUZZ_BUILD)/corpus/<target>/, kept between runs), seeded from the
+# repository's inputs and a short 2D and 3D run (checkpoints, dumped steps)
+# and from the committed regression inputs (tests/data/fuzz/<target>/, which
+# make test replays). A finding is written to $(FUZZ_BUILD)/findings/<target>/
+# and stops that target with an error; its log is $(FUZZ_BUILD)/logs/<target>.log.
+# make -j2 fuzz runs two targets at once. nice -n 10: long runs keep the CPU.
+FUZZ_PKGS := clang libclang-rt-14-dev libomp-dev
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 600
+FUZZ_TARGETS ?= scene checkpoint2 checkpoint3 cdp cdp3 dat hdf5 csv fit
+# Longest input: binary files need room for a small sample or problem
+# (the larger seeds are cut to it), text ones a few KB.
+fuzz_max_len = $(if $(filter hdf5,$(1)),131072,$(if $(filter checkpoint2 checkpoint3 cdp cdp3 dat,$(1)),65536,16384))
+FUZZ_RSS_MB ?= 4096
+.PHONY: fuzz
+fuzz:
+	$(call install_missing,fuzz,$(DEB_PKGS) $(FUZZ_PKGS))
+	@[ -f $(FUZZ_BUILD)/CMakeCache.txt ] || { echo "make fuzz: configuring $(FUZZ_BUILD)/ (clang, sanitizers)"; \
+	  CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=Debug -DCDLAB_FUZZ=ON \
+	    -DCDLAB_TESTS=OFF -DCDLAB_BENCH=OFF -DCMAKE_TARGET_MESSAGES=OFF --log-level=WARNING; }
+	nice -n 10 cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_all cdsim
+	@[ -f $(FUZZ_SEEDS)/.done ] || $(MAKE) $(FUZZ_SEEDS)/.done
+	$(MAKE) $(addprefix fuzz-,$(FUZZ_TARGETS))
+	@echo "make fuzz: $(FUZZ_TARGETS): $(FUZZ_SECONDS) s each, nothing found; statistics in $(FUZZ_BUILD)/logs/"
+
+# The seeds: the repository's own inputs of each kind, and the checkpoints
+# and dumped steps (.cdp, .cdp3, .hdf5) of two short runs.
+FUZZ_SEEDS := $(FUZZ_BUILD)/seeds
+$(FUZZ_SEEDS)/.done:
+	rm -rf $(FUZZ_SEEDS) && mkdir -p $(addprefix $(FUZZ_SEEDS)/,$(FUZZ_TARGETS))
+	cp configs/*.toml tests/data/config/full.toml $(FUZZ_SEEDS)/scene/
+	cp tests/data/regress/inertial/I_0.1/scene.toml $(FUZZ_SEEDS)/scene/resolved2.toml
+	cp tests/data/regress3d/inertial/I_0.1/scene.toml $(FUZZ_SEEDS)/scene/resolved3.toml
+	cp tests/data/contact-problems/*.dat $(FUZZ_SEEDS)/dat/
+	cp tests/data/contact-problems/*.hdf5 $(FUZZ_SEEDS)/hdf5/
+	cp tests/data/regress/inertial/I_0.1/series.csv $(FUZZ_SEEDS)/csv/series2.csv
+	cp tests/data/regress3d/inertial/I_0.1/series.csv $(FUZZ_SEEDS)/csv/series3.csv
+	cp tests/data/analysis/mu_i/I_0.1/series.csv $(FUZZ_SEEDS)/csv/series-synthetic.csv
+	cp tests/data/validation/angularity-periodic.csv $(FUZZ_SEEDS)/csv/
+	cp tests/data/analysis/mu_i/fits.toml $(FUZZ_SEEDS)/fit/fits-synthetic.toml
+	cp tests/data/validation/angularity-periodic-fits.toml $(FUZZ_SEEDS)/fit/
+	cp tests/data/regress/mu_i.toml $(FUZZ_SEEDS)/fit/mu_i2.toml
+	cp tests/data/regress3d/mu_i.toml $(FUZZ_SEEDS)/fit/mu_i3.toml
+	rm -rf $(FUZZ_SEEDS)/runs && export ASAN_OPTIONS=detect_leaks=0 && \
+	  $(FUZZ_BUILD)/cd/cdsim tests/fuzz/seed2.toml -q --threads 1 --out $(FUZZ_SEEDS)/runs/2d --dump-problem last && \
+	  $(FUZZ_BUILD)/cd/cdsim tests/fuzz/seed3.toml -q --threads 1 --out $(FUZZ_SEEDS)/runs/3d --dump-problem last
+	cp $(FUZZ_SEEDS)/runs/2d/checkpoint.bin $(FUZZ_SEEDS)/checkpoint2/
+	cp $(FUZZ_SEEDS)/runs/3d/checkpoint.bin $(FUZZ_SEEDS)/checkpoint3/
+	cp $(FUZZ_SEEDS)/runs/2d/problem_*.cdp $(FUZZ_SEEDS)/cdp/
+	cp $(FUZZ_SEEDS)/runs/2d/problem_*.dat $(FUZZ_SEEDS)/dat/
+	cp $(FUZZ_SEEDS)/runs/3d/problem_*.cdp3 $(FUZZ_SEEDS)/cdp3/
+	cp $(FUZZ_SEEDS)/runs/3d/problem_*.hdf5 $(FUZZ_SEEDS)/hdf5/
+	cp $(FUZZ_SEEDS)/runs/2d/scene.toml $(FUZZ_SEEDS)/scene/run2.toml
+	cp $(FUZZ_SEEDS)/runs/3d/scene.toml $(FUZZ_SEEDS)/scene/run3.toml
+	cp $(FUZZ_SEEDS)/runs/2d/series.csv $(FUZZ_SEEDS)/csv/run2.csv
+	cp $(FUZZ_SEEDS)/runs/3d/series.csv $(FUZZ_SEEDS)/csv/run3.csv
+	@touch $@
+
+# One target, after make fuzz has built it: fuzz-<name>. The corpus first
+# (new inputs go there), then the seeds and the regression inputs (read only).
+fuzz-%:
+	@mkdir -p $(FUZZ_BUILD)/corpus/$* $(FUZZ_BUILD)/findings/$* $(FUZZ_BUILD)/logs
+	@echo "make fuzz: $* for $(FUZZ_SECONDS) s (log: $(FUZZ_BUILD)/logs/$*.log)"
+	@cd $(FUZZ_BUILD) && LSAN_OPTIONS=suppressions=$(CURDIR)/tests/fuzz/lsan.supp nice -n 10 ./tests/fuzz/fuzz_$* corpus/$* seeds/$* $(abspath $(wildcard tests/data/fuzz/$*)) \
+	  -max_total_time=$(FUZZ_SECONDS) -max_len=$(call fuzz_max_len,$*) -rss_limit_mb=$(FUZZ_RSS_MB) \
+	  -timeout=60 -print_final_stats=1 -artifact_prefix=findings/$*/ > logs/$*.log 2>&1; \
+	  rc=$$?; grep -E '^(#[0-9]+ +DONE|stat::number_of_executed_units|Done )' logs/$*.log | sed 's/^/  $*: /'; \
+	  if [ $$rc != 0 ]; then echo "make fuzz: $* found a problem (exit $$rc): $(FUZZ_BUILD)/findings/$*/, log:"; \
+	    tail -40 logs/$*.log; exit 1; fi
 
 # ---- Dense shear side by side with LIGGGHTS (docs/accuracy.md) ---------------
 # make compare-liggghts-shear [QUICK=1] [CMP_STRAIN=2] [CMP_I=0.01] [SHEAR_TOL=...] [SHEAR_SET=...]

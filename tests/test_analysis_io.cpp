@@ -458,6 +458,24 @@ TEST(AnalysisIo, CompareFitsWithNanToleranceIsRefusedNotPassed) {
     EXPECT_EQ(run_cda(ab + " " + opt).code, 2) << opt;
 }
 
+// A TOML file that is not UTF-8 (fits, a run's scene.toml or summary.toml)
+// is refused by file, line and byte before toml11 parses it (which read
+// outside its buffer reporting such a string; tests/data/fuzz/fit/).
+TEST(AnalysisIo, TomlThatIsNotUtf8IsRefusedByPosition) {
+  const auto d = scratch("toml_utf8");
+  write(d / "fits.toml", "[mu_I]\nnote = 'a\xA9'\n");
+  try {
+    read_fit_toml((d / "fits.toml").string());
+    ADD_FAILURE() << "no InputError";
+  } catch (const cda::InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("'{}' is not TOML text: invalid UTF-8 byte 0xa9 at line 2, byte 17",
+                                                 (d / "fits.toml").string()));
+  }
+  write(d / "ok.toml", "# \xC3\xA9t\xC3\xA9\n[mu_I]\nformula = 'gr\xC3\xA4in'\nnames = [\"mu1\"]\n"
+                       "[mu_I.params.mu1]\nvalue = 0.26\nerror = 0.002\n");
+  EXPECT_EQ(read_fit_toml((d / "ok.toml").string()).models.at("mu_I").params.at("mu1").value, 0.26);
+}
+
 // Exit 2 (bad input), not 1 (refused), for what is the input's fault; a
 // folder where a file should be is named as a folder; file content in a
 // message never carries control bytes to the terminal.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <sstream>
 #include <toml.hpp>
 
 namespace cda {
@@ -25,9 +26,10 @@ FitFile read_fit_toml(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(fmt::format("fit file '{}' does not exist", path));
   refuse_folder(path);
+  std::istringstream text(toml_text(path));
   toml::value root;
   try {
-    root = toml::parse(path);
+    root = toml::parse(text, path);
   } catch (const std::exception& e) {
     throw InputError(fmt::format("fit file '{}' does not parse as TOML: {}", path, e.what()));
   }

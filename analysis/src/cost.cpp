@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <filesystem>
+#include <sstream>
 #include <toml.hpp>
 
 #include "error.hpp"
@@ -16,9 +17,10 @@ std::optional<RunCost> read_run_cost(const std::string& run_dir) {
   std::error_code ec;
   if (!fs::exists(file, ec)) return std::nullopt;
   refuse_folder(file);
+  std::istringstream text(toml_text(file));
   toml::value root;
   try {
-    root = toml::parse(file);
+    root = toml::parse(text, file);
   } catch (const std::exception& e) {
     throw InputError(fmt::format("'{}' does not parse as TOML: {}", file, e.what()));
   }

@@ -46,4 +46,10 @@ inline void refuse_folder(const std::string& path) {
 // (cd/src/scene/printable.hpp: the rule cdsim's scene errors follow too).
 using cd::printable;
 
+// The text of a TOML file the analysis reads, checked to be UTF-8 first
+// (TOML's rule; toml11 3.7 reads outside its buffer when it reports a
+// string that is not). Throws InputError naming the file, the line and the
+// byte, or that it cannot be opened.
+std::string toml_text(const std::string& path);
+
 }  // namespace cda

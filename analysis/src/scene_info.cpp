@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <sstream>
 #include <vector>
 #include <toml.hpp>
 
@@ -36,9 +37,10 @@ SceneInfo read_scene_info(const std::string& run_dir) {
   if (!fs::exists(s.file, ec))
     throw InputError(fmt::format("run folder '{}' has no scene.toml", run_dir));
   refuse_folder(s.file);
+  std::istringstream text(toml_text(s.file));
   toml::value root;
   try {
-    root = toml::parse(s.file);
+    root = toml::parse(text, s.file);
   } catch (const std::exception& e) {
     throw InputError(fmt::format("'{}' does not parse as TOML: {}", s.file, e.what()));
   }

@@ -32,6 +32,19 @@ std::vector<std::string> split(const std::string& line) {
 
 Table::Table(std::vector<std::string> names) : names_(std::move(names)), cols_(names_.size()) {}
 
+std::string toml_text(const std::string& path) {
+  refuse_folder(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("cannot open '{}'", path));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  std::string s = std::move(ss).str();
+  if (const auto f = cd::utf8_fault(s))
+    throw InputError(fmt::format("'{}' is not TOML text: invalid UTF-8 byte 0x{:02x} at line {}, byte {}", path,
+                                 f->value, f->line, f->byte));
+  return s;
+}
+
 Table Table::read_csv(const std::string& path, bool allow_nan, const std::vector<std::string>& text) {
   refuse_folder(path);
   std::ifstream in(path);

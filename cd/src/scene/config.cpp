@@ -664,6 +664,15 @@ Scene read_scene(const toml::value& root, const std::string& path) {
 }
 
 // ---- overrides -----------------------------------------------------------------
+// Throws ConfigError "WHAT: invalid UTF-8 byte 0xNN at line L, byte B" for
+// the first byte of `text` that does not start a UTF-8 sequence.
+// (TOML text is UTF-8; printable.hpp says why nothing else reaches toml11.)
+void check_utf8(std::string_view text, const std::string& what) {
+  if (const auto f = utf8_fault(text))
+    throw ConfigError(fmt::format("{}: invalid UTF-8 byte 0x{:02x} at line {}, byte {}", what, f->value, f->line,
+                                  f->byte));
+}
+
 std::string trim(std::string_view s) {
   const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
   return b == std::string_view::npos ? "" : std::string(s.substr(b, e - b + 1));
@@ -683,6 +692,7 @@ void apply_override(toml::value& root, const std::string& set) {
   if (!p)
     throw ConfigError(fmt::format("{}: unknown key '{}'{}", src, key, did_you_mean(key, labels(scene_params()))));
 
+  check_utf8(value, fmt::format("--set {}: the value", key));  // not echoed: it is not text
   const auto parse = [&](const std::string& v) {
     std::istringstream in("v = " + v);
     return toml::value(toml::parse(in, src).at("v"));
@@ -717,6 +727,7 @@ void apply_override(toml::value& root, const std::string& set) {
 // ---- public API -------------------------------------------------------------------
 Scene parse_scene(const std::string& text, const std::string& path,
                   const std::vector<std::string>& overrides) {
+  check_utf8(text, fmt::format("'{}' is not a scene file (TOML text)", path));
   toml::value root;
   try {
     std::istringstream in(text);
