@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "cell_dof.hpp"
+#include "rigid_rotation.hpp"
 #include "coupling3.hpp"
 
 namespace cd {
@@ -15,15 +16,9 @@ namespace cd {
 namespace {
 
 
-// exp(h w) q: the rotation by the angle h |w| about w (world frame), then
-// renormalised so that round-off does not accumulate in |q|.
-Quat rotate(const Quat& q, const Vec3& w, double h) {
-  const double a = h * w.norm();
-  if (a == 0.0) return q;
-  Quat r = Quat(Eigen::AngleAxisd(a, w.normalized())) * q;
-  r.normalize();
-  return r;
-}
+// exp(h w) q (rigid_rotation.hpp): the rotation by the angle h |w| about w
+// (world frame), renormalised.
+Quat rotate(const Quat& q, const Vec3& w, double h) { return rotate_orientation(q, w, h); }
 
 }  // namespace
 
