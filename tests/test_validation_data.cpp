@@ -170,3 +170,30 @@ TEST(ValidationData, AngularPolygonsAreStrongerThanDisks) {
     }
   }
 }
+
+// The I probe (angularity-I-probe.csv: the same shapes and samples at
+// I = 1e-2 and 3e-3) against the campaign's I = 1e-3: the packing fraction
+// rises as I falls (phi(I) = phi_max - b I, da Cruz et al. 2005) beyond 3
+// combined standard errors for every shape, and mu* falls (mu(I) rises with
+// I): the shapes' summed difference mu*(I) - mu*(1e-3) positive beyond 3
+// standard errors of the sum.
+TEST(ValidationData, TheIProbeMovesTowardTheQuasiStaticLimit) {
+  const Table probe = Table::read_csv((data / "angularity-I-probe.csv").string(), true, words);
+  const Table low = table("periodic");
+  const auto at = by_ns(low);
+  int compared = 0;
+  double dmu = 0, var = 0;
+  for (std::size_t i = 0; i < probe.rows(); ++i) {
+    const int ns = static_cast<int>(probe.column("ns")[i]);
+    if (probe.column("I")[i] != 0.01 || !at.contains(ns)) continue;
+    ++compared;
+    const std::size_t j = at.at(ns);
+    EXPECT_GT(low.column("nu")[j] - probe.column("nu")[i],
+              3 * combined(low.column("nu_err")[j], probe.column("nu_err")[i]))
+        << "ns " << ns;
+    dmu += probe.column("mu")[i] - low.column("mu")[j];
+    var += std::pow(probe.column("mu_err")[i], 2) + std::pow(low.column("mu_err")[j], 2);
+  }
+  EXPECT_GE(compared, 3);
+  EXPECT_GT(dmu, 3 * std::sqrt(var));
+}
