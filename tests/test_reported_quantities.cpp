@@ -12,12 +12,11 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <numbers>
-#include <sstream>
 #include <string>
 
+#include "analysis/src/table.hpp"
 #include "checkpoint.hpp"
 #include "checkpoint3.hpp"
 #include "cli_util.hpp"
@@ -35,15 +34,11 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// The last row of a series.csv, by column name.
+// The last row of a series.csv, by column name (cdanalysis' reader).
 std::map<std::string, double> last_row(const fs::path& series) {
-  std::ifstream f(series);
-  std::string head, line, last;
-  std::getline(f, head);
-  while (std::getline(f, line)) last = line;
+  const cda::Table t = cda::Table::read_csv(series.string());
   std::map<std::string, double> row;
-  std::istringstream h(head), v(last);
-  for (std::string name, val; std::getline(h, name, ',') && std::getline(v, val, ',');) row[name] = std::stod(val);
+  for (const std::string& name : t.names()) row[name] = t.column(name).back();
   return row;
 }
 
