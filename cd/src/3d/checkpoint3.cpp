@@ -29,9 +29,20 @@ constexpr std::tuple kBodies3Arrays{
     std::pair{"3d.driven", &Bodies3::driven},
 };
 // Bodies3 holds only vectors, so a member left out of the list shows here.
+// Three are not written: the polyhedra's shape_id, moments and shapes
+// (save_checkpoint3 refuses polyhedra; a checkpoint's bodies are spheres
+// and planes, whose shape_id and moments restore_derived gives).
 static_assert(sizeof(Bodies3) ==
-                  std::tuple_size_v<decltype(kBodies3Arrays)> * sizeof(std::vector<char>),
+                  (std::tuple_size_v<decltype(kBodies3Arrays)> + 3) * sizeof(std::vector<char>),
               "a Bodies3 member is missing from kBodies3Arrays (checkpoint3.cpp)");
+
+void restore_derived(Bodies3& b) {
+  b.shape_id.assign(b.size(), -1);
+  b.moments.resize(b.size());
+  for (std::size_t i = 0; i < b.size(); ++i)
+    b.moments[i] = b.shape[i] == Shape3::Sphere ? Vec3::Constant(b.inertia[i]) : Vec3::Zero();
+  b.polyhedra.clear();
+}
 
 // Every body's arrays, checked as a scene's bodies are: the shape tag,
 // planes driven with a unit normal, spheres of positive radius, masses and
@@ -107,6 +118,8 @@ constexpr ckpt::WorldFile kFile{3, "3d.warm.keys", "3d.warm.p"};
 
 void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
                       const RunTotals& totals) {
+  if (w.bodies.has_polyhedra())
+    throw std::invalid_argument("checkpoint: a world of polyhedra is not written to checkpoints yet");
   ckpt::save_world(path, w, kFile, kBodies3Arrays, scene_key, totals, [&](ckpt::Writer& o) {
     const WorldParams3& p = w.params();
     const CellState3& c = w.cell();
@@ -146,7 +159,10 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
         }
         return c;
       },
-      [](World3& w, const CellState3& c) { w.set_cell(c); });
+      [](World3& w, const CellState3& c) {
+        restore_derived(w.bodies);
+        w.set_cell(c);
+      });
 }
 
 }  // namespace cd

@@ -97,6 +97,9 @@ struct ContactInfo3 {
   // Periodic image of body 2 the contact is with: its position is x2 + ix
   // L_x e_x + iy (L_y e_y + le_offset e_x) + iz L_z e_z (0, 0, 0: itself).
   std::int8_t ix = 0, iy = 0, iz = 0;
+  // A polyhedron's contact point: its feature key (polyhedron_contact.hpp),
+  // which names it within its pair (key) from step to step; 0 otherwise.
+  std::uint64_t feature = 0;
 };
 
 inline std::uint64_t contact_key3(std::int32_t b1, std::int32_t b2) {

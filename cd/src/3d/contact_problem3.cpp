@@ -14,16 +14,20 @@
 
 namespace cd {
 
-double update_dof(CellDof3& d, SweepRow3* rows) {
-  // core/cell_dof.hpp's damped update, with the 3D rows' impulses and
-  // responses (W = diag(W_nn, W_tt, W_tt)).
+namespace {
+
+// core/cell_dof.hpp's damped update, with the 3D rows' impulses and the
+// responses of their blocks' diagonals, (1/W_nn, 1/W_tt, 1/W_tt) for
+// sphere rows, the reciprocals of W's diagonal for block rows.
+template <class Row, class Response>
+double update_dof3(CellDof3& d, Row* rows, Response response) {
   return cell_dof::update(
       d,
       [&](std::size_t i, double& s, double& k) {
-        const SweepRow3& r = rows[d.rows[i]];
+        const Row& r = rows[d.rows[i]];
         const Vec3& a = d.a[i];
         s += a.dot(r.r);
-        if (r.r[0] + r.adh > 0.0) k += a[0] * a[0] * r.iwnn + (a[1] * a[1] + a[2] * a[2]) * r.iwtt;
+        if (r.r[0] + r.adh > 0.0) k += response(r, a);
       },
       [&](std::size_t i, double dv) {
         const std::int32_t j = d.rows[i];
@@ -35,7 +39,56 @@ double update_dof(CellDof3& d, SweepRow3* rows) {
       });
 }
 
+}  // namespace
+
+double update_dof(CellDof3& d, SweepRow3* rows) {
+  return update_dof3(d, rows, [](const SweepRow3& r, const Vec3& a) {
+    return a[0] * a[0] * r.iwnn + (a[1] * a[1] + a[2] * a[2]) * r.iwtt;
+  });
+}
+
+double update_dof(CellDof3& d, BlockRow3* rows) {
+  return update_dof3(d, rows, [](const BlockRow3& r, const Vec3& a) {
+    return a[0] * a[0] / r.W(0, 0) + a[1] * a[1] / r.W(1, 1) + a[2] * a[2] / r.W(2, 2);
+  });
+}
+
+namespace {
+
+// The problem of bodies with inverse inertia tensors: its rows as
+// block_coupling3.hpp's BlockRow3.
+SolveStats nlgs_solve_blocks3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer) {
+  const int n = static_cast<int>(p.rows.size());
+  if (p.inv_inertia.size() != p.vel.size())
+    throw std::invalid_argument(fmt::format("3D contact problem: {} inverse inertia tensors for {} bodies",
+                                            p.inv_inertia.size(), p.vel.size()));
+  if (p.compliance > 0)
+    throw std::invalid_argument("3D contact problem: compliant contacts need bodies of scalar inertia (spheres)");
+  std::vector<BlockRow3> rows(n);
+#pragma omp parallel for schedule(static) if (n >= prm.min_parallel)
+  for (int k = 0; k < n; ++k) rows[k] = make_block_row3(p.rows[k], p.vel.data(), p.inv_inertia.data());
+  RowExtra3* extra = p.extra.empty() ? nullptr : p.extra.data();
+  for (CellDof3& d : p.dofs) d.extra = extra;
+  std::vector<CellDof3>* dofs = p.dofs.empty() ? nullptr : &p.dofs;
+  const SolveStats st = std::visit(
+      [&](auto law) {
+        using L = decltype(law);
+        sweep::BlockCoupling3 c{p.vel.data(), extra, rows.data()};
+        return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
+      },
+      p.law);
+#pragma omp parallel for schedule(static) if (n >= prm.min_parallel)
+  for (int k = 0; k < n; ++k) {
+    p.rows[k].r = rows[k].r;
+    p.rows[k].bn = rows[k].bn;
+  }
+  return st;
+}
+
+}  // namespace
+
 SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer) {
+  if (!p.inv_inertia.empty()) return nlgs_solve_blocks3(p, prm, observer);
   // The rows as the sweep streams them, made once per solve (a few percent
   // of one sweep), given back after: the impulses and b_n (the dofs move it).
   const int n = static_cast<int>(p.rows.size());
@@ -84,8 +137,20 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
   return st;
 }
 
-void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& vel) {
-  for (const SphereRow& r : rows) push_impulse(r, r.r, vel.data());
+void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& vel, const std::vector<Mat3>& J) {
+  if (J.empty()) {
+    for (const SphereRow& r : rows) push_impulse(r, r.r, vel.data());
+    return;
+  }
+  for (const SphereRow& r : rows) {
+    const Vec3 P = r.to_world(r.r);
+    BodyVel3& A = vel[r.b1];
+    BodyVel3& B = vel[r.b2];
+    B.v += B.inv_m * P;
+    B.w += J[r.b2] * r.c2.cross(P);
+    A.v -= A.inv_m * P;
+    A.w -= J[r.b1] * r.c1.cross(P);
+  }
 }
 
 // ---- .cdp3 files -----------------------------------------------------------
@@ -105,6 +170,9 @@ Vec3 vec3(TextReader& rd, const std::string& what) {
 }  // namespace
 
 void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, std::ostream& out) {
+  if (!p.inv_inertia.empty())
+    throw std::invalid_argument(
+        "3D contact problem: a problem of bodies with inertia tensors (polyhedra) has no .cdp3 form yet");
   // Version 1: rigid; 2: compliant, k_t = k; 3: compliant, k_t != k.
   const bool split = p.tangential_compliance() != p.compliance;
   out << "cdlab-contact-problem3 " << (p.compliance > 0 ? (split ? 3 : 2) : 1) << "\n";

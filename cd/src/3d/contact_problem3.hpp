@@ -15,6 +15,9 @@
 //   colouring  which rows may be updated at once;
 //   vel        every body's velocity and inverse mass and inertia, with the
 //              rows' impulses (the warm start) already in it;
+//   inv_inertia  every body's world inverse inertia tensor, in scenes with
+//              bodies that are not spheres (empty otherwise: vel's scalar
+//              inv_I); its rows are then block rows (block_coupling3.hpp);
 //   dofs       the cell lengths solved with the contacts (CellDof3);
 //   law        the local law, one type for the whole problem (coupling3.hpp).
 #pragma once
@@ -24,6 +27,7 @@
 #include <vector>
 
 #include "bodies3.hpp"
+#include "block_coupling3.hpp"
 #include "contact3.hpp"
 #include "coupling3.hpp"
 #include "solver.hpp"
@@ -45,12 +49,14 @@ struct CellDof3 {
   RowExtra3* extra = nullptr;  // the problem's extras (set by nlgs_solve3), or null
 };
 double update_dof(CellDof3& d, SweepRow3* rows);
+double update_dof(CellDof3& d, BlockRow3* rows);
 
 struct ContactProblem3 {
   std::vector<SphereRow> rows;
   std::vector<RowExtra3> extra;
   Colouring colouring;
   std::vector<BodyVel3> vel;
+  std::vector<Mat3> inv_inertia;
   std::vector<CellDof3> dofs;
   LocalLaw3 law;
   // rho = 1 / (k dt^2) of compliant contacts (contact.stiffness k), the
@@ -66,13 +72,18 @@ struct ContactProblem3 {
 // Solves the problem in place (impulses, velocities, dofs) from the impulses
 // held in the rows, which must already be in the velocities. The law is
 // resolved here, once, into a template instance of core/sweep.hpp, which
-// sweeps the rows as contact3.hpp's SweepRow3. Throws std::invalid_argument
-// naming the row when a row is not a sphere's (see SweepRow3).
+// sweeps the rows as contact3.hpp's SweepRow3, or, with inv_inertia, as
+// block_coupling3.hpp's BlockRow3 (rigid contacts only). Throws
+// std::invalid_argument naming the row when a row is not a sphere's (see
+// SweepRow3) in a problem without inv_inertia, or when inv_inertia's size
+// is not the bodies' or it comes with compliant contacts.
 SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer = {});
 
 // Adds the impulses held in the rows to the body velocities (warm start);
-// in row order, one thread (bodies are shared).
-void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& vel);
+// in row order, one thread (bodies are shared). With inverse inertia
+// tensors J (not empty), the rotations are J (c x P).
+void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& vel,
+                    const std::vector<Mat3>& J = {});
 
 // ---- files -------------------------------------------------------------
 // cdlab's own text format of a ContactProblem3 (".cdp3"): every number a C
@@ -87,6 +98,8 @@ void apply_impulses(const std::vector<SphereRow>& rows, std::vector<BodyVel3>& v
 // R) and E lines "bt1 bt2 mu_b"; `dofs D` and per dof "v0 v inv_mass scale
 // axis M" then M lines "row a_n a_t1 a_t2". Malformed input throws
 // std::runtime_error naming the file, the line and what was expected.
+// Problems with inverse inertia tensors (polyhedra) have no such file yet:
+// write_contact_problem throws std::invalid_argument for them.
 // (dump3.cpp writes the text with core/files.hpp's atomic write.)
 void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, std::ostream& out);
 ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name, SolverParams& prm);

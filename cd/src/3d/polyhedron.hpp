@@ -36,7 +36,7 @@
 
 #include <Eigen/Core>
 
-#include "bodies3.hpp"
+#include "vec3.hpp"
 
 namespace cd {
 

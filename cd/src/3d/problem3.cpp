@@ -314,6 +314,8 @@ Problem3 to_matrix(const ContactProblem3& cp) {
     throw std::invalid_argument("a cohesive problem (adhesion impulse > 0) has no FCLib matrix form");
   if (cp.compliance > 0)
     throw std::invalid_argument("a problem with compliant contacts (compliance > 0) has no FCLib matrix form");
+  if (!cp.inv_inertia.empty())
+    throw std::invalid_argument("a problem of bodies with inertia tensors (polyhedra) has no FCLib matrix form yet");
   const auto& rows = cp.rows;
   const auto& V = cp.vel;
   const int nc = static_cast<int>(rows.size()), nb = static_cast<int>(V.size());

@@ -8,8 +8,11 @@
 // put in; the contact forces' work on the displacements is reported
 // (StepStats::projection_work). Rotations: a sphere's gap does not depend on
 // its orientation and frictionless rows carry no tangential impulse, so the
-// pseudo-problem never turns a sphere.
+// pseudo-problem never turns a sphere; a polyhedron's normal impulses off
+// its centroid do turn it (the rows' inverse inertia tensors), and its
+// midpoint orientation turns by dt times its pseudo angular velocity.
 #include "projection_trigger.hpp"
+#include "rigid_rotation.hpp"
 #include "world3.hpp"
 
 namespace cd {
@@ -31,6 +34,7 @@ struct World3::Projection {
     q.colouring = w.prob_.colouring;
     q.law = choose_law3(LawSpec3{});  // frictionless, no adhesion
     q.vel = w.bodies.vel;
+    q.inv_inertia = w.prob_.inv_inertia;
     for (BodyVel3& v : q.vel) v.v = v.w = Vec3::Zero();
     q.dofs = w.prob_.dofs;
     for (CellDof3& d : q.dofs) d.v0 = d.v = 0.0;
@@ -55,6 +59,9 @@ struct World3::Projection {
   }
   void move(double dt) {
     for (std::size_t i = 0; i < w.bodies.size(); ++i) w.xm_[i] += dt * q.vel[i].v;
+    if (w.poly_)
+      for (std::size_t i = 0; i < w.bodies.size(); ++i)
+        if (w.bodies.shape[i] == Shape3::Polyhedron) w.qm_[i] = rotate_orientation(w.qm_[i], q.vel[i].w, dt);
     for (const CellDof3& d : q.dofs) w.cm_[d.axis] += dt * d.v;
   }
 };

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <variant>
 
+#include <fmt/format.h>
+
 #include "cell_dof.hpp"
 #include "rigid_rotation.hpp"
 #include "coupling3.hpp"
@@ -106,6 +108,9 @@ void World3::predict() {
   xm_.resize(n);
   qm_.resize(n);
   const bool par = static_cast<int>(n) >= prm_.solver.min_parallel / 2;
+  poly_ = bodies.has_polyhedra();
+  if (poly_ && prm_.stiffness > 0.0)
+    throw std::invalid_argument("WorldParams3: compliant contacts need bodies of scalar inertia (spheres)");
   std::visit([&](const auto& b) { b.predict(*this, h); }, boundary_);
 #pragma omp parallel for schedule(static) if (par)
   for (std::size_t i = 0; i < n; ++i) {
@@ -117,9 +122,27 @@ void World3::predict() {
 
 void World3::detect_stage() {
   std::visit([&](const auto& b) { b.detect(*this); }, boundary_);
+  if (poly_)
+    polyhedra_rows3(bodies, xm_, qm_, alert_, poly_memory_, prob_.rows, info_, poly_axes_,
+                    prm_.solver.min_parallel);
 }
 
 void World3::build() {
+  // Polyhedra: every body's world inverse inertia at the midpoint (a
+  // sphere's is its scalar's, a driven body's zero), for the blocks.
+  if (poly_) {
+    const std::size_t n = bodies.size();
+    prob_.inv_inertia.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const BodyVel3& v = bodies.vel[i];
+      if (!bodies.is_dynamic(i)) prob_.inv_inertia[i].setZero();
+      else if (bodies.shape[i] == Shape3::Polyhedron)
+        prob_.inv_inertia[i] = world_inverse_inertia(bodies.moments[i], qm_[i]);
+      else prob_.inv_inertia[i] = v.inv_I * Mat3::Identity();
+    }
+  } else {
+    prob_.inv_inertia.clear();
+  }
   std::visit([&](const auto& b) { build_rows(b); }, boundary_);
 }
 
@@ -143,7 +166,8 @@ void World3::build_rows([[maybe_unused]] const B& b) {
         r.t2 = r.n.cross(r.t1);
       }
     }
-    set_block(r, V[r.b1], V[r.b2]);
+    if (poly_) set_block(r, V[r.b1], V[r.b2], prob_.inv_inertia[r.b1], prob_.inv_inertia[r.b2]);
+    else set_block(r, V[r.b1], V[r.b2]);
     const bool wall = bodies.driven[r.b1];
     r.mu = wall ? prm_.mu_wall : prm_.mu;
     RowExtra3* x = extras_on_ ? &prob_.extra[k] : nullptr;
@@ -152,7 +176,7 @@ void World3::build_rows([[maybe_unused]] const B& b) {
       x->mu_b = prm_.orthotropic ? (wall ? prm_.mu_wall_b : prm_.mu_b) : r.mu;
     }
     // Warm start: the previous impulse by contact key, on the new frame.
-    if (const Vec3* p = warm_.find(info_[k].key)) {
+    if (const Vec3* p = poly_ ? remembered_impulse(poly_memory_, info_[k]) : warm_.find(info_[k].key)) {
       r.r = r.to_frame(*p);
       if (!friction_on_) r.r[1] = r.r[2] = 0.0;
     }
@@ -213,13 +237,34 @@ void World3::solve() {
     for (std::size_t i = 0; i < bodies.size(); ++i)
       if (bodies.is_dynamic(i)) V[i].v += dv;
   }
+  if (poly_) free_rotations();
   // Warm-start impulses into the velocities (sequential: bodies are shared).
-  apply_impulses(prob_.rows, V);
+  apply_impulses(prob_.rows, V, prob_.inv_inertia);
   solve_problem(prm_.solver, [](ContactProblem3& p, const SolverParams& s) { return nlgs_solve3(p, s); });
   for (const CellDof3& d : prob_.dofs) cell_.rate[d.axis] = d.v;
   if (prm_.overlap_projection > 0.0) project_overlaps();
   // The impulses, in the world frame, for the next step's warm start.
-  keep_warm([&](std::size_t k) { return prob_.rows[k].to_world(prob_.rows[k].r); });
+  if (poly_) keep_polyhedra_memory3(prob_.rows, info_, poly_axes_, poly_memory_);
+  else keep_warm([&](std::size_t k) { return prob_.rows[k].to_world(prob_.rows[k].r); });
+}
+
+// Each dynamic polyhedron's angular velocity before the contacts: the
+// implicit midpoint rule's, with the gyroscopic torque, at the midpoint
+// inertia (rigid_rotation.hpp). A solve that does not converge (dt |w| of
+// order 1: far beyond what contacts allow) stops the run.
+void World3::free_rotations() {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies.shape[i] != Shape3::Polyhedron || !bodies.is_dynamic(i)) continue;
+    BodyVel3& v = bodies.vel[i];
+    const GyroscopicSolve g =
+        solve_free_angular_velocity(bodies.moments[i], qm_[i], v.w, Vec3::Zero(), prm_.dt);
+    if (!g.converged)
+      throw std::runtime_error(fmt::format(
+          "body {}: its rotation over one step did not converge (dt |w| = {:.3g} rad): the time step is too "
+          "large for its spin",
+          i, prm_.dt * v.w.norm()));
+    v.w = g.w;
+  }
 }
 
 // One dof per controlled length (as 2D's LeesEdwardsCell::set_dofs): its
@@ -295,7 +340,7 @@ void World3::wrap_into_cell(double off) {
     Vec3 P = Vec3::Zero();
     double mass = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      if (bodies.shape[i] != Shape3::Sphere) continue;
+      if (bodies.shape[i] == Shape3::Plane) continue;
       std::array<int, 3> k;
       bodies.pos[i] = c.wrap(bodies.pos[i], k);
       const Vec3 dv(k[0] * R.x(), k[1] * R.y(), k[2] * R.z());
@@ -313,7 +358,7 @@ void World3::wrap_into_cell(double off) {
   }
 #pragma omp parallel for schedule(static) if (static_cast<int>(n) >= prm_.solver.min_parallel / 2)
   for (std::size_t i = 0; i < n; ++i) {
-    if (bodies.shape[i] != Shape3::Sphere) continue;
+    if (bodies.shape[i] == Shape3::Plane) continue;
     std::array<int, 3> k;
     bodies.pos[i] = c.wrap(bodies.pos[i], k);
     if (k[1] != 0) bodies.vel[i].v.x() += k[1] * le_velocity_;
@@ -351,9 +396,25 @@ double World3::kinetic_energy() const {
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (!bodies.is_dynamic(i)) continue;
     const BodyVel3& v = bodies.vel[i];
-    e += 0.5 * bodies.mass[i] * v.v.squaredNorm() + 0.5 * bodies.inertia[i] * v.w.squaredNorm();
+    const double rot = bodies.shape[i] == Shape3::Polyhedron
+                           ? v.w.dot(world_inertia(bodies.moments[i], bodies.orient[i]) * v.w)
+                           : bodies.inertia[i] * v.w.squaredNorm();
+    e += 0.5 * bodies.mass[i] * v.v.squaredNorm() + 0.5 * rot;
   }
   return e;
+}
+
+Vec3 World3::angular_momentum() const {
+  Vec3 L = Vec3::Zero();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies.is_dynamic(i)) continue;
+    const BodyVel3& v = bodies.vel[i];
+    const Vec3 spin = bodies.shape[i] == Shape3::Polyhedron
+                          ? Vec3(world_inertia(bodies.moments[i], bodies.orient[i]) * v.w)
+                          : Vec3(bodies.inertia[i] * v.w);
+    L += bodies.mass[i] * bodies.pos[i].cross(v.v) + spin;
+  }
+  return L;
 }
 
 std::vector<obs::Contact<3>> World3::contact_forces() const {

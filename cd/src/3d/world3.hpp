@@ -33,6 +33,7 @@
 #include "contact_problem3.hpp"
 #include "detect3.hpp"
 #include "observables.hpp"
+#include "poly_rows3.hpp"
 #include "solver.hpp"
 #include "stages.hpp"
 #include "world_shell.hpp"
@@ -127,6 +128,16 @@ struct CellState3 {
   double strain = 0.0;
 };
 
+// Polyhedra (bodies of Shape3::Polyhedron; a scene has them or spheres,
+// with planes either way): detect adds the narrow phase of poly_rows3.hpp
+// (the candidates' points), build takes every body's world inverse inertia
+// at the midpoint orientation (ContactProblem3::inv_inertia; the solver
+// then sweeps block rows, block_coupling3.hpp), and solve gives each
+// polyhedron its free angular velocity with the gyroscopic torque by the
+// implicit midpoint rule before the contacts (rigid_rotation.hpp). The
+// warm start is then the pair memory of poly_rows3.hpp in place of the
+// shell's. Checkpoints, problem dumps and the compliant law refuse them.
+//
 // The shell (bodies, clock, timers, the last step's problem and records,
 // solver slot, warm-start memory, colour stage) is core/world_shell.hpp's,
 // shared with the 2D World. The warm-start memory holds the impulses in the
@@ -158,7 +169,12 @@ class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
   // has tangential offsets or an orthotropic cone).
   const std::vector<RowExtra3>& row_extras() const { return prob_.extra; }
 
+  // The polyhedra's warm-start memory (empty in scenes of spheres).
+  const PolyMemory3& polyhedra_memory() const { return poly_memory_; }
+
   double kinetic_energy() const;    // translational + rotational, dynamic bodies
+  // Sum of m x v + I_w w over the dynamic bodies, about the origin.
+  Vec3 angular_momentum() const;
   double potential_energy() const;  // -m g.x summed over dynamic bodies
 
   // Observables of the last step (method.md section 10, core/observables.hpp).
@@ -198,6 +214,7 @@ class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
   void integrate();
   void observe();
   void project_overlaps();
+  void free_rotations();
   struct Projection;  // its adaptor (projection3.cpp)
 
   template <class B>
@@ -215,6 +232,9 @@ class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
        dofs_on_ = false, friction_on_ = false;
   double alert_ = 0.0;
   double le_velocity_ = 0.0;  // V of the step (LeesEdwardsCell3)
+  bool poly_ = false;  // the bodies hold polyhedra (set at each step's predict)
+  PolyMemory3 poly_memory_;
+  std::vector<PolyPairAxis3> poly_axes_;
   std::vector<Vec3> xm_;
   std::vector<Quat> qm_;
   ContactProblem3 proj_;  // project_overlaps' pseudo-velocity problem

@@ -1,0 +1,129 @@
+#include "poly_rows3.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <optional>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace cd {
+
+namespace {
+
+enum class Candidate : std::uint8_t { Kept, Polyhedra, Refused };
+
+}  // namespace
+
+void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const std::vector<Quat>& q,
+                     double alert, const PolyMemory3& memory, std::vector<SphereRow>& rows,
+                     std::vector<ContactInfo3>& info, std::vector<PolyPairAxis3>& axes, int min_parallel) {
+  const int nc = static_cast<int>(rows.size());
+  std::vector<Candidate> what(static_cast<std::size_t>(nc), Candidate::Kept);
+  std::vector<std::optional<PolyContact>> hit(static_cast<std::size_t>(nc));
+  std::vector<Vec3> pos2(static_cast<std::size_t>(nc));
+  // The narrow phase, one slot per candidate.
+#pragma omp parallel for schedule(static) if (nc >= min_parallel)
+  for (int k = 0; k < nc; ++k) {
+    const auto u = static_cast<std::size_t>(k);
+    const int b1 = rows[u].b1, b2 = rows[u].b2;
+    const Shape3 s1 = bodies.shape[static_cast<std::size_t>(b1)], s2 = bodies.shape[static_cast<std::size_t>(b2)];
+    if (s1 != Shape3::Polyhedron && s2 != Shape3::Polyhedron) continue;
+    if (s1 == Shape3::Sphere || s2 == Shape3::Sphere) {
+      what[u] = Candidate::Refused;
+      continue;
+    }
+    what[u] = Candidate::Polyhedra;
+    const ContactInfo3& f = info[u];
+    // Body 2's image: its centre seen from body 1 (detect3's branch) when
+    // the pair meets across the cell.
+    const bool image = f.ix != 0 || f.iy != 0 || f.iz != 0;
+    pos2[u] = image ? Vec3(x[static_cast<std::size_t>(b1)] + f.branch) : x[static_cast<std::size_t>(b2)];
+    const Pose3 pose2{pos2[u], q[static_cast<std::size_t>(b2)]};
+    if (s1 == Shape3::Plane) {
+      hit[u] = collide_plane(x[static_cast<std::size_t>(b1)], bodies.normal[static_cast<std::size_t>(b1)],
+                             bodies.polyhedron(static_cast<std::size_t>(b2)), pose2, alert);
+    } else {
+      const PolyPairMemory3* m = memory.find(f.key);
+      hit[u] = collide(bodies.polyhedron(static_cast<std::size_t>(b1)),
+                       Pose3{x[static_cast<std::size_t>(b1)], q[static_cast<std::size_t>(b1)]},
+                       bodies.polyhedron(static_cast<std::size_t>(b2)), pose2, alert,
+                       m ? std::optional<PolyAxis>(m->axis) : std::nullopt);
+    }
+  }
+  for (int k = 0; k < nc; ++k)
+    if (what[static_cast<std::size_t>(k)] == Candidate::Refused)
+      throw std::invalid_argument(fmt::format(
+          "bodies {} and {} are a sphere and a polyhedron: contacts between the two are not implemented (a scene "
+          "holds spheres or polyhedra, with planes)",
+          rows[static_cast<std::size_t>(k)].b1, rows[static_cast<std::size_t>(k)].b2));
+  // The rows, in the candidates' order.
+  std::vector<SphereRow> out;
+  std::vector<ContactInfo3> out_info;
+  out.reserve(rows.size());
+  out_info.reserve(rows.size());
+  axes.clear();
+  for (int k = 0; k < nc; ++k) {
+    const auto u = static_cast<std::size_t>(k);
+    if (what[u] == Candidate::Kept) {
+      out.push_back(rows[u]);
+      out_info.push_back(info[u]);
+      continue;
+    }
+    if (!hit[u]) continue;
+    const PolyContact& c = *hit[u];
+    const auto b1 = static_cast<std::size_t>(rows[u].b1);
+    const bool plane = bodies.shape[b1] == Shape3::Plane;
+    if (!plane) axes.push_back({info[u].key, c.axis});
+    SphereRow row = rows[u];
+    row.n = c.normal;
+    orthonormal_basis(c.normal, row.t1, row.t2);
+    row.wnn = row.wtt = row.bn = row.mu = row.adh = 0.0;
+    ContactInfo3 f = info[u];
+    // A plane's branch runs from the body's foot on the plane to its centre.
+    if (plane) f.branch = (pos2[u] - x[b1]).dot(c.normal) * c.normal;
+    for (const PolyContactPoint& p : c.points()) {
+      row.c1 = p.position - x[b1];
+      row.c2 = p.position - pos2[u];
+      row.r = Vec3::Zero();
+      f.gap = p.gap;
+      f.point = p.position;
+      f.feature = p.key;
+      out.push_back(row);
+      out_info.push_back(f);
+    }
+  }
+  rows.swap(out);
+  info.swap(out_info);
+}
+
+void keep_polyhedra_memory3(const std::vector<SphereRow>& rows, const std::vector<ContactInfo3>& info,
+                            const std::vector<PolyPairAxis3>& axes, PolyMemory3& memory) {
+  const std::size_t n = rows.size();
+  std::vector<std::size_t> idx(n);
+  std::iota(idx.begin(), idx.end(), std::size_t{0});
+  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) {
+    return info[a].key != info[b].key ? info[a].key < info[b].key : info[a].feature < info[b].feature;
+  });
+  std::vector<PolyPairAxis3> ax = axes;
+  std::sort(ax.begin(), ax.end(), [](const PolyPairAxis3& a, const PolyPairAxis3& b) { return a.key < b.key; });
+  memory.keys.clear();
+  memory.p.clear();
+  for (std::size_t i = 0; i < n;) {
+    const std::uint64_t key = info[idx[i]].key;
+    PolyPairMemory3 m;
+    const auto a = std::lower_bound(ax.begin(), ax.end(), key,
+                                    [](const PolyPairAxis3& e, std::uint64_t k) { return e.key < k; });
+    if (a != ax.end() && a->key == key) m.axis = a->axis;
+    for (; i < n && info[idx[i]].key == key; ++i) {
+      if (m.count == 4) throw std::logic_error("keep_polyhedra_memory3: more than 4 points in one pair");
+      const auto j = static_cast<std::size_t>(m.count++);
+      m.feature[j] = info[idx[i]].feature;
+      m.p[j] = rows[idx[i]].to_world(rows[idx[i]].r);
+    }
+    memory.keys.push_back(key);
+    memory.p.push_back(m);
+  }
+}
+
+}  // namespace cd

@@ -1,0 +1,399 @@
+// Polyhedra in the 3D engine (bodies3's polyhedra, poly_rows3, block_coupling3,
+// World3's stages): closed forms a wrong lever arm, inertia tensor, frame
+// or local solve would break. A cube at rest on a plane (four points, m g,
+// the centre of pressure under the centroid), a cube on an incline (sticks
+// with the centre of pressure moved downhill by (a/2) tan(theta), slides at
+// g (sin - mu cos) above), two cubes stacked, a free asymmetric body
+// (energy and |L| to round-off, L's direction to second order in dt), a
+// tetrahedron dropped on a vertex coming to rest on a face, the block
+// solve against the assembled W, and one thread against two.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include <omp.h>
+
+#include "block_coupling3.hpp"
+#include "polyhedron.hpp"
+#include "rigid_rotation.hpp"
+#include "world3.hpp"
+
+using namespace cd;
+
+namespace {
+
+constexpr double kG = 9.81;
+constexpr double kRho = 2600.0;
+
+WorldParams3 params(double mu, double dt = 1e-3) {
+  WorldParams3 p;
+  p.dt = dt;
+  p.gravity = Vec3(0, 0, -kG);
+  p.mu = p.mu_wall = mu;
+  p.alert = 1e-4;
+  p.solver.tol = 1e-13;
+  p.solver.max_iter = 10000;
+  return p;
+}
+
+// Sum of the rows' impulses on body b (world frame), and their centre of
+// pressure (normal impulses as weights) with the total normal impulse.
+struct Load {
+  Vec3 impulse = Vec3::Zero();
+  Vec3 cop = Vec3::Zero();
+  double normal = 0.0;
+  int rows = 0;
+};
+Load load_on(const World3& w, int b) {
+  Load l;
+  for (std::size_t k = 0; k < w.rows().size(); ++k) {
+    const SphereRow& r = w.rows()[k];
+    if (r.b2 != b && r.b1 != b) continue;
+    const double s = r.b2 == b ? 1.0 : -1.0;
+    l.impulse += s * r.to_world(r.r);
+    l.cop += r.r[0] * w.infos()[k].point;
+    l.normal += r.r[0];
+    ++l.rows;
+  }
+  if (l.normal > 0) l.cop /= l.normal;
+  return l;
+}
+
+}  // namespace
+
+// A cube of side a resting face down on a plane: four contact points (the
+// face's corners), normal impulses summing to m g dt, no tangential
+// impulse, the centre of pressure under the centroid, and the cube does not
+// move. Four points are hyperstatic: only the sum and the moment are
+// determined, and only they are checked.
+TEST(Polyhedra3, CubeRestsOnPlaneWithFourPoints) {
+  World3 w(params(0.3));
+  w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
+  const double a = 0.02;
+  const int shape = w.bodies.add_shape(cuboid(a, a, a));
+  const Vec3 x0(0.1, -0.05, a / 2);
+  const int c = w.bodies.add_polyhedron(x0, shape, kRho);
+  const double m = w.bodies.mass[c];
+  EXPECT_NEAR(m, kRho * a * a * a, 1e-12 * m);
+  const double dt = w.params().dt;
+  for (int k = 0; k < 500; ++k) {
+    w.step();
+    const Load l = load_on(w, c);
+    ASSERT_EQ(l.rows, 4);
+    EXPECT_NEAR(l.impulse.z(), m * kG * dt, 1e-11 * m * kG * dt);
+    EXPECT_LT(l.impulse.head<2>().norm(), 1e-11 * m * kG * dt);
+    EXPECT_LT((l.cop - Vec3(x0.x(), x0.y(), 0)).head<2>().norm(), 1e-9 * a);
+    EXPECT_LE(w.last().solve.residual_max, 1e-11);
+  }
+  EXPECT_LT((w.bodies.pos[c] - x0).norm(), 1e-12 * a);
+  EXPECT_LT(w.bodies.vel[c].v.norm(), 1e-12);
+  EXPECT_LT(w.bodies.vel[c].w.norm(), 1e-10);
+  EXPECT_NEAR(std::abs(w.bodies.orient[c].w()), 1.0, 1e-12);
+}
+
+namespace {
+
+struct CubeIncline {
+  double v_along = 0, v_normal = 0, w = 0;
+  Load load;
+  double cop_downhill = 0;  // centre of pressure from the centroid's foot, down the slope
+  double max_residual = 0;
+  int steps = 0;
+};
+
+// A cube of side a released at rest on a plane tilted by theta about y.
+CubeIncline cube_incline(double theta, double mu, int steps) {
+  World3 w(params(mu));
+  const Vec3 n(std::sin(theta), 0, std::cos(theta)), d(std::cos(theta), 0, -std::sin(theta));
+  w.bodies.add_plane(Vec3::Zero(), n);
+  const double a = 0.02;
+  const int shape = w.bodies.add_shape(cuboid(a, a, a));
+  const Quat q(Eigen::AngleAxisd(theta, Vec3::UnitY()));  // a face on the plane
+  const int c = w.bodies.add_polyhedron(0.5 * a * n, shape, kRho, q);
+  CubeIncline out;
+  for (int k = 0; k < steps; ++k) {
+    w.step();
+    out.max_residual = std::max(out.max_residual, w.last().solve.residual_max);
+  }
+  const BodyVel3& v = w.bodies.vel[c];
+  out.v_along = v.v.dot(d);
+  out.v_normal = v.v.dot(n);
+  out.w = v.w.norm();
+  out.load = load_on(w, c);
+  // The contact points are the midpoint configuration's: the centroid there.
+  const Vec3 x = w.bodies.pos[c] - 0.5 * w.params().dt * v.v;
+  const Vec3 foot = x - x.dot(n) * n;
+  out.cop_downhill = (out.load.cop - foot).dot(d);
+  out.steps = steps;
+  return out;
+}
+
+}  // namespace
+
+// Below tan(theta) = mu the cube sticks: the plane carries m g cos dt
+// normal and m g sin dt up the slope, and the friction at the base, a/2
+// below the centroid, turns the cube downhill unless the normal force
+// moves downhill by (a/2) tan(theta) (moments about the centroid). Above,
+// it slides with a = g (sin - mu cos) without turning (the centre of
+// pressure then at (a/2) mu, inside the face while mu < 1).
+TEST(Polyhedra3, CubeOnInclineSticksThenSlides) {
+  const double mu = 0.4, dt = 1e-3, a = 0.02;
+  const double m = kRho * a * a * a;
+  const double t1 = std::atan(0.8 * mu);
+  const CubeIncline s = cube_incline(t1, mu, 300);
+  EXPECT_LT(std::abs(s.v_along), 1e-12);
+  EXPECT_LT(std::abs(s.v_normal), 1e-12);
+  EXPECT_LT(s.w, 1e-9);
+  EXPECT_EQ(s.load.rows, 4);
+  EXPECT_NEAR(s.load.normal, m * kG * std::cos(t1) * dt, 1e-10 * m * kG * dt);
+  EXPECT_NEAR(s.cop_downhill, 0.5 * a * std::tan(t1), 1e-8 * a);
+  EXPECT_LE(s.max_residual, 1e-10);
+
+  const double t2 = std::atan(1.2 * mu);
+  const CubeIncline g = cube_incline(t2, mu, 300);
+  const double expect = kG * (std::sin(t2) - mu * std::cos(t2)) * dt * g.steps;
+  EXPECT_NEAR(g.v_along, expect, 1e-9 * expect);
+  EXPECT_LT(std::abs(g.v_normal), 1e-10 * expect);
+  EXPECT_LT(g.w * a, 1e-9 * expect);
+  EXPECT_NEAR(g.cop_downhill, 0.5 * a * mu, 1e-8 * a);
+  EXPECT_LE(g.max_residual, 1e-10);
+}
+
+// Two cubes stacked face to face on a plane, the upper one shifted by a/4
+// along x: the floor carries 2 m g dt under the pair's centre of mass, the
+// upper contact m g dt under the upper centroid (its overlap with the lower
+// face is a rectangle: four points).
+TEST(Polyhedra3, TwoCubesStacked) {
+  World3 w(params(0.5));
+  w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
+  const double a = 0.02;
+  const int shape = w.bodies.add_shape(cuboid(a, a, a));
+  const int lo = w.bodies.add_polyhedron(Vec3(0, 0, a / 2), shape, kRho);
+  const int hi = w.bodies.add_polyhedron(Vec3(a / 4, 0, 1.5 * a), shape, kRho);
+  const double m = w.bodies.mass[lo], dt = w.params().dt;
+  for (int k = 0; k < 300; ++k) w.step();
+  int floor_rows = 0;
+  double floor_n = 0;
+  Vec3 floor_cop = Vec3::Zero();
+  for (std::size_t k = 0; k < w.rows().size(); ++k) {
+    const SphereRow& r = w.rows()[k];
+    if (r.b2 == lo && r.b1 == 0) {
+      ++floor_rows;
+      floor_n += r.r[0];
+      floor_cop += r.r[0] * w.infos()[k].point;
+    }
+  }
+  floor_cop /= floor_n;
+  EXPECT_EQ(floor_rows, 4);
+  EXPECT_NEAR(floor_n, 2 * m * kG * dt, 1e-10 * m * kG * dt);
+  EXPECT_NEAR(floor_cop.x(), a / 8, 1e-8 * a);  // (0 + a/4) / 2
+  const Load top = load_on(w, hi);
+  EXPECT_EQ(top.rows, 4);
+  EXPECT_NEAR(top.impulse.z(), m * kG * dt, 1e-10 * m * kG * dt);
+  EXPECT_NEAR(top.cop.x(), a / 4, 1e-8 * a);
+  EXPECT_LT(w.bodies.vel[hi].v.norm() + w.bodies.vel[lo].v.norm(), 1e-10);
+}
+
+namespace {
+
+// A free cuboid of sides (1, 2, 3) a spun about a generic axis, no gravity:
+// energy, |L| and L after `steps` steps of dt.
+struct Flight {
+  double e0, e1, l0, l1;
+  Vec3 L0, L1;
+};
+Flight free_flight(double dt, int steps) {
+  WorldParams3 p;
+  p.dt = dt;
+  World3 w(p);
+  const double a = 0.01;
+  const int shape = w.bodies.add_shape(cuboid(a, 2 * a, 3 * a));
+  const Quat q(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
+  const int b = w.bodies.add_polyhedron(Vec3(0, 0, 0), shape, kRho, q, Vec3(0.1, 0, 0), Vec3(3, 40, 5));
+  (void)b;
+  Flight f;
+  f.e0 = w.kinetic_energy();
+  f.L0 = w.angular_momentum() - w.bodies.mass[b] * w.bodies.pos[b].cross(w.bodies.vel[b].v);
+  for (int k = 0; k < steps; ++k) w.step();
+  f.e1 = w.kinetic_energy();
+  f.L1 = w.angular_momentum() - w.bodies.mass[b] * w.bodies.pos[b].cross(w.bodies.vel[b].v);
+  f.l0 = f.L0.norm();
+  f.l1 = f.L1.norm();
+  return f;
+}
+
+}  // namespace
+
+// The implicit midpoint rule keeps the energy and |L| of a free body to
+// round-off at any step (rigid_rotation.hpp); the direction of L, fixed in
+// the world for the exact motion, moves by O(dt^2) over a fixed time: its
+// error falls by 4 (3.5 to 4.5 allowed) when dt halves. The body spins near
+// its intermediate axis (40 rad/s about the 2a side), where an explicit
+// gyroscopic term would blow up.
+TEST(Polyhedra3, FreeAsymmetricBodyKeepsEnergyAndAngularMomentum) {
+  const double T = 0.5;
+  const Flight f1 = free_flight(1e-3, static_cast<int>(T / 1e-3));
+  const Flight f2 = free_flight(5e-4, static_cast<int>(T / 5e-4));
+  EXPECT_NEAR(f1.e1, f1.e0, 1e-12 * f1.e0);
+  EXPECT_NEAR(f1.l1, f1.l0, 1e-12 * f1.l0);
+  EXPECT_NEAR(f2.e1, f2.e0, 1e-12 * f2.e0);
+  const double err1 = (f1.L1 - f1.L0).norm() / f1.l0, err2 = (f2.L1 - f2.L0).norm() / f2.l0;
+  std::printf("L direction error over %.1f s: %.3g at dt 1e-3, %.3g at dt 5e-4 (ratio %.3f)\n", T, err1, err2,
+              err1 / err2);
+  EXPECT_GT(err1, 0.0);
+  EXPECT_GT(err1 / err2, 3.5);
+  EXPECT_LT(err1 / err2, 4.5);
+}
+
+// A regular tetrahedron released on one vertex with a small tilt, under
+// gravity, friction 0.5: it falls over and comes to rest on a face, three
+// contact points carrying m g dt, the face's outward normal pointing down.
+TEST(Polyhedra3, TetrahedronDroppedOnAVertexRestsOnAFace) {
+  World3 w(params(0.5));
+  w.params();
+  w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
+  const double r = 0.01;
+  const ConvexPolyhedron tet = platonic(Platonic::Tetrahedron, r);
+  const int shape = w.bodies.add_shape(tet);
+  // Vertex (1, 1, 1)/sqrt(3) r turned to point straight down, then tilted by 0.05 rad.
+  const Vec3 v0 = w.bodies.polyhedra[0].vertices()[0];
+  Quat q = Quat::FromTwoVectors(v0.normalized(), Vec3(0, 0, -1));
+  q = Quat(Eigen::AngleAxisd(0.05, Vec3(1, 0.3, 0).normalized())) * q;
+  const double low = [&] {
+    double z = 0;
+    for (const Vec3& v : w.bodies.polyhedra[0].vertices()) z = std::min(z, (q * v).z());
+    return z;
+  }();
+  const int b = w.bodies.add_polyhedron(Vec3(0, 0, -low + 1e-5), shape, kRho, q);
+  const double m = w.bodies.mass[b], dt = w.params().dt;
+  for (int k = 0; k < 1500; ++k) w.step();
+  const Load l = load_on(w, b);
+  EXPECT_EQ(l.rows, 3);
+  EXPECT_NEAR(l.normal, m * kG * dt, 1e-8 * m * kG * dt);
+  double down = 1.0;
+  for (const PolyFace& f : w.bodies.polyhedra[0].faces()) down = std::min(down, (w.bodies.orient[b] * f.normal).z());
+  EXPECT_NEAR(down, -1.0, 1e-8);
+  EXPECT_LT(w.kinetic_energy(), 1e-12 * m * kG * r);
+  // The centroid a quarter of the height above the floor: r / 3 for a
+  // regular tetrahedron of circumradius r (its inradius).
+  EXPECT_NEAR(w.bodies.pos[b].z(), r / 3, 1e-9 * r);
+}
+
+// The block of a polyhedron's row (block_coupling3.hpp) against W = H^T
+// M^-1 H assembled from the two bodies' 6 dofs with their full inverse
+// inertia tensors, and the sweep's velocity and impulse against the same H.
+TEST(Polyhedra3, BlockRowAgainstAssembledDelassus) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int trial = 0; trial < 20; ++trial) {
+    SphereRow r{};
+    r.b1 = 0;
+    r.b2 = 1;
+    r.n = Vec3(U(rng), U(rng), U(rng)).normalized();
+    orthonormal_basis(r.n, r.t1, r.t2);
+    r.c1 = Vec3(U(rng), U(rng), U(rng));
+    r.c2 = Vec3(U(rng), U(rng), U(rng));
+    BodyVel3 vel[2];
+    Mat3 J[2];
+    for (int i = 0; i < 2; ++i) {
+      vel[i].inv_m = 0.5 + 0.5 * U(rng) + 0.5;
+      const Vec3 moments(1 + 0.5 * U(rng), 2 + U(rng), 3 + U(rng));
+      J[i] = world_inverse_inertia(moments, Quat(Eigen::AngleAxisd(3 * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized())));
+      vel[i].v = Vec3(U(rng), U(rng), U(rng));
+      vel[i].w = Vec3(U(rng), U(rng), U(rng));
+    }
+    const BlockRow3 b = make_block_row3(r, vel, J);
+    Eigen::Matrix3d F;
+    F.row(0) = r.n;
+    F.row(1) = r.t1;
+    F.row(2) = r.t2;
+    auto skew = [](const Vec3& c) {
+      Eigen::Matrix3d m;
+      m << 0, -c.z(), c.y(), c.z(), 0, -c.x(), -c.y(), c.x(), 0;
+      return m;
+    };
+    // u = F (v2 + w2 x c2 - v1 - w1 x c1) = H^T (v1, w1, v2, w2)
+    Eigen::Matrix<double, 3, 12> Ht;
+    Ht.block<3, 3>(0, 0) = -F;
+    Ht.block<3, 3>(0, 3) = F * skew(r.c1);
+    Ht.block<3, 3>(0, 6) = F;
+    Ht.block<3, 3>(0, 9) = -F * skew(r.c2);
+    Eigen::Matrix<double, 12, 12> Minv = Eigen::Matrix<double, 12, 12>::Zero();
+    Minv.block<3, 3>(0, 0) = vel[0].inv_m * Mat3::Identity();
+    Minv.block<3, 3>(3, 3) = J[0];
+    Minv.block<3, 3>(6, 6) = vel[1].inv_m * Mat3::Identity();
+    Minv.block<3, 3>(9, 9) = J[1];
+    const Mat3 W = Ht * Minv * Ht.transpose();
+    EXPECT_LT((b.W - W).norm(), 1e-13 * W.norm());
+    Eigen::Matrix<double, 12, 1> V;
+    V << vel[0].v, vel[0].w, vel[1].v, vel[1].w;
+    sweep::BlockCoupling3 c{vel, nullptr, &b};
+    EXPECT_LT((c.velocity(b) - Ht * V).norm(), 1e-13 * V.norm());
+    // An impulse dr changes u by W dr.
+    const Vec3 dr(U(rng), U(rng), U(rng));
+    const Vec3 u0 = c.velocity(b);
+    push_impulse(b, dr, vel);
+    EXPECT_LT((c.velocity(b) - u0 - W * dr).norm(), 1e-12 * (u0.norm() + W.norm() * dr.norm()));
+  }
+}
+
+namespace {
+
+// Bodies of the library's shapes dropped in a box of five planes, random
+// orientations and velocities: the state after `steps` steps.
+std::vector<double> polyhedra_box(int threads, int steps, int& rows) {
+  omp_set_num_threads(threads);
+  WorldParams3 p = params(0.4);
+  p.solver.tol = 1e-4;
+  p.solver.max_iter = 30;  // the same sweeps on both runs: identity, not convergence, is tested
+  p.solver.min_parallel = 8;
+  p.alert = 2e-3;
+  World3 w(p);
+  const double L = 0.1;
+  w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
+  w.bodies.add_plane(Vec3(-L / 2, 0, 0), Vec3(1, 0, 0));
+  w.bodies.add_plane(Vec3(L / 2, 0, 0), Vec3(-1, 0, 0));
+  w.bodies.add_plane(Vec3(0, -L / 2, 0), Vec3(0, 1, 0));
+  w.bodies.add_plane(Vec3(0, L / 2, 0), Vec3(0, -1, 0));
+  const double r = 0.01;
+  const int shapes[3] = {w.bodies.add_shape(cuboid(r, r, r)), w.bodies.add_shape(platonic(Platonic::Tetrahedron, r)),
+                         w.bodies.add_shape(platonic(Platonic::Icosahedron, r * 0.7))};
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> U(-1, 1);
+  int k = 0;
+  for (int iz = 0; iz < 3; ++iz)
+    for (int iy = 0; iy < 4; ++iy)
+      for (int ix = 0; ix < 4; ++ix, ++k) {
+        const Vec3 x(-0.03 + 0.02 * ix, -0.03 + 0.02 * iy, 0.01 + 0.018 * iz);
+        const Quat q(Eigen::AngleAxisd(3 * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized()));
+        w.bodies.add_polyhedron(x, shapes[k % 3], kRho, q, 0.2 * Vec3(U(rng), U(rng), U(rng)),
+                                5.0 * Vec3(U(rng), U(rng), U(rng)));
+      }
+  for (int s = 0; s < steps; ++s) w.step();
+  rows = static_cast<int>(w.rows().size());
+  std::vector<double> st;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.pos[i][c]);
+    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.vel[i].w[c]);
+    st.push_back(w.bodies.orient[i].w());
+  }
+  return st;
+}
+
+}  // namespace
+
+TEST(Polyhedra3, IdenticalWithOneAndTwoThreads) {
+  int rows1 = 0, rows2 = 0;
+  const std::vector<double> s1 = polyhedra_box(1, 120, rows1), s2 = polyhedra_box(2, 120, rows2);
+  omp_set_num_threads(omp_get_num_procs());
+  std::printf("%d rows at the end\n", rows1);
+  EXPECT_GT(rows1, 40);
+  EXPECT_EQ(rows1, rows2);
+  ASSERT_EQ(s1.size(), s2.size());
+  std::size_t diff = 0;
+  for (std::size_t k = 0; k < s1.size(); ++k) diff += s1[k] != s2[k];
+  EXPECT_EQ(diff, 0u);
+}
