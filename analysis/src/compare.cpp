@@ -48,6 +48,8 @@ FitFile read_fit_toml(const std::string& path) {
       continue;
     FitRecord r;
     if (m.contains("converged") && m.at("converged").is_boolean()) r.converged = m.at("converged").as_boolean();
+    if (m.contains("chi2") && m.at("chi2").is_floating()) r.chi2 = m.at("chi2").as_floating();
+    if (m.contains("dof") && m.at("dof").is_integer()) r.dof = static_cast<int>(m.at("dof").as_integer());
     if (!m.contains("params") || !m.at("params").is_table())
       throw InputError(fmt::format("fit file '{}': [{}] has no [{}.params] tables", path, name, name));
     std::vector<std::string> names;

@@ -12,6 +12,7 @@
 // non-finite value or error, or a fit that no longer converges, FAILs too.
 // Models and parameters only in the new file are listed, not failed.
 #pragma once
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -26,6 +27,8 @@ struct FitParam {
 
 struct FitRecord {
   bool converged = true;
+  double chi2 = std::numeric_limits<double>::quiet_NaN();  // NaN, dof -1: not in the file
+  int dof = -1;
   std::vector<std::string> order;          // parameter names in file order
   std::map<std::string, FitParam> params;
 };
