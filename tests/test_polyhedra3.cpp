@@ -83,6 +83,8 @@ TEST(Polyhedra3, CubeRestsOnPlaneWithFourPoints) {
     w.step();
     const Load l = load_on(w, c);
     ASSERT_EQ(l.rows, 4);
+    for (const ContactInfo3& f : w.infos())
+      EXPECT_EQ(f.kind, 1 + static_cast<int>(PolyContactKind::FaceFace));
     EXPECT_NEAR(l.impulse.z(), m * kG * dt, 1e-11 * m * kG * dt);
     EXPECT_LT(l.impulse.head<2>().norm(), 1e-11 * m * kG * dt);
     EXPECT_LT((l.cop - Vec3(x0.x(), x0.y(), 0)).head<2>().norm(), 1e-9 * a);
@@ -272,6 +274,7 @@ TEST(Polyhedra3, TetrahedronDroppedOnAVertexRestsOnAFace) {
   for (int k = 0; k < 1500; ++k) w.step();
   const Load l = load_on(w, b);
   EXPECT_EQ(l.rows, 3);
+  for (const ContactInfo3& f : w.infos()) EXPECT_EQ(f.kind, 1 + static_cast<int>(PolyContactKind::FaceFace));
   EXPECT_NEAR(l.normal, m * kG * dt, 1e-8 * m * kG * dt);
   double down = 1.0;
   for (const PolyFace& f : w.bodies.polyhedra[0].faces()) down = std::min(down, (w.bodies.orient[b] * f.normal).z());

@@ -100,6 +100,9 @@ struct ContactInfo3 {
   // A polyhedron's contact point: its feature key (polyhedron_contact.hpp),
   // which names it within its pair (key) from step to step; 0 otherwise.
   std::uint64_t feature = 0;
+  // A polyhedron's contact: 1 + its PolyContactKind (1 vertex-face, 2
+  // edge-face, 3 face-face, 4 edge-edge); 0: a sphere's or a plane's.
+  std::uint8_t kind = 0;
 };
 
 inline std::uint64_t contact_key3(std::int32_t b1, std::int32_t b2) {

@@ -82,6 +82,7 @@ void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const st
     ContactInfo3 f = info[u];
     // A plane's branch runs from the body's foot on the plane to its centre.
     if (plane) f.branch = (pos2[u] - x[b1]).dot(c.normal) * c.normal;
+    f.kind = static_cast<std::uint8_t>(1 + static_cast<int>(c.kind));
     for (const PolyContactPoint& p : c.points()) {
       row.c1 = p.position - x[b1];
       row.c2 = p.position - pos2[u];
