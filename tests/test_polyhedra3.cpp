@@ -17,6 +17,10 @@
 #include <omp.h>
 
 #include "block_coupling3.hpp"
+#include "checkpoint3.hpp"
+#include "cli_util.hpp"
+#include "config.hpp"
+#include "setup3.hpp"
 #include "polyhedron.hpp"
 #include "rigid_rotation.hpp"
 #include "world3.hpp"
@@ -399,4 +403,86 @@ TEST(Polyhedra3, IdenticalWithOneAndTwoThreads) {
   std::size_t diff = 0;
   for (std::size_t k = 0; k < s1.size(); ++k) diff += s1[k] != s2[k];
   EXPECT_EQ(diff, 0u);
+}
+
+namespace {
+
+// The world of configs/pile-polyhedra.toml, made smaller: 64 cubes.
+Scene small_polyhedra_pile(Shape3d shape) {
+  Scene s = load_scene(std::string(CDLAB_SOURCE_DIR) + "/configs/pile-polyhedra.toml");
+  s.shape = shape;
+  s.n = 64;
+  s.max_iter = 100;  // identity, not convergence, is what these tests see
+  return s;
+}
+
+std::vector<double> state_bits(const World3& w) {
+  std::vector<double> st;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.pos[i][c]);
+    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.vel[i].v[c]);
+    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.vel[i].w[c]);
+    st.push_back(w.bodies.orient[i].w());
+    st.push_back(w.bodies.orient[i].x());
+  }
+  return st;
+}
+
+}  // namespace
+
+// A scene's polyhedra: each grain the scene's solid with the circumscribed
+// diameter of its size, its volume the solid's (a cube of circumradius r:
+// (2 r / sqrt 3)^3), at a unit orientation; the placement is the spheres'.
+TEST(Polyhedra3, SceneMakesTheSolidsOfItsSizes) {
+  const World3 w = build_world3(small_polyhedra_pile(Shape3d::Cube));
+  const World3 spheres = build_world3(small_polyhedra_pile(Shape3d::Sphere));
+  ASSERT_EQ(w.bodies.size(), spheres.bodies.size());
+  int cubes = 0;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    if (w.bodies.shape[i] == Shape3::Plane) continue;
+    ++cubes;
+    ASSERT_EQ(w.bodies.shape[i], Shape3::Polyhedron);
+    const double r = spheres.bodies.radius[i];
+    EXPECT_EQ(w.bodies.pos[i], spheres.bodies.pos[i]);
+    EXPECT_NEAR(w.bodies.polyhedron(i).circumradius(), r, 1e-14 * r);
+    const double side = 2 * r / std::sqrt(3.0);
+    EXPECT_NEAR(w.bodies.mass[i], 2600.0 * side * side * side, 1e-12 * w.bodies.mass[i]);
+    EXPECT_NEAR(w.bodies.moments[i].x(), w.bodies.mass[i] * side * side / 6, 1e-12 * w.bodies.moments[i].x());
+    EXPECT_NEAR(w.bodies.orient[i].norm(), 1.0, 1e-15);
+  }
+  EXPECT_EQ(cubes, 64);
+}
+
+// A run of polyhedra resumes from its checkpoint bit for bit: 60 steps, a
+// checkpoint, 60 more, against 120 steps straight (the pair memory of
+// impulses and axes, the shapes' ids and moments all restored).
+TEST(Polyhedra3, CheckpointResumesBitForBit) {
+  const Scene s = small_polyhedra_pile(Shape3d::Tetrahedron);
+  World3 a = build_world3(s);
+  for (int k = 0; k < 120; ++k) a.step();
+  World3 b = build_world3(s);
+  for (int k = 0; k < 60; ++k) b.step();
+  ASSERT_FALSE(b.polyhedra_memory().keys.empty());
+  const auto dir = cdtest::scratch_dir("test_polyhedra3", "ckpt");
+  const std::string path = (dir / "checkpoint.bin").string();
+  save_checkpoint3(path, b, 7);
+  World3 c = build_world3(s);
+  EXPECT_EQ(load_checkpoint3(path, c), 7u);
+  EXPECT_EQ(c.polyhedra_memory().keys, b.polyhedra_memory().keys);
+  for (int k = 0; k < 60; ++k) c.step();
+  EXPECT_GT(a.last().contacts, 0);
+  const std::vector<double> sa = state_bits(a), sc = state_bits(c);
+  ASSERT_EQ(sa.size(), sc.size());
+  std::size_t diff = 0;
+  for (std::size_t k = 0; k < sa.size(); ++k) diff += sa[k] != sc[k];
+  EXPECT_EQ(diff, 0u);
+
+  // Into a scene of other shapes (cubes): refused, naming the shapes.
+  World3 d = build_world3(small_polyhedra_pile(Shape3d::Cube));
+  try {
+    load_checkpoint3(path, d);
+    ADD_FAILURE() << "a checkpoint of tetrahedra loaded into a scene of cubes";
+  } catch (const CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("other shapes"), std::string::npos) << e.what();
+  }
 }

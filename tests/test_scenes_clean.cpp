@@ -38,6 +38,7 @@ const std::map<std::string, std::string> kShort = {
     {"hexagons", "--set time.duration=0.1"},
     {"mixture", "--set time.duration=0.1"},
     {"pile3d", "--max-steps 40"},
+    {"pile-polyhedra", "--max-steps 40"},
     // to its own stop (settled, ~1100 steps): the shear scenes start from a
     // jammed sample, as a user's do (from 300 steps, phi 0.49, the cohesive
     // shear compacted it further with the cell at its approach floor, and

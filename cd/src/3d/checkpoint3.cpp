@@ -29,9 +29,10 @@ constexpr std::tuple kBodies3Arrays{
     std::pair{"3d.driven", &Bodies3::driven},
 };
 // Bodies3 holds only vectors, so a member left out of the list shows here.
-// Three are not written: the polyhedra's shape_id, moments and shapes
-// (save_checkpoint3 refuses polyhedra; a checkpoint's bodies are spheres
-// and planes, whose shape_id and moments restore_derived gives).
+// Three are not in the list: the polyhedra's shape_id and moments, written
+// only when there are polyhedra (the "3d.poly" arrays below; spheres and
+// planes have them from restore_derived), and the shapes, which are the
+// scene's (checked by their fingerprint).
 static_assert(sizeof(Bodies3) ==
                   (std::tuple_size_v<decltype(kBodies3Arrays)> + 3) * sizeof(std::vector<char>),
               "a Bodies3 member is missing from kBodies3Arrays (checkpoint3.cpp)");
@@ -41,7 +42,137 @@ void restore_derived(Bodies3& b) {
   b.moments.resize(b.size());
   for (std::size_t i = 0; i < b.size(); ++i)
     b.moments[i] = b.shape[i] == Shape3::Sphere ? Vec3::Constant(b.inertia[i]) : Vec3::Zero();
-  b.polyhedra.clear();
+}
+
+// The polyhedra of a checkpoint: each body's shape and moments, the count
+// and fingerprint of the shape library they index (the scene's), and the
+// pair memory as flat arrays (no struct padding in the file: identical
+// runs write identical bytes).
+struct PolyState3 {
+  std::vector<std::uint64_t> shapes;  // count, fingerprint
+  std::vector<std::int32_t> shape_id;
+  std::vector<Vec3> moments;
+  std::vector<std::uint64_t> keys;
+  std::vector<std::int32_t> axis;     // per pair: kind, a, b, count
+  std::vector<std::uint64_t> feature; // per pair: 4
+  std::vector<Vec3> p;                // per pair: 4
+};
+
+// FNV-1a over the library's vertices, faces and circumradii: two libraries
+// with the same fingerprint are the same shapes in the same order.
+std::uint64_t shapes_fingerprint(const std::vector<ConvexPolyhedron>& lib) {
+  std::uint64_t h = fnv1a({});
+  const auto bytes = [&](const void* d, std::size_t n) { h = fnv1a({static_cast<const char*>(d), n}, h); };
+  for (const ConvexPolyhedron& c : lib) {
+    bytes(c.vertices().data(), c.vertices().size() * sizeof(Vec3));
+    for (const PolyFace& f : c.faces()) bytes(f.loop.data(), f.loop.size() * sizeof(int));
+    const double r = c.circumradius();
+    bytes(&r, sizeof r);
+  }
+  return h;
+}
+
+void write_poly3(ckpt::Writer& o, const World3& w) {
+  const Bodies3& b = w.bodies;
+  if (!b.has_polyhedra()) return;
+  o.array("3d.poly.shapes", std::vector<std::uint64_t>{b.polyhedra.size(), shapes_fingerprint(b.polyhedra)});
+  o.array("3d.poly.shape_id", b.shape_id);
+  o.array("3d.poly.moments", b.moments);
+  const PolyMemory3& m = w.polyhedra_memory();
+  std::vector<std::int32_t> axis;
+  std::vector<std::uint64_t> feature;
+  std::vector<Vec3> p;
+  for (const PolyPairMemory3& e : m.p) {
+    axis.insert(axis.end(), {static_cast<std::int32_t>(e.axis.kind), e.axis.a, e.axis.b, e.count});
+    feature.insert(feature.end(), e.feature.begin(), e.feature.end());
+    p.insert(p.end(), e.p.begin(), e.p.end());
+  }
+  o.array("3d.poly.memory.keys", m.keys);
+  o.array("3d.poly.memory.axis", axis);
+  o.array("3d.poly.memory.feature", feature);
+  o.array("3d.poly.memory.p", p);
+}
+
+// The polyhedra section if the checkpoint has one, checked against the
+// bodies and the scene's shape library `lib`.
+PolyState3 read_poly3(ckpt::Reader& in, const Bodies3& b, const std::vector<ConvexPolyhedron>& lib) {
+  PolyState3 ps;
+  const bool has = in.next_name("3d.poly.shapes") == "3d.poly.shapes";
+  bool any_poly = false;
+  for (std::size_t i = 0; i < b.size(); ++i) any_poly |= b.shape[i] == Shape3::Polyhedron;
+  if (!has) {
+    if (any_poly) in.fail("is corrupt: it has polyhedra (3d.shape 2) but no '3d.poly' arrays");
+    if (!lib.empty()) in.fail("holds spheres; this scene's grains are polyhedra (particles.shape)");
+    return ps;
+  }
+  in.array("3d.poly.shapes", ps.shapes);
+  in.array("3d.poly.shape_id", ps.shape_id);
+  in.array("3d.poly.moments", ps.moments);
+  in.array("3d.poly.memory.keys", ps.keys);
+  in.array("3d.poly.memory.axis", ps.axis);
+  in.array("3d.poly.memory.feature", ps.feature);
+  in.array("3d.poly.memory.p", ps.p);
+  if (ps.shapes.size() != 2 || ps.shapes[0] != lib.size() || ps.shapes[1] != shapes_fingerprint(lib))
+    in.fail(fmt::format("holds polyhedra of other shapes than this scene's ({} shapes; particles.shape and the "
+                        "sizes make them)", lib.size()));
+  const std::size_t n = b.size(), np = ps.keys.size();
+  if (ps.shape_id.size() != n || ps.moments.size() != n)
+    in.fail(fmt::format("is corrupt: '3d.poly.shape_id' and '3d.poly.moments' hold {} and {} elements for {} bodies",
+                        ps.shape_id.size(), ps.moments.size(), n));
+  if (ps.axis.size() != 4 * np || ps.feature.size() != 4 * np || ps.p.size() != 4 * np)
+    in.fail(fmt::format("is corrupt: the '3d.poly.memory' arrays are not 4 per pair of its {} pairs", np));
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool poly = b.shape[i] == Shape3::Polyhedron;
+    const std::int32_t id = ps.shape_id[i];
+    if (poly ? !(id >= 0 && static_cast<std::size_t>(id) < lib.size()) : id != -1)
+      in.bad("3d.poly.shape_id", i, "", fmt::format("is {} ({})", id, poly ? fmt::format("a shape of the {} "
+                                                    "of this scene", lib.size()) : "-1 for a sphere or a plane"));
+    if (!poly) continue;
+    const ConvexPolyhedron& c = lib[static_cast<std::size_t>(id)];
+    if (!(std::abs(b.radius[i] - c.circumradius()) <= 1e-12 * c.circumradius()))
+      in.bad("3d.radius", i, "", fmt::format("is {:.17g}, but its shape's circumradius is {:.17g}", b.radius[i],
+                                             c.circumradius()));
+    // Moments: the body's density (mass / volume) times the shape's unit
+    // moments, to round-off (a driven body keeps its mass).
+    const Vec3 expect = b.mass[i] / c.volume() * c.unit_inertia().diagonal();
+    for (int k = 0; k < 3; ++k)
+      if (!(std::abs(ps.moments[i][k] - expect[k]) <= 1e-9 * expect[k]))
+        in.bad("3d.poly.moments", i, std::string(1, "xyz"[k]),
+               fmt::format("is {:.17g}, but the mass and shape give {:.17g}", ps.moments[i][k], expect[k]));
+  }
+  for (std::size_t k = 0; k < np; ++k) {
+    if (k > 0 && !(ps.keys[k] > ps.keys[k - 1]))
+      in.bad("3d.poly.memory.keys", k, "", "is not above the one before (the keys are strictly increasing)");
+    const std::int32_t kind = ps.axis[4 * k], count = ps.axis[4 * k + 3];
+    if (kind < 0 || kind > 2) in.bad("3d.poly.memory.axis", k, "kind", fmt::format("is {} (0, 1 or 2)", kind));
+    if (count < 0 || count > 4) in.bad("3d.poly.memory.axis", k, "count", fmt::format("is {} (0 to 4)", count));
+    for (std::size_t j = 0; j < 4; ++j)
+      for (int c = 0; c < 3; ++c) in.finite("3d.poly.memory.p", 4 * k + j, std::string(1, "xyz"[c]), ps.p[4 * k + j][c]);
+  }
+  return ps;
+}
+
+void apply_poly3(World3& w, const PolyState3& ps, std::vector<ConvexPolyhedron> lib) {
+  Bodies3& b = w.bodies;
+  restore_derived(b);
+  PolyMemory3 m;
+  if (!ps.shapes.empty()) {
+    b.polyhedra = std::move(lib);
+    b.shape_id = ps.shape_id;
+    b.moments = ps.moments;
+    m.keys = ps.keys;
+    m.p.resize(ps.keys.size());
+    for (std::size_t k = 0; k < ps.keys.size(); ++k) {
+      PolyPairMemory3& e = m.p[k];
+      e.axis = {static_cast<PolyAxisKind>(ps.axis[4 * k]), ps.axis[4 * k + 1], ps.axis[4 * k + 2]};
+      e.count = ps.axis[4 * k + 3];
+      for (std::size_t j = 0; j < 4; ++j) {
+        e.feature[j] = ps.feature[4 * k + j];
+        e.p[j] = ps.p[4 * k + j];
+      }
+    }
+  }
+  w.set_polyhedra_memory(std::move(m));
 }
 
 // Every body's arrays, checked as a scene's bodies are: the shape tag,
@@ -55,14 +186,18 @@ void check_bodies3(const ckpt::Reader& in, const Bodies3& b) {
   };
   for (std::size_t i = 0; i < n; ++i) {
     const auto shape = static_cast<unsigned>(b.shape[i]);
-    if (shape > static_cast<unsigned>(Shape3::Plane))
-      in.bad("3d.shape", i, "", fmt::format("is {} (0 sphere, 1 plane)", shape));
+    if (shape > static_cast<unsigned>(Shape3::Polyhedron))
+      in.bad("3d.shape", i, "", fmt::format("is {} (0 sphere, 1 plane, 2 polyhedron)", shape));
+    // A polyhedron's inertia is its moments (3d.poly.moments): no scalar.
+    const bool poly = b.shape[i] == Shape3::Polyhedron;
+    if (poly && (b.inertia[i] != 0 || b.vel[i].inv_I != 0))
+      in.bad("3d.inertia", i, "", "is not 0 for a polyhedron (its inertia is its principal moments)");
     if (b.driven[i] > 1) in.bad("3d.driven", i, "", fmt::format("is {} (0 or 1)", b.driven[i]));
     const bool plane = b.shape[i] == Shape3::Plane;
     if (plane && !b.driven[i]) in.bad("3d.driven", i, "", "is 0 for a plane (planes are driven)");
     in.non_negative("3d.radius", i, "", b.radius[i], !plane);
     in.non_negative("3d.mass", i, "", b.mass[i], !b.driven[i]);
-    in.non_negative("3d.inertia", i, "", b.inertia[i], !b.driven[i]);
+    in.non_negative("3d.inertia", i, "", b.inertia[i], !b.driven[i] && !poly);
     vec("3d.normal", i, b.normal[i]);
     if (plane && !(std::abs(b.normal[i].norm() - 1) < 1e-9))
       in.bad("3d.normal", i, "", fmt::format("has norm {:.6g} (a plane's normal is a unit vector)", b.normal[i].norm()));
@@ -70,12 +205,12 @@ void check_bodies3(const ckpt::Reader& in, const Bodies3& b) {
     vec("3d.vel", i, v.v);
     vec("3d.vel", i, v.w);
     in.non_negative("3d.vel", i, "inv_m", v.inv_m, !b.driven[i]);
-    in.non_negative("3d.vel", i, "inv_I", v.inv_I, !b.driven[i]);
+    in.non_negative("3d.vel", i, "inv_I", v.inv_I, !b.driven[i] && !poly);
     if (b.driven[i] && (v.inv_m != 0 || v.inv_I != 0))
       in.bad("3d.vel", i, "inv_m", "is not 0 for a driven body");
     if (!b.driven[i]) {
       in.inverse("3d.vel", i, "inv_m", v.inv_m, b.mass[i], "mass");
-      in.inverse("3d.vel", i, "inv_I", v.inv_I, b.inertia[i], "inertia");
+      if (!poly) in.inverse("3d.vel", i, "inv_I", v.inv_I, b.inertia[i], "inertia");
     }
     vec("3d.pos", i, b.pos[i]);
     const Quat& q = b.orient[i];
@@ -118,18 +253,19 @@ constexpr ckpt::WorldFile kFile{3, "3d.warm.keys", "3d.warm.p"};
 
 void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
                       const RunTotals& totals) {
-  if (w.bodies.has_polyhedra())
-    throw std::invalid_argument("checkpoint: a world of polyhedra is not written to checkpoints yet");
   ckpt::save_world(path, w, kFile, kBodies3Arrays, scene_key, totals, [&](ckpt::Writer& o) {
     const WorldParams3& p = w.params();
     const CellState3& c = w.cell();
     o.array("3d.cell", std::vector<double>{c.size.x(), c.size.y(), c.size.z(), c.le_offset, double(p.periodic[0]),
                                            double(p.periodic[1]), double(p.periodic[2]), c.rate.x(), c.rate.y(),
                                            c.rate.z(), c.strain});
+    write_poly3(o, w);
   });
 }
 
 std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals) {
+  // The shapes are the scene's: those of the world built from it.
+  std::vector<ConvexPolyhedron> lib = w.bodies.polyhedra;
   return ckpt::load_world(
       path, w, kFile, kBodies3Arrays, totals, check_bodies3,
       [&](ckpt::Reader& in, const Bodies3& b) {
@@ -157,11 +293,11 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
         } catch (const std::invalid_argument& e) {
           in.fail(fmt::format("is corrupt: '3d.cell' holds a cell this scene cannot take ({})", e.what()));
         }
-        return c;
+        return std::pair{c, read_poly3(in, b, lib)};
       },
-      [](World3& w, const CellState3& c) {
-        restore_derived(w.bodies);
-        w.set_cell(c);
+      [&](World3& w, const std::pair<CellState3, PolyState3>& own) {
+        apply_poly3(w, own.second, std::move(lib));
+        w.set_cell(own.first);
       });
 }
 

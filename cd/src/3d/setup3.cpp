@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <random>
 #include <utility>
@@ -91,9 +92,26 @@ void set_cell_mass3(const Scene& s, World3& w) {
 
 }  // namespace
 
+namespace {
+
+// What a polyhedra scene (particles.shape) cannot have yet, refused by key.
+void check_polyhedra3(const Scene& s) {
+  if (s.shape == Shape3d::Sphere) return;
+  const std::string what = fmt::format("particles.shape = \"{}\"", name_of(s.shape));
+  if (!s.start.empty())
+    fail3(fmt::format("shear.start: a started sample holds spheres; {} grains start from their own placement "
+                      "(shear.start = \"\")", what));
+  if (contact_stiffness(s) > 0)
+    fail3(fmt::format("contact.stiffness: compliant contacts need grains of scalar inertia (spheres); {} grains "
+                      "take rigid contacts (no contact.stiffness)", what));
+}
+
+}  // namespace
+
 void check_scene3(const Scene& s) {
   const auto fail = fail3;
   if (s.dimension != 3) fail(fmt::format("dimension = {}: not a 3D scene", s.dimension));
+  check_polyhedra3(s);
   if (s.gravity.size() != 3) fail("gravity.g: a 3D scene needs [gx, gy, gz]");
   // A setting that cannot act under the scene's law is refused, not ignored.
   if (s.subspace > 0 && s.orthotropic())
@@ -268,6 +286,41 @@ void check_start_overlaps3(const Scene& s, const World3& w) {
 
 }  // namespace
 
+namespace {
+
+// A polyhedra scene (particles.shape): each generated sphere becomes the
+// scene's Platonic solid of the same circumscribed radius, centred where
+// the sphere was (so the placement's no-overlap rules hold), at a uniformly
+// random orientation (Shoemake's three uniforms, from a stream of its own
+// seeded by particles.seed: the placement draws stay those of spheres).
+// One shape per distinct size. Bodies keep their order and velocities.
+void make_polyhedra3(const Scene& s, World3& w) {
+  if (s.shape == Shape3d::Sphere) return;
+  const Platonic kind = static_cast<Platonic>(static_cast<int>(s.shape) - 1);
+  const Bodies3& B = w.bodies;
+  Bodies3 out;
+  std::map<double, int> shapes;
+  std::mt19937_64 g(s.seed ^ 0x9e3779b97f4a7c15ull);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (std::size_t i = 0; i < B.size(); ++i) {
+    if (B.shape[i] == Shape3::Plane) {
+      out.add_plane(B.pos[i], B.normal[i], B.vel[i].v);
+      continue;
+    }
+    const double r = B.radius[i];
+    auto it = shapes.find(r);
+    if (it == shapes.end()) it = shapes.emplace(r, out.add_shape(platonic(kind, r))).first;
+    const double u1 = U(g), u2 = U(g), u3 = U(g);
+    const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1), t2 = 2 * std::numbers::pi * u2,
+                 t3 = 2 * std::numbers::pi * u3;
+    const Quat q(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));
+    out.add_polyhedron(B.pos[i], it->second, s.density, q, B.vel[i].v, B.vel[i].w);
+  }
+  w.bodies = std::move(out);
+}
+
+}  // namespace
+
 World3 build_cell3(const Scene& s0) {
   WorldParams3 p = world_params3(s0);
   const Scene s = with_auto_cell3(s0);
@@ -297,6 +350,7 @@ World3 build_cell3(const Scene& s0) {
     w.bodies.add_sphere(Vec3((i + 0.5) * pitch + jx, (j + 0.5) * pitch + jy, (l + 0.5) * pitch + jz),
                         0.5 * d[k], s.density);
   }
+  make_polyhedra3(s, w);
   set_cell_mass3(s, w);
   return w;
 }
@@ -307,8 +361,10 @@ World3 build_world3(const Scene& s0) {
   const WorldParams3 p = world_params3(s);
   const std::vector<double> d = generated_diameters(s);
   const double r_max = 0.5 * diameter_bounds(s).second;
-  return lattice_pile3d(p, static_cast<int>(d.size()), r_max, s.density, s.seed,
-                        [&](std::mt19937_64&, int m) { return 0.5 * d[m]; }, s.box_width, s.box_depth);
+  World3 w = lattice_pile3d(p, static_cast<int>(d.size()), r_max, s.density, s.seed,
+                            [&](std::mt19937_64&, int m) { return 0.5 * d[m]; }, s.box_width, s.box_depth);
+  make_polyhedra3(s, w);
+  return w;
 }
 
 }  // namespace cd

@@ -171,6 +171,7 @@ class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
 
   // The polyhedra's warm-start memory (empty in scenes of spheres).
   const PolyMemory3& polyhedra_memory() const { return poly_memory_; }
+  void set_polyhedra_memory(PolyMemory3 m) { poly_memory_ = std::move(m); }
 
   double kinetic_energy() const;    // translational + rotational, dynamic bodies
   // Sum of m x v + I_w w over the dynamic bodies, about the origin.

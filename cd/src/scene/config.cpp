@@ -111,7 +111,7 @@ Rule disk_density() {
 template <class T>
 using Field = std::variant<double T::*, int T::*, unsigned T::*, bool T::*, std::string T::*,
                            std::array<double, 2> T::*, std::vector<double> T::*, ShearMode T::*,
-                           ShearControl T::*, SizeDist T::*>;
+                           ShearControl T::*, SizeDist T::*, Shape3d T::*>;
 
 template <class T>
 struct Param {
@@ -162,6 +162,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"particles", "density", &Scene::density, "kg/m^2 (2D), kg/m^3 (3D)", gt(0), "2D: mass per unit area (2600 kg/m^3 x 1 mm = 2.6); 3D: mass per unit volume (2600 for glass)"},
       {"particles", "seed", &Scene::seed, "", any(), "random seed of sizes and positions"},
       {"particles", "nsides", &Scene::nsides, "", side_list(), "shapes of the generated particles, drawn uniformly from the list: 0 disk, n >= 3 regular n-gon (sizes are then circumscribed diameters)"},
+      {"particles", "shape", &Scene::shape, "", one_of<Shape3d>(), "3D only: the generated grains' shape: spheres, or a Platonic solid (a convex polyhedron of the engine, docs/3d.md) whose circumscribed diameter is the grain's size, placed at a random orientation"},
       {"particles", "region", &Scene::region, "m", region(), "generation region [xmin, ymin, xmax, ymax]; []: inside the box"},
       {"box", "width", &Scene::box_width, "m", ge(0), "box of four static walls [0, width] x [0, height]; width and height both 0 (no box) or both > 0"},
       {"box", "height", &Scene::box_height, "m", ge(0), "box height; 3D: must be 0 (the box is open at the top)"},
@@ -620,6 +621,10 @@ Scene read_scene(const toml::value& root, const std::string& path) {
     out.add(child(child(root, "box"), "depth"), "depth",
             fmt::format("box.depth = {}: only a dimension = 3 scene has a depth",
                         text(s.box_depth, false)));
+  if (s.dimension == 2 && s.shape != Shape3d::Sphere)
+    out.add(child(child(root, "particles"), "shape"), "shape",
+            fmt::format("particles.shape = \"{}\": a dimension = 3 key; 2D shapes are particles.nsides",
+                        name_of(s.shape)));
   if (s.dimension == 2 && s.subspace > 0)
     out.add(child(child(root, "solver"), "subspace"), "subspace",
             fmt::format("solver.subspace = {}: the subspace correction serves 3D spheres only (dimension = 3); "
@@ -707,6 +712,7 @@ void apply_override(toml::value& root, const std::string& set) {
                       std::holds_alternative<ShearMode Scene::*>(p->field) ||
                       std::holds_alternative<ShearControl Scene::*>(p->field) ||
                       std::holds_alternative<SizeDist Scene::*>(p->field) ||
+                      std::holds_alternative<Shape3d Scene::*>(p->field) ||
                       (value == "auto" && auto_key(key));
     if (!word)
       throw ConfigError(fmt::format("{}: '{}' is not a TOML value (a number, true, false, "

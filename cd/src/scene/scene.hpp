@@ -30,12 +30,20 @@ inline constexpr std::array<std::string_view, 2> kShearControlNames = {"pressure
 enum class SizeDist { Uniform, UniformArea };
 inline constexpr std::array<std::string_view, 2> kSizeDistNames = {"uniform", "uniform_area"};
 
+// particles.shape: the generated grains' shape in 3D: spheres, or a
+// Platonic solid whose circumscribed diameter is the grain's size (the
+// engine's convex polyhedra, docs/3d.md).
+enum class Shape3d { Sphere, Tetrahedron, Cube, Octahedron, Dodecahedron, Icosahedron };
+inline constexpr std::array<std::string_view, 6> kShape3dNames = {"sphere", "tetrahedron", "cube",
+                                                                  "octahedron", "dodecahedron", "icosahedron"};
+
 // The names of an enum's values (config.cpp reads and writes every enum key
 // through this overload; a new enum adds its names here and its member type
 // to config.cpp's Field), and the name of one value, for messages.
 constexpr const auto& enum_names(ShearMode) { return kShearModeNames; }
 constexpr const auto& enum_names(ShearControl) { return kShearControlNames; }
 constexpr const auto& enum_names(SizeDist) { return kSizeDistNames; }
+constexpr const auto& enum_names(Shape3d) { return kShape3dNames; }
 template <class E>
 constexpr std::string_view name_of(E e) { return enum_names(e)[static_cast<std::size_t>(e)]; }
 
@@ -111,6 +119,8 @@ struct Scene {
   // shapes drawn uniformly from this list: 0 disk, 3..60 regular polygon
   // (sizes then refer to the circumscribed diameter 2R)
   std::vector<double> nsides{0.0};
+  // 3D: the generated grains' shape (sizes then circumscribed diameters)
+  Shape3d shape = Shape3d::Sphere;
   // generation region [xmin, ymin, xmax, ymax]; empty: inside the box
   std::vector<double> region;
 
