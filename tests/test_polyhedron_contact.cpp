@@ -273,6 +273,42 @@ TEST(PolyhedronContact, CrossedEdgesGiveOnePointBetweenThem) {
   EXPECT_FALSE(collide(cube(), pose(Vec3::Zero(), qa), cube(), pose({x0, y0, 2 * h * kS2 + 0.06 * h}, qb), 0.05 * h));
 }
 
+// face_too on random poses of two cubes near contact: whenever an edge
+// pair is the axis and the best face axis leaves points, those points are
+// that face's (normal one of the six face normals of A or B, turned), none
+// deeper than the edge pair's separation less its margin, their keys apart
+// from the edge point's; and a face axis never gives any.
+TEST(PolyhedronContact, AnEdgePairGivesTheClosingFaceToo) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> U(-1, 1);
+  int edge_with_face = 0;
+  for (int t = 0; t < 3000; ++t) {
+    const Quat qa(Eigen::AngleAxisd(3 * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized()));
+    const Quat qb(Eigen::AngleAxisd(3 * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized()));
+    const Vec3 xb = Vec3(U(rng), U(rng), U(rng)).normalized() * (2 * h * (1.0 + 0.4 * U(rng)));
+    PolyContact face;
+    const auto c = collide(cube(), pose(Vec3::Zero(), qa), cube(), pose(xb, qb), 0.2 * h, std::nullopt, &face);
+    if (!c) continue;
+    if (c->axis.kind != PolyAxisKind::EdgePair) {
+      EXPECT_EQ(face.count, 0);
+      continue;
+    }
+    if (face.count == 0) continue;
+    ++edge_with_face;
+    double best = 0;
+    for (const Quat& q : {qa, qb})
+      for (int k = 0; k < 3; ++k) best = std::max(best, std::abs(face.normal.dot(q * Vec3::Unit(k))));
+    EXPECT_NEAR(best, 1.0, 1e-12);
+    const double floor = c->separation - (0.02 * std::abs(c->separation) + 1e-3 * h * std::sqrt(3.0));  // L: the circumradius
+    for (const PolyContactPoint& p : face.points()) {
+      EXPECT_GE(p.gap, floor - 1e-12) << t;
+      EXPECT_NE(p.key, c->point[0].key) << t;
+    }
+  }
+  std::printf("%d edge pairs with a closing face\n", edge_with_face);
+  EXPECT_GT(edge_with_face, 20);
+}
+
 namespace {
 // A tetrahedron of circumradius 0.3, its vertex (-1, -1, 1) r / sqrt 3
 // turned to point down (-z). (Not vertex 0: a key made of the vertex's

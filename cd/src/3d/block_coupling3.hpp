@@ -13,7 +13,7 @@
 //     v2 += m2^-1 P,  w2 += sum_j dr_j k2_j,  (body 1: minus, with k1_j)
 //     P = sum_j dr_j e_j,  k_i_j = J_i a_i_j,
 // and the block is W_jk = (1/m1 + 1/m2) d_jk + a1_j.k1_k + a2_j.k2_k.
-// The row keeps a_i and k_i (12 vectors) and W.
+// The row keeps a_i and k_i (12 vectors), W and its inverse.
 //
 // The local solve is exact: from the velocity u at the current impulse r,
 // the free velocity q = u - W r (the others' impulses fixed), and
@@ -41,6 +41,7 @@ struct BlockRow3 {
   std::array<Vec3, 3> a1, a2;  // c_i x e_j
   std::array<Vec3, 3> k1, k2;  // J_i (c_i x e_j)
   Mat3 W;                      // the Delassus block, frame components
+  Mat3 W_inv;                  // its inverse (the stick trial)
   double bn, mu;
   std::int32_t b1, b2;
   Vec3 r;
@@ -68,6 +69,7 @@ inline BlockRow3 make_block_row3(const SphereRow& r, const BodyVel3* vel, const 
     for (int k = 0; k < 3; ++k)
       b.W(j, k) = (j == k ? im : 0.0) + b.a1[j].dot(b.k1[k]) + b.a2[j].dot(b.k2[k]);
   b.W = 0.5 * (b.W + b.W.transpose());  // symmetric to the bit
+  b.W_inv = b.W.inverse();
   b.bn = r.bn;
   b.mu = r.mu;
   b.b1 = r.b1;
@@ -162,7 +164,7 @@ struct BlockCoupling3 {
     const RowExtra3* e = extra_of(r);
     const Vec3 q = velocity(r) - r.W * r.r;
     Vec3 rn;
-    solve_local3(r.W, q, cone<L>(r, e), L::cohesive ? r.adh : 0.0, rn);
+    solve_local3(r.W, q, cone<L>(r, e), L::cohesive ? r.adh : 0.0, rn, &r.r, &r.W_inv);
     const Vec3 dr = rn - r.r;
     r.r = rn;
     dp2 = dr.squaredNorm();

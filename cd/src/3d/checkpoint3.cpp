@@ -54,8 +54,8 @@ struct PolyState3 {
   std::vector<Vec3> moments;
   std::vector<std::uint64_t> keys;
   std::vector<std::int32_t> axis;     // per pair: kind, a, b, count
-  std::vector<std::uint64_t> feature; // per pair: 4
-  std::vector<Vec3> p;                // per pair: 4
+  std::vector<std::uint64_t> feature; // per pair: PolyPairMemory3::kMaxRows
+  std::vector<Vec3> p;                // per pair: PolyPairMemory3::kMaxRows
 };
 
 // FNV-1a over the library's vertices, faces and circumradii: two libraries
@@ -119,8 +119,10 @@ PolyState3 read_poly3(ckpt::Reader& in, const Bodies3& b, const std::vector<Conv
   if (ps.shape_id.size() != n || ps.moments.size() != n)
     in.fail(fmt::format("is corrupt: '3d.poly.shape_id' and '3d.poly.moments' hold {} and {} elements for {} bodies",
                         ps.shape_id.size(), ps.moments.size(), n));
-  if (ps.axis.size() != 4 * np || ps.feature.size() != 4 * np || ps.p.size() != 4 * np)
-    in.fail(fmt::format("is corrupt: the '3d.poly.memory' arrays are not 4 per pair of its {} pairs", np));
+  constexpr std::size_t R = PolyPairMemory3::kMaxRows;
+  if (ps.axis.size() != 4 * np || ps.feature.size() != R * np || ps.p.size() != R * np)
+    in.fail(fmt::format("is corrupt: the '3d.poly.memory' arrays are not 4 (axis) and {} per pair of its {} pairs",
+                        R, np));
   for (std::size_t i = 0; i < n; ++i) {
     const bool poly = b.shape[i] == Shape3::Polyhedron;
     const std::int32_t id = ps.shape_id[i];
@@ -145,9 +147,10 @@ PolyState3 read_poly3(ckpt::Reader& in, const Bodies3& b, const std::vector<Conv
       in.bad("3d.poly.memory.keys", k, "", "is not above the one before (the keys are strictly increasing)");
     const std::int32_t kind = ps.axis[4 * k], count = ps.axis[4 * k + 3];
     if (kind < 0 || kind > 2) in.bad("3d.poly.memory.axis", k, "kind", fmt::format("is {} (0, 1 or 2)", kind));
-    if (count < 0 || count > 4) in.bad("3d.poly.memory.axis", k, "count", fmt::format("is {} (0 to 4)", count));
-    for (std::size_t j = 0; j < 4; ++j)
-      for (int c = 0; c < 3; ++c) in.finite("3d.poly.memory.p", 4 * k + j, std::string(1, "xyz"[c]), ps.p[4 * k + j][c]);
+    if (count < 0 || count > static_cast<int>(R))
+      in.bad("3d.poly.memory.axis", k, "count", fmt::format("is {} (0 to {})", count, R));
+    for (std::size_t j = 0; j < R; ++j)
+      for (int c = 0; c < 3; ++c) in.finite("3d.poly.memory.p", R * k + j, std::string(1, "xyz"[c]), ps.p[R * k + j][c]);
   }
   return ps;
 }
@@ -166,9 +169,9 @@ void apply_poly3(World3& w, const PolyState3& ps, std::vector<ConvexPolyhedron> 
       PolyPairMemory3& e = m.p[k];
       e.axis = {static_cast<PolyAxisKind>(ps.axis[4 * k]), ps.axis[4 * k + 1], ps.axis[4 * k + 2]};
       e.count = ps.axis[4 * k + 3];
-      for (std::size_t j = 0; j < 4; ++j) {
-        e.feature[j] = ps.feature[4 * k + j];
-        e.p[j] = ps.p[4 * k + j];
+      for (std::size_t j = 0; j < PolyPairMemory3::kMaxRows; ++j) {
+        e.feature[j] = ps.feature[PolyPairMemory3::kMaxRows * k + j];
+        e.p[j] = ps.p[PolyPairMemory3::kMaxRows * k + j];
       }
     }
   }

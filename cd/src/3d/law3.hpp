@@ -71,40 +71,59 @@ inline Vec3 project_cone(const Vec3& x, double mu) {
   return {yn, f * x[1], f * x[2]};
 }
 
-// Sliding on the unit cone: returns the number of valid candidates and the
-// best one in p (shifted, scaled impulse). Wn = W_nn, wt = W_tn, Wt = W_tt.
-inline bool slide_unit(const Mat3& W, const Vec3& b, Vec3& p) {
-  const double wnn = W(0, 0), bn = b[0];
-  const Eigen::Vector2d wt(W(1, 0), W(2, 0)), bt(b[1], b[2]);
-  const Eigen::Matrix2d Wt = W.bottomRightCorner<2, 2>();
-  auto cross = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-    return x[0] * y[1] - x[1] * y[0];
-  };
-  auto h = [&](double f, double* dh) {
+// The sliding branch on the unit cone |p_t| <= p_n: p = p_n (1, cos f,
+// sin f) with u = W p + b, u_n = 0 (so p_n = -b_n / (W_nn + w_t.d)) and
+// u_t opposite to d. h(f) = 0 is the alignment condition (u_t x d = 0,
+// times the positive W_nn + w_t.d); candidate() checks the rest (p_n >= 0,
+// u_t against d, not along it) and measures what the root's accuracy
+// leaves (misalignment and |u_n|).
+struct SlideUnit {
+  double wnn, bn;
+  Eigen::Vector2d wt, bt;
+  Eigen::Matrix2d Wt;
+  const Mat3& W;
+  const Vec3& b;
+  SlideUnit(const Mat3& W_, const Vec3& b_)
+      : wnn(W_(0, 0)), bn(b_[0]), wt(W_(1, 0), W_(2, 0)), bt(b_[1], b_[2]), Wt(W_.bottomRightCorner<2, 2>()),
+        W(W_), b(b_) {}
+  static double cross(const Eigen::Vector2d& x, const Eigen::Vector2d& y) { return x[0] * y[1] - x[1] * y[0]; }
+  double h(double f, double* dh) const {
     const Eigen::Vector2d d(std::cos(f), std::sin(f)), dd(-d[1], d[0]);
     const double den = wnn + wt.dot(d);
     const Eigen::Vector2d g = wt + Wt * d;
-    if (dh)
-      *dh = wt.dot(dd) * cross(d, bt) + den * cross(dd, bt) -
-            bn * (cross(dd, g) + cross(d, Wt * dd));
+    if (dh) *dh = wt.dot(dd) * cross(d, bt) + den * cross(dd, bt) - bn * (cross(dd, g) + cross(d, Wt * dd));
     return den * cross(d, bt) - bn * cross(d, g);
-  };
+  }
+  // The impulse at angle f and its error, or false if it is not a slide.
+  bool candidate(double f, Vec3& q, double& err) const {
+    const Eigen::Vector2d d(std::cos(f), std::sin(f));
+    const double den = wnn + wt.dot(d);
+    if (!(den > 0.0)) return false;
+    const double pn = -bn / den;
+    if (pn < 0.0) return false;
+    q = Vec3(pn, pn * d[0], pn * d[1]);
+    const Vec3 v = W * q + b;
+    const double alpha = -(d[0] * v[1] + d[1] * v[2]);
+    if (alpha < -1e-12 * scale(q)) return false;
+    err = std::abs(cross(d, v.tail<2>())) + std::abs(v[0]);
+    return true;
+  }
+  double scale(const Vec3& q) const { return b.norm() + W.norm() * q.norm(); }
+};
+
+// Sliding on the unit cone: returns whether a valid candidate was found,
+// the best one in p (shifted, scaled impulse): h's roots, bracketed on 96
+// angles and refined by safeguarded Newton, and its near-tangent minima.
+inline bool slide_unit(const Mat3& W, const Vec3& b, Vec3& p) {
+  const SlideUnit su(W, b);
+  auto h = [&](double f, double* dh) { return su.h(f, dh); };
   // Candidate evaluation: the full law at angle f.
   double best = std::numeric_limits<double>::infinity();
   bool found = false;
   auto consider = [&](double f) {
-    const Eigen::Vector2d d(std::cos(f), std::sin(f));
-    const double den = wnn + wt.dot(d);
-    if (!(den > 0.0)) return;
-    const double pn = -bn / den;
-    if (pn < 0.0) return;
-    const Vec3 q(pn, pn * d[0], pn * d[1]);
-    const Vec3 v = W * q + b;
-    const double alpha = -(d[0] * v[1] + d[1] * v[2]);
-    const double scale = b.norm() + W.norm() * q.norm();
-    if (alpha < -1e-12 * scale) return;
-    // Misalignment of v_t with -d, and u_n: what the root's accuracy leaves.
-    const double err = std::abs(cross(d, v.tail<2>())) + std::abs(v[0]);
+    Vec3 q;
+    double err;
+    if (!su.candidate(f, q, err)) return;
     if (err < best) {
       best = err;
       p = q;
@@ -158,6 +177,30 @@ inline bool slide_unit(const Mat3& W, const Vec3& b, Vec3& p) {
   return found;
 }
 
+// Sliding from a guess f0 of the slip angle (the sweep's previous impulse):
+// Newton on h from f0, kept if it converges (the step below 1e-14 rad) to a
+// valid slide whose error is round-off (1e-12 of the problem's scale);
+// false otherwise, and the caller scans (slide_unit). A row's slip turns
+// little from one sweep to the next, so this takes 2 to 4 evaluations where
+// the scan takes over a hundred.
+inline bool slide_unit_from(const Mat3& W, const Vec3& b, double f0, Vec3& p) {
+  const SlideUnit su(W, b);
+  double x = f0;
+  for (int it = 0; it < 12; ++it) {
+    double dh;
+    const double hx = su.h(x, &dh);
+    if (!(dh != 0.0) || !std::isfinite(hx)) return false;
+    const double dx = hx / dh;
+    if (std::abs(dx) > 0.5) return false;  // far from the guess: leave it to the scan
+    x -= dx;
+    if (std::abs(dx) <= 1e-14 * (1.0 + std::abs(x))) {
+      double err;
+      return su.candidate(x, p, err) && err <= 1e-12 * su.scale(p);
+    }
+  }
+  return false;
+}
+
 // One tangential axis with friction mu (the other carries none): the 2D
 // enumeration on the (n, t) block of W and b. Returns s = (s_n, s_t).
 inline Branch3 solve_plane(double wnn, double wnt, double wtt, double bn, double bt, double mu,
@@ -188,8 +231,15 @@ inline Branch3 solve_plane(double wnn, double wnt, double wtt, double bn, double
 }  // namespace law3_detail
 
 // The exact local solve: r (3) from W (3x3 SPD), q, the cone and the
-// adhesion impulse a >= 0. Returns the branch taken.
-inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double a, Vec3& r) {
+// adhesion impulse a >= 0. Returns the branch taken. guess (optional): an
+// impulse near the answer (the sweep's previous one); a slide is then
+// sought first from its slip direction (slide_unit_from), the scan only
+// if that fails. The answer is a solution of the law either way; where the
+// law has several slides (a strongly coupled block and a large mu), the
+// guess picks the one nearest the sweep's path. W_inv (optional): W's
+// inverse, for the stick trial (a row's, computed once per solve).
+inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double a, Vec3& r,
+                            const Vec3* guess = nullptr, const Mat3* W_inv = nullptr) {
   using namespace law3_detail;
   const Vec3 b = q - a * W.col(0);  // u = W s + b, s = r + a e_n
   Vec3 s = Vec3::Zero();
@@ -203,7 +253,7 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
     const int k = c.mu_a == 0.0 ? 2 : 1;  // the axis with friction
     br = solve_plane(W(0, 0), W(0, k), W(k, k), b[0], b[k], std::max(c.mu_a, c.mu_b), s[0], s[k]);
   } else {
-    const Vec3 g = -W.ldlt().solve(b);
+    const Vec3 g = W_inv ? Vec3(-(*W_inv * b)) : Vec3(-W.ldlt().solve(b));
     if (g[0] >= 0.0 && std::hypot(g[1] / c.mu_a, g[2] / c.mu_b) <= g[0]) {
       s = g;
       br = Branch3::Stick;
@@ -212,7 +262,9 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
       const Mat3 Wt = T.asDiagonal() * W * T.asDiagonal();
       const Vec3 bt = T.cwiseProduct(b);
       Vec3 p;
-      if (slide_unit(Wt, bt, p)) {
+      const bool warm = guess && ((*guess)[1] != 0.0 || (*guess)[2] != 0.0) &&
+                        slide_unit_from(Wt, bt, std::atan2((*guess)[2] / c.mu_b, (*guess)[1] / c.mu_a), p);
+      if (warm || slide_unit(Wt, bt, p)) {
         s = T.cwiseProduct(p);
         br = Branch3::Slide;
       } else {  // not seen for W SPD; kept so that the sweep never stalls

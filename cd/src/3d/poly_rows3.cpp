@@ -21,6 +21,7 @@ void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const st
   const int nc = static_cast<int>(rows.size());
   std::vector<Candidate> what(static_cast<std::size_t>(nc), Candidate::Kept);
   std::vector<std::optional<PolyContact>> hit(static_cast<std::size_t>(nc));
+  std::vector<PolyContact> face(static_cast<std::size_t>(nc));  // an edge pair's face contact too
   std::vector<Vec3> pos2(static_cast<std::size_t>(nc));
   // The narrow phase, one slot per candidate.
 #pragma omp parallel for schedule(static) if (nc >= min_parallel)
@@ -48,7 +49,7 @@ void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const st
       hit[u] = collide(bodies.polyhedron(static_cast<std::size_t>(b1)),
                        Pose3{x[static_cast<std::size_t>(b1)], q[static_cast<std::size_t>(b1)]},
                        bodies.polyhedron(static_cast<std::size_t>(b2)), pose2, alert,
-                       m ? std::optional<PolyAxis>(m->axis) : std::nullopt);
+                       m ? std::optional<PolyAxis>(m->axis) : std::nullopt, &face[u]);
     }
   }
   for (int k = 0; k < nc; ++k)
@@ -75,23 +76,27 @@ void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const st
     const auto b1 = static_cast<std::size_t>(rows[u].b1);
     const bool plane = bodies.shape[b1] == Shape3::Plane;
     if (!plane) axes.push_back({info[u].key, c.axis});
-    SphereRow row = rows[u];
-    row.n = c.normal;
-    orthonormal_basis(c.normal, row.t1, row.t2);
-    row.wnn = row.wtt = row.bn = row.mu = row.adh = 0.0;
-    ContactInfo3 f = info[u];
-    // A plane's branch runs from the body's foot on the plane to its centre.
-    if (plane) f.branch = (pos2[u] - x[b1]).dot(c.normal) * c.normal;
-    f.kind = static_cast<std::uint8_t>(1 + static_cast<int>(c.kind));
-    for (const PolyContactPoint& p : c.points()) {
-      row.c1 = p.position - x[b1];
-      row.c2 = p.position - pos2[u];
-      row.r = Vec3::Zero();
-      f.gap = p.gap;
-      f.point = p.position;
-      f.feature = p.key;
-      out.push_back(row);
-      out_info.push_back(f);
+    // The contact's points, then (an edge pair's) its face's, each set with
+    // its own normal.
+    for (const PolyContact* cc : {&c, static_cast<const PolyContact*>(&face[u])}) {
+      SphereRow row = rows[u];
+      row.n = cc->normal;
+      orthonormal_basis(cc->normal, row.t1, row.t2);
+      row.wnn = row.wtt = row.bn = row.mu = row.adh = 0.0;
+      ContactInfo3 f = info[u];
+      // A plane's branch runs from the body's foot on the plane to its centre.
+      if (plane) f.branch = (pos2[u] - x[b1]).dot(cc->normal) * cc->normal;
+      f.kind = static_cast<std::uint8_t>(1 + static_cast<int>(cc->kind));
+      for (const PolyContactPoint& p : cc->points()) {
+        row.c1 = p.position - x[b1];
+        row.c2 = p.position - pos2[u];
+        row.r = Vec3::Zero();
+        f.gap = p.gap;
+        f.point = p.position;
+        f.feature = p.key;
+        out.push_back(row);
+        out_info.push_back(f);
+      }
     }
   }
   rows.swap(out);
@@ -117,7 +122,8 @@ void keep_polyhedra_memory3(const std::vector<SphereRow>& rows, const std::vecto
                                     [](const PolyPairAxis3& e, std::uint64_t k) { return e.key < k; });
     if (a != ax.end() && a->key == key) m.axis = a->axis;
     for (; i < n && info[idx[i]].key == key; ++i) {
-      if (m.count == 4) throw std::logic_error("keep_polyhedra_memory3: more than 4 points in one pair");
+      if (m.count == PolyPairMemory3::kMaxRows)
+        throw std::logic_error("keep_polyhedra_memory3: more rows in one pair than the memory holds");
       const auto j = static_cast<std::size_t>(m.count++);
       m.feature[j] = info[idx[i]].feature;
       m.p[j] = rows[idx[i]].to_world(rows[idx[i]].r);

@@ -6,7 +6,9 @@
 //
 // A candidate pair of polyhedra (or a plane and a polyhedron) becomes 0 to
 // 4 rows, one per contact point, which share the contact's frame (n from
-// body 1 to body 2, t1 and t2 from n as for spheres); a point's lever arms
+// body 1 to body 2, t1 and t2 from n as for spheres), and on an edge pair's
+// axis the points of the best face axis as well, with that face's normal
+// (collide's face_too: 5 rows at most); a point's lever arms
 // run from each body's centroid (a plane's: from its point) to the point,
 // its gap is the point's, its ContactInfo3 key the pair's and its feature
 // the point's key. Candidates without a polyhedron stay as detect3 made
@@ -38,10 +40,13 @@
 namespace cd {
 
 struct PolyPairMemory3 {
+  // A contact's points (up to 4) and, on an edge pair's axis, the edge
+  // point with the face's (up to 4 more, as the narrow phase gives them).
+  static constexpr int kMaxRows = 5;
   PolyAxis axis;
   int count = 0;
-  std::array<std::uint64_t, 4> feature{};
-  std::array<Vec3, 4> p{};  // world frame, on body 2
+  std::array<std::uint64_t, kMaxRows> feature{};
+  std::array<Vec3, kMaxRows> p{};  // world frame, on body 2
 };
 using PolyMemory3 = WarmStart<PolyPairMemory3>;
 

@@ -349,7 +349,8 @@ std::vector<int> reduce_points(std::span<const PolyContactPoint> pts, const Vec3
 
 std::optional<PolyContact> collide(const ConvexPolyhedron& A, const Pose3& pose_a,
                                    const ConvexPolyhedron& B, const Pose3& pose_b, double alert,
-                                   const std::optional<PolyAxis>& hint) {
+                                   const std::optional<PolyAxis>& hint, PolyContact* face_too) {
+  if (face_too) face_too->count = 0;
   check_size(A, "A");
   check_size(B, "B");
   const Vec3 origin = pose_a.position;
@@ -395,7 +396,24 @@ std::optional<PolyContact> collide(const ConvexPolyhedron& A, const Pose3& pose_
       ne = nh;
     }
   }
-  if (ea >= 0 && beats(se, sf, L)) return edge_contact(pa, ea, pb, eb, ne, origin);
+  if (ea >= 0 && beats(se, sf, L)) {
+    if (face_too) {
+      // The face's points that are not deeper than the edge pair's own
+      // separation (within its margin): those about to close. A deeper one
+      // is beside the other body, not in it (below the face's plane, beyond
+      // the edge), and would hold the bodies apart where they are free.
+      PolyContact f = face_b ? face_contact(pb, face, pa, true, sf, alert, L, origin)
+                             : face_contact(pa, face, pb, false, sf, alert, L, origin);
+      const double floor = se - margin(se, L);
+      face_too->axis = f.axis;
+      face_too->normal = f.normal;
+      face_too->separation = f.separation;
+      for (const PolyContactPoint& p : f.points())
+        if (p.gap >= floor) face_too->point[static_cast<std::size_t>(face_too->count++)] = p;
+      face_too->kind = face_too->count > 0 ? kind_of(face_too->count) : f.kind;
+    }
+    return edge_contact(pa, ea, pb, eb, ne, origin);
+  }
   return face_b ? face_contact(pb, face, pa, true, sf, alert, L, origin)
                 : face_contact(pa, face, pb, false, sf, alert, L, origin);
 }

@@ -116,9 +116,18 @@ struct PolyContact {
 // alert (>= 0, a distance). hint: the previous step's axis of this pair
 // (ignored if it is no longer a valid axis). Tolerances scale with L, the
 // smaller circumradius.
+// face_too (optional): when an edge pair is the axis, the points of the
+// best face axis' contact too (its separation is within alert, or there
+// would be no contact) that are not deeper than the edge pair's separation
+// less its margin, their keys distinct from the edge point's; count 0
+// otherwise (and when no such point is left). An edge–edge point alone holds the bodies at one point, and
+// they can turn about it until their faces meet inside each other within a
+// step (measured in a pile of cubes: overlaps of 0.1 d); the face's points,
+// with their own normal, hold the faces apart as they close.
 std::optional<PolyContact> collide(const ConvexPolyhedron& A, const Pose3& pose_a,
                                    const ConvexPolyhedron& B, const Pose3& pose_b, double alert,
-                                   const std::optional<PolyAxis>& hint = std::nullopt);
+                                   const std::optional<PolyAxis>& hint = std::nullopt,
+                                   PolyContact* face_too = nullptr);
 
 // The plane through p0 with unit normal n (into the free side; body 1)
 // against B: B's vertices within alert of the plane (gap n . (v - p0)),
