@@ -8,13 +8,31 @@
 // the bi-periodic cell, and in 3D's tri-periodic cell. The run is stopped
 // after a few hundred steps (RunOptions::max_steps), which writes a series
 // row at its last step; the world is then in that step's state.
+//
+// And summary.toml, every line but cdlab_version, against what it says it
+// is: the series' rows (one a step here, so that each row is one step's
+// record), the timings' rows, the scene's length, the clock and CPU time
+// and load averages read by this process around the run call, and the
+// per-step records of a twin world stepped here from the same start (the
+// runs are deterministic: tests/test_reproducible.cpp), for what the series
+// does not hold (CG iterations, stalled accelerations, floor steps). The
+// walls run mixes (solver.anderson = 5) and the 3D run takes the subspace
+// correction (solver.subspace = 10), so that those lines count something;
+// the periodic run's sweep cap (solver.max_iter = 40) stops some of its steps.
 #include <gtest/gtest.h>
+#include <omp.h>
+#include <sys/resource.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <functional>
 #include <map>
 #include <numbers>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "analysis/src/table.hpp"
 #include "checkpoint.hpp"
@@ -79,6 +97,163 @@ RunOptions stop_after(const fs::path& dir, std::int64_t steps) {
   return opt;
 }
 
+// A series row every step (and none by strain): each row is one step's.
+const std::vector<std::string> kRowEveryStep = {"output.series_strain=0", "output.series_interval=1e-12"};
+std::vector<std::string> with(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+double process_cpu() {  // user + system seconds of this process, every thread
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+std::vector<double> loadavg() {  // the 1, 5 and 15 min load averages
+  std::ifstream in("/proc/loadavg");
+  std::vector<double> l(3, -1.0);
+  in >> l[0] >> l[1] >> l[2];
+  return l;
+}
+
+// What this process saw around a run call.
+struct Around {
+  double wall = 0, cpu = 0;  // elapsed and CPU seconds of the call
+  std::vector<double> load_before, load_after;
+};
+Around around(const std::function<void()>& call) {
+  Around a;
+  a.load_before = loadavg();
+  const double cpu0 = process_cpu();
+  const auto t0 = std::chrono::steady_clock::now();
+  call();
+  a.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  a.cpu = process_cpu() - cpu0;
+  a.load_after = loadavg();
+  return a;
+}
+
+// The per-step records of a world stepped here, summed as summary.toml
+// says it sums them.
+struct Tally {
+  std::int64_t steps = 0;
+  double sweeps = 0, sweeps_max = 0, cap = 0, cg = 0, anderson_off = 0, subspace_off = 0, floor = 0;
+  double residual_max = 0, residual_last = 0, overlap_max = 0;
+};
+template <class W>
+Tally step_twin(W& w, std::int64_t steps) {
+  Tally t;
+  for (; t.steps < steps; ++t.steps) {
+    w.step();
+    const StepStats& st = w.last();
+    t.sweeps += st.solve.iterations;
+    t.sweeps_max = std::max(t.sweeps_max, double(st.solve.iterations));
+    t.cap += st.solve.cap_hit;
+    t.cg += st.solve.subspace_iterations;
+    t.anderson_off += st.solve.anderson_off > 0;
+    t.subspace_off += st.solve.subspace_off > 0;
+    t.floor += st.floor_held;
+    t.residual_max = std::max(t.residual_max, st.solve.residual_max);
+    t.residual_last = st.solve.residual_max;
+    t.overlap_max = std::max(t.overlap_max, st.max_overlap);
+  }
+  return t;
+}
+
+double number(const std::map<std::string, std::string>& f, const char* key) {
+  EXPECT_TRUE(f.count(key)) << key;
+  return f.count(key) ? std::stod(f.at(key)) : std::nan("");
+}
+
+std::vector<double> triple(const std::map<std::string, std::string>& f, const char* key) {
+  std::string v = f.count(key) ? f.at(key) : "";
+  EXPECT_TRUE(v.size() > 2 && v.front() == '[' && v.back() == ']') << key << " = " << v;
+  for (char& c : v)
+    if (c == '[' || c == ']' || c == ',') c = ' ';
+  std::istringstream in(v);
+  std::vector<double> l;
+  for (double x; in >> x;) l.push_back(x);
+  return l;
+}
+
+// summary.toml of a run stopped by max_steps after `steps` steps of a scene
+// of total_steps (or ended at them), against the series and timings (a row
+// a step), the twin's tally, and what this process saw around the call.
+void expect_summary(const fs::path& dir, std::int64_t steps, std::int64_t total_steps, const Tally& twin,
+                    const Around& a, int threads) {
+  const auto f = cdtest::summary_fields(dir / "summary.toml");
+  const cda::Table series = cda::Table::read_csv((dir / "series.csv").string());
+  const cda::Table timings = cda::Table::read_csv((dir / "timings.csv").string());
+  ASSERT_EQ(series.rows(), static_cast<std::size_t>(steps)) << "a row a step";
+  ASSERT_EQ(twin.steps, steps);
+  // Stopped by max_steps before the scene's end, or at it (the 3D run's
+  // 200 steps are its whole strain).
+  EXPECT_EQ(f.at("status"), steps < total_steps ? "\"max-steps\"" : "\"done\"");
+  EXPECT_EQ(number(f, "steps"), static_cast<double>(steps));
+  EXPECT_EQ(series.column("step").back(), static_cast<double>(steps));
+  EXPECT_EQ(number(f, "total_steps"), static_cast<double>(total_steps));
+  EXPECT_EQ(number(f, "sessions"), 1.0);
+  EXPECT_EQ(number(f, "threads"), static_cast<double>(threads));
+
+  // From the series: each row is one step's, written to 10 digits.
+  const auto& it = series.column("iterations");
+  double sweeps = 0, sweeps_max = 0, cap = 0, res = 0, ov = 0;
+  for (std::size_t r = 0; r < series.rows(); ++r) {
+    EXPECT_EQ(series.column("step")[r], static_cast<double>(r + 1));
+    sweeps += it[r];
+    sweeps_max = std::max(sweeps_max, series.column("iterations_max")[r]);
+    cap += series.column("cap_hit")[r];
+    res = std::max(res, series.column("residual")[r]);
+    ov = std::max(ov, series.column("max_overlap")[r]);
+  }
+  const double n = static_cast<double>(steps);
+  expect_written(number(f, "sweeps_mean"), sweeps / n, "sweeps_mean");
+  EXPECT_EQ(number(f, "sweeps_max"), sweeps_max);
+  EXPECT_EQ(number(f, "cap_steps"), cap);
+  EXPECT_DOUBLE_EQ(number(f, "cap_share"), cap / n);
+  expect_written(number(f, "residual_max"), res, "residual_max");
+  expect_written(number(f, "residual_final"), series.column("residual").back(), "residual_final");
+  expect_written(number(f, "overlap_max"), ov, "overlap_max");
+
+  // From the twin's own records (exact: the same steps).
+  EXPECT_EQ(number(f, "sweeps_mean"), twin.sweeps / n);
+  EXPECT_EQ(number(f, "sweeps_max"), twin.sweeps_max);
+  EXPECT_EQ(number(f, "cap_steps"), twin.cap);
+  EXPECT_EQ(number(f, "residual_max"), twin.residual_max);
+  EXPECT_EQ(number(f, "residual_final"), twin.residual_last);
+  EXPECT_EQ(number(f, "overlap_max"), twin.overlap_max);
+  EXPECT_EQ(number(f, "cg_iterations"), twin.cg);
+  EXPECT_EQ(number(f, "cg_iterations_mean"), twin.cg / n);
+  EXPECT_EQ(number(f, "anderson_off_steps"), twin.anderson_off);
+  EXPECT_EQ(number(f, "subspace_off_steps"), twin.subspace_off);
+  EXPECT_EQ(number(f, "floor_steps"), twin.floor);
+
+  // Wall time: the run loop's, so at least the sum of its stages' times in
+  // timings.csv (measured inside it, on the same steady clock; 10 digits)
+  // and at most the call's elapsed time. CPU time: the process's over the
+  // loop, so at most its CPU time over the call (getrusage is monotone).
+  double stages = 0;
+  for (const std::string& c : timings.names())
+    if (c.starts_with("t_"))
+      for (double x : timings.column(c)) stages += x;
+  const double wall = number(f, "wall_time"), cpu = number(f, "cpu_time");
+  EXPECT_GT(stages, 0.0);
+  EXPECT_GE(wall, stages * (1 - 1e-9));
+  EXPECT_LE(wall, a.wall);
+  EXPECT_GT(cpu, 0.0);
+  EXPECT_LE(cpu, a.cpu + 1e-6);
+  // The loads are /proc/loadavg's, read by the run as it starts and ends;
+  // the kernel updates them every 5 s, so a call shorter than that sees at
+  // most one update: each is what this process read before or after.
+  const auto ls = triple(f, "load_start"), le = triple(f, "load_end");
+  ASSERT_EQ(ls.size(), 3u);
+  ASSERT_EQ(le.size(), 3u);
+  if (a.wall < 4.5) {
+    for (const auto& l : {ls, le}) EXPECT_TRUE(l == a.load_before || l == a.load_after) << l[0] << " " << l[1];
+  }
+}
+
 }  // namespace
 
 // 120 hexagons between rough walls (configs/shear-walls.toml, its cell
@@ -88,11 +263,17 @@ RunOptions stop_after(const fs::path& dir, std::int64_t steps) {
 // the grains whose centre lies in [H/4, 3H/4).
 TEST(ReportedQuantities, WallsRowMatchesItsDefinitions) {
   const Scene s = load_scene(std::string(CDLAB_SOURCE_DIR) + "/configs/shear-walls.toml",
-                             {"particles.n=120", "shear.width=0", "shear.height=0", "shear.inertial_number=0.05",
-                              "output.snapshot_interval=0", "time.duration=1"});
+                             with({"particles.n=120", "shear.width=0", "shear.height=0", "shear.inertial_number=0.05",
+                                   "output.snapshot_interval=0", "time.duration=1", "solver.anderson=5"},
+                                  kRowEveryStep));
   World w = build_world(s);
   const fs::path dir = cdtest::scratch_dir("test_reported_quantities", "walls");
-  const RunSummary sum = run(w, s, stop_after(dir, 300));
+  RunSummary sum;
+  const Around a = around([&] { sum = run(w, s, stop_after(dir, 300)); });
+  World twin = build_world(s);
+  const Tally t = step_twin(twin, 300);
+  EXPECT_EQ(s.strain, 0.0);  // the run's length is time.duration
+  expect_summary(dir, 300, std::llround(s.duration / w.params().dt), t, a, omp_get_max_threads());
   const auto r = last_row(dir / "series.csv");
   ASSERT_EQ(r.at("step"), 300);
   const double W = w.cell.width, H = w.cell.height;
@@ -145,10 +326,17 @@ TEST(ReportedQuantities, PeriodicRowMatchesItsDefinitions) {
     save_checkpoint(ckpt, w, 1);
   }
   const Scene s = load_scene(cfg + "shear-inertial.toml",
-                             {"shear.start=\"" + ckpt + "\"", "shear.inertial_number=0.05", "particles.nsides=[5]",
-                              "output.snapshot_interval=0"});
+                             with({"shear.start=\"" + ckpt + "\"", "shear.inertial_number=0.05",
+                                   "particles.nsides=[5]", "output.snapshot_interval=0", "solver.max_iter=40"},
+                                  kRowEveryStep));
   World w = build_world(s);
-  run(w, s, stop_after(dir / "shear", 200));
+  const Around a = around([&] { run(w, s, stop_after(dir / "shear", 200)); });
+  World twin = build_world(s);
+  const Tally t = step_twin(twin, 200);
+  EXPECT_GT(t.cap, 0.0);  // some steps need more than 40 sweeps
+  const double gd = s.inertial_number * std::sqrt(s.pressure / s.density) / s.d_mean;
+  // The run's length is shear.strain at the imposed rate.
+  expect_summary(dir / "shear", 200, std::llround(s.strain / gd / w.params().dt), t, a, omp_get_max_threads());
   const auto r = last_row(dir / "shear" / "series.csv");
   ASSERT_EQ(r.at("step"), 200);
   double solid = 0;
@@ -157,7 +345,6 @@ TEST(ReportedQuantities, PeriodicRowMatchesItsDefinitions) {
     solid += area(w.bodies.radius[i], 5);
   }
   expect_written(r.at("packing_fraction"), solid / (w.cell.width * w.cell.height), "packing_fraction");
-  const double gd = s.inertial_number * std::sqrt(s.pressure / s.density) / s.d_mean;
   expect_written(r.at("strain"), 200 * w.params().dt * gd, "strain");
   expect_invariants_2d(r);
   expect_inertial(r, s, "syy", "kyy");
@@ -175,16 +362,23 @@ TEST(ReportedQuantities, TriPeriodicRowMatchesItsDefinitions) {
     for (int k = 0; k < 300; ++k) w.step();
     save_checkpoint3(ckpt, w, 1);
   }
-  const Scene s = cdtest::shear3_shear_scene(ckpt, 0.1);
+  Scene s = cdtest::shear3_shear_scene(ckpt, 0.1);
+  s.subspace = 10;
+  s.series_strain = 0;
+  s.series_interval = 1e-12;  // a row a step
   World3 w = build_world3(s);
-  run3(w, s, stop_after(dir / "shear", 200));
+  const Around a = around([&] { run3(w, s, stop_after(dir / "shear", 200)); });
+  World3 twin = build_world3(s);
+  const Tally t = step_twin(twin, 200);
+  EXPECT_GT(t.cg, 0.0);
+  const double gd = s.inertial_number * std::sqrt(s.pressure / s.density) / s.d_mean;
+  expect_summary(dir / "shear", 200, std::llround(s.strain / gd / w.params().dt), t, a, omp_get_max_threads());
   const auto r = last_row(dir / "shear" / "series.csv");
   ASSERT_EQ(r.at("step"), 200);
   double solid = 0;
   for (std::size_t i = 0; i < w.bodies.size(); ++i) solid += 4.0 / 3.0 * kPi * std::pow(w.bodies.radius[i], 3);
   const Vec3 L = w.cell().size;
   expect_written(r.at("packing_fraction"), solid / (L.x() * L.y() * L.z()), "packing_fraction");
-  const double gd = s.inertial_number * std::sqrt(s.pressure / s.density) / s.d_mean;
   expect_written(r.at("strain"), 200 * w.params().dt * gd, "strain");
   Eigen::Matrix3d S;
   const char* names[3][3] = {{"sxx", "sxy", "sxz"}, {"syx", "syy", "syz"}, {"szx", "szy", "szz"}};

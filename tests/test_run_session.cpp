@@ -336,24 +336,33 @@ TEST(CostRecord, CountsEachStepIntoTheSessionAndTheRun) {
   b.floor_held = true;
   c.add(a);
   c.add(b);
+  // A capped step whose mixing ran to the cap, and one whose mixing stalled
+  // without a cap: neither is a capped step that ended as plain NLGS.
+  cd::StepStats on = stats(40, 5e-4, 0.03), off = stats(40, 5e-4, 0.03);
+  on.solve.cap_hit = true;
+  off.solve.anderson_off = 7;
+  c.add(on);
+  c.add(off);
   const cd::RunTotals t = c.totals_now();
-  EXPECT_EQ(t.sweeps, 150);
+  EXPECT_EQ(t.sweeps, 230);
   EXPECT_EQ(t.sweeps_max, 50) << "the earlier sessions' most";
-  EXPECT_EQ(t.cap_steps, 1);
+  EXPECT_EQ(t.cap_steps, 2);
   EXPECT_EQ(t.residual_max, 1e-3);
   EXPECT_EQ(t.residual_last, 5e-4);
   EXPECT_EQ(t.overlap_max, 0.03);
   EXPECT_EQ(t.sessions, 2);
-  EXPECT_EQ(t.anderson_off_steps, 1);
+  EXPECT_EQ(t.anderson_off_steps, 2);
   EXPECT_EQ(t.floor_steps, 1);
   EXPECT_GE(t.wall, 0);
-  c.end_session(100, 102, 200);
+  c.end_session(100, 104, 200);
   const cd::RunSummary& s = c.summary();
   EXPECT_EQ(s.first_step, 100);
-  EXPECT_EQ(s.steps, 2);
-  EXPECT_EQ(s.mean_iterations, 25);
+  EXPECT_EQ(s.steps, 4);
+  EXPECT_EQ(s.mean_iterations, 32.5);
   EXPECT_EQ(s.max_iterations, 40);
-  EXPECT_EQ(s.cap_hits, 1);
+  EXPECT_EQ(s.cap_hits, 2);
+  EXPECT_EQ(s.anderson_off, 2);
+  EXPECT_EQ(s.cap_anderson_off, 1) << "b alone: at the cap, its mixing off";
   EXPECT_EQ(s.max_overlap, 0.03);
 }
 

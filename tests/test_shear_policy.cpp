@@ -3,9 +3,13 @@
 // scene resolved to it (and refused where there is no I), and a campaign
 // point and a single run at the same I resolving to the same settings: the
 // command `make -n` shows for a campaign run and the single run of the same
-// scene, both printed by cdsim --print-scene.
+// scene, both printed by cdsim --print-scene; and an explicit solver.tol
+// keeping the "auto" mixing, with what cdsim says of the steps it leaves at
+// the sweep cap.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <map>
 #include <sstream>
 #include <string>
@@ -13,6 +17,8 @@
 
 #include "cli_util.hpp"
 #include "config.hpp"
+#include "run.hpp"
+#include "setup.hpp"
 #include "setup3.hpp"
 #include "shear_policy.hpp"
 
@@ -347,6 +353,86 @@ TEST(ShearPolicy, ACampaignPointAndASingleRunAtTheSameIRunTheSameSettings) {
   EXPECT_EQ(c3b, s3b);
   EXPECT_EQ(std::stod(s3b.at("solver.tol")), cd::shear_settings(0.01, cd::Acceleration::Subspace, kSpheres).tol);
   EXPECT_EQ(std::stod(s3.at("solver.tol")), p3.tol);
+}
+
+// An explicit solver.tol keeps the "auto" acceleration's mixing (measured:
+// at an explicit tol 1e-4, 300 disks at I = 0.01, plain NLGS stopped 7x as
+// many steps at the sweep cap, docs/accuracy.md), and a run whose mixing
+// leaves steps at the cap says how many of them had it stalled and off,
+// and names the settings that end such steps: a law-residual stop
+// (solver.residual_tol) or more sweeps. 100 disks compacted (the
+// preparation's stop rule), sheared at tol 1e-5 with a cap of 300 sweeps for 100 steps: C steps at
+// the cap, K of them with the mixing off, both counted again on a world
+// stepped here.
+TEST(ShearPolicy, AnExplicitTolKeepsTheAutoMixingAndCappedStepsNameTheSetting) {
+  const std::filesystem::path dir = cdtest::scratch_dir("test_shear_policy", "explicit_tol");
+  const std::string ckpt = (dir / "prep" / "checkpoint.bin").string();
+  {  // compacted to the preparation's stop rule, which writes the sample
+    const cd::Scene p = cd::load_scene(std::string(CDLAB_SOURCE_DIR) + "/configs/shear-prep.toml",
+                                       {"particles.n=100", "shear.width=0.016", "shear.height=0.016",
+                                        "output.snapshot_interval=0"});
+    cd::World w = cd::build_world(p);
+    cd::RunOptions opt;
+    opt.out = (dir / "prep").string();
+    opt.quiet = true;
+    EXPECT_TRUE(cd::run(w, p, opt).settled);
+  }
+  const std::string scene = std::string(CDLAB_SOURCE_DIR) + "/configs/shear-inertial.toml";
+  const std::vector<std::string> set = {"shear.start=\"" + ckpt + "\"", "shear.inertial_number=0.01",
+                                        "solver.tol=1e-5", "solver.max_iter=300", "output.snapshot_interval=0"};
+  const cd::Scene s = cd::load_scene(scene, set);
+  EXPECT_EQ(s.tol, 1e-5);
+  EXPECT_EQ(s.anderson, cd::kAnderson);  // disks: the band's mixing, kept
+  cd::World w = cd::build_world(s);
+  long cap = 0, cap_off = 0;
+  for (int k = 0; k < 100; ++k) {
+    w.step();
+    const cd::SolveStats& st = w.last().solve;
+    cap += st.cap_hit;
+    cap_off += st.cap_hit && st.anderson_off > 0;
+  }
+  ASSERT_GT(cap, 1) << "more than 1 % of the steps at the cap";
+  ASSERT_GT(cap_off, 0);
+
+  const auto cdsim = [&](const std::string& out) {
+    std::string cmd = std::string(CDLAB_BINARY_DIR) + "/cd/cdsim " + scene + " --quiet --max-steps 100 --threads 1 " +
+                      "--out " + (dir / out).string();
+    for (const auto& a : set) cmd += " --set '" + a + "'";
+    return cmd;
+  };
+  const auto r = cdtest::run_command(cdsim("anderson"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  // The resolved scene says what ran.
+  const auto resolved = cdtest::printed_keys(cdtest::slurp(dir / "anderson" / "scene.toml"));
+  EXPECT_EQ(std::stod(resolved.at("solver.tol")), 1e-5);
+  EXPECT_EQ(std::stoi(resolved.at("solver.anderson")), cd::kAnderson);
+  EXPECT_NE(r.out.find(fmt::format("cdsim: warning: of this session's {} steps at the sweep cap, {} ended as plain "
+                                   "NLGS after Anderson's mixing (solver.anderson = 5) stalled and went off, and {} "
+                                   "with it on; the setting that ends such steps is a law-residual stop, "
+                                   "solver.residual_tol (0.003 is the policy's with plain NLGS below I = 0.01), or a "
+                                   "larger solver.max_iter",
+                                   cap, cap_off, cap - cap_off)),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(std::stod(resolved.at("solver.residual_tol")), 0.0) << "the band's stop from I = 0.01 has none";
+  EXPECT_NE(r.out.find(fmt::format(", on {} of the {} steps at the sweep cap\n", cap_off, cap)), std::string::npos)
+      << r.out;
+  // Plain NLGS: no word of the mixing.
+  const auto p = cdtest::run_command(cdsim("plain") + " --set solver.anderson=0");
+  EXPECT_EQ(p.code, 0) << p.out;
+  EXPECT_NE(p.out.find("stopped at the sweep cap"), std::string::npos) << p.out;
+  EXPECT_EQ(p.out.find("Anderson"), std::string::npos) << p.out;
+  // What the warning says, on this sample: plain NLGS at the same stop
+  // stops more steps at the cap (100 of 100 against 46 with the mixing),
+  // the law-residual stop fewer (26, at this small cap).
+  const auto residual = cdtest::run_command(cdsim("residual") + " --set solver.residual_tol=3e-3");
+  EXPECT_EQ(residual.code, 0) << residual.out;
+  const auto capped = [&](const std::string& out) {
+    return std::stod(cdtest::summary_fields(dir / out / "summary.toml").at("cap_steps"));
+  };
+  EXPECT_EQ(capped("anderson"), static_cast<double>(cap));
+  EXPECT_GT(capped("plain"), capped("anderson"));
+  EXPECT_LT(capped("residual"), capped("anderson"));
 }
 
 }  // namespace

@@ -34,6 +34,7 @@
 #include "run3.hpp"
 #include "setup.hpp"
 #include "setup3.hpp"
+#include "shear_policy.hpp"
 
 namespace {
 
@@ -61,8 +62,10 @@ int report(const cd::RunSummary& s, const cd::Scene& scene, const std::string& o
       s.max_iterations, s.cap_hits, s.steps ? 100.0 * double(s.cap_hits) / double(s.steps) : 0.0,
       s.max_residual, s.max_overlap, s.max_overlap_small);
   if (scene.anderson > 0)  // how often the mixing stalled and the solve went on as plain NLGS
-    fmt::print("cdsim: Anderson's mixing stalled and went off on {} steps ({:.1f} % of steps)\n", s.anderson_off,
-               s.steps ? 100.0 * double(s.anderson_off) / double(s.steps) : 0.0);
+    fmt::print("cdsim: Anderson's mixing stalled and went off on {} steps ({:.1f} % of steps){}\n", s.anderson_off,
+               s.steps ? 100.0 * double(s.anderson_off) / double(s.steps) : 0.0,
+               s.cap_hits ? fmt::format(", on {} of the {} steps at the sweep cap", s.cap_anderson_off, s.cap_hits)
+                          : std::string());
   if (scene.subspace > 0)  // the corrections' cost, in CG iterations (each about half a sweep's cost)
     fmt::print("cdsim: subspace corrections: {:.1f} CG iterations a step; stalled and stopped on {} steps ({:.1f} % of steps)\n",
                s.steps ? double(s.subspace_iterations) / double(s.steps) : 0.0, s.subspace_off,
@@ -88,6 +91,22 @@ int report(const cd::RunSummary& s, const cd::Scene& scene, const std::string& o
                "docs/accuracy.md)\n",
                100.0 * s.cap_share(), static_cast<long long>(s.totals.cap_steps), s.last_step,
                scene.max_iter);
+  // With the mixing on, which setting ends such steps (docs/accuracy.md,
+  // "Anderson at an explicit tolerance"): a law-residual stop when the run
+  // has none (without one, plain NLGS capped as many steps or more, 2D and
+  // 3D, measured), or more sweeps.
+  if (s.cap_share() > 0.01 && scene.anderson > 0 && s.cap_hits > 0)
+    fmt::print(stderr,
+               "cdsim: warning: of this session's {} steps at the sweep cap, {} ended as plain NLGS after Anderson's "
+               "mixing (solver.anderson = {}) stalled and went off, and {} with it on; {} (docs/accuracy.md)\n",
+               s.cap_hits, s.cap_anderson_off, scene.anderson, s.cap_hits - s.cap_anderson_off,
+               scene.residual_tol > 0
+                   ? std::string("a larger solver.max_iter ends such steps")
+                   : fmt::format("the setting that ends such steps is a law-residual stop, solver.residual_tol "
+                                 "({:g} is the policy's with plain NLGS below I = 0.01), or a larger "
+                                 "solver.max_iter: plain NLGS (solver.anderson = 0) without one capped as many "
+                                 "steps or more",
+                                 cd::kShearBands.front().plain.residual_tol));
   // The overlap users read: relative to the smaller grain of the pair.
   constexpr double kOverlapWarn = 0.01;
   if (s.max_overlap_small > kOverlapWarn)

@@ -66,6 +66,9 @@ struct RunSummary {
   int max_iterations = 0;
   std::int64_t cap_hits = 0;
   std::int64_t anderson_off = 0;  // steps whose Anderson mixing stalled and went off (SolveStats::anderson_off)
+  // Steps at the sweep cap whose Anderson mixing had stalled and gone off:
+  // their last sweeps were plain NLGS's.
+  std::int64_t cap_anderson_off = 0;
   std::int64_t subspace_off = 0;  // steps whose subspace corrections stalled and stopped (SolveStats::subspace_off)
   std::int64_t subspace_iterations = 0;  // conjugate-gradient iterations of the subspace corrections, all steps
   // Steps on which a pressure-driven length was held at its approach floor

@@ -246,6 +246,7 @@ void CostRecord::add(const StepStats& st) {
   sum_.max_iterations = std::max(sum_.max_iterations, st.solve.iterations);
   sum_.cap_hits += st.solve.cap_hit;
   sum_.anderson_off += st.solve.anderson_off > 0;
+  sum_.cap_anderson_off += st.solve.cap_hit && st.solve.anderson_off > 0;
   sum_.subspace_off += st.solve.subspace_off > 0;
   sum_.subspace_iterations += st.solve.subspace_iterations;
   sum_.floor_steps += st.floor_held;
