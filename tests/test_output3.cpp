@@ -26,6 +26,7 @@
 
 #include "analysis/src/snapshot.hpp"
 #include "cli_util.hpp"
+#include "files.hpp"
 #include "output3.hpp"
 #include "pile3d.hpp"
 #include "polyhedron.hpp"
@@ -185,6 +186,7 @@ TEST(Output3, PolyhedraAreTheirTrueFaces) {
     ASSERT_EQ(ids->GetNumberOfIds(), 3);
     for (vtkIdType k = 0; k < 3; ++k) EXPECT_LT(ids->GetId(k), 4);
   }
+  EXPECT_THROW(write_polyhedra_vtp(w, (dir / "missing" / "p.vtp").string()), WriteError);
   std::filesystem::remove_all(dir);
 }
 

@@ -44,6 +44,7 @@ void write_contacts3_vtp(const World3& w, const std::string& path);
 // world frame, the loop counter-clockwise seen from outside), cell data
 // repeated on each face of a body: id (body index), shape_id (index into
 // bodies.polyhedra), radius (circumradius), velocity (3), omega (3).
+// Written and refused as write_spheres_vtp (WriteError).
 void write_polyhedra_vtp(const World3& w, const std::string& path);
 
 // 0 open, 1 stick, 2 slide: row k of the last step (as 2D's ContactStatus).
