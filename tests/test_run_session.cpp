@@ -188,7 +188,7 @@ TEST(RunFolder, ClearPreviousRemovesOnlyARunsOwnFiles) {
   const fs::path d = cdtest::scratch_dir("test_run_session", "clear");
   for (const char* f : {"series.csv", "timings.csv", "scene.toml", "summary.toml", "checkpoint.bin",
                         "checkpoint.bin.tmp.12", "problem_5.cdp", "particles.pvd", "particles_00001.vtp",
-                        "spheres_00002.vtp", "notes.txt", "mine.vtp", ".cdsim.lock"})
+                        "spheres_00002.vtp", "polyhedra_00003.vtp", "notes.txt", "mine.vtp", ".cdsim.lock"})
     write(d / f, "x");
   cd::clear_previous(d);
   std::set<std::string> left;

@@ -6,8 +6,8 @@
 // valid Python (python3's parser; python3 comes with libvtk9-dev), and every
 // collection it opens for that dimension exists in the folder. Rendering it
 // was checked by hand with Debian's ParaView 5.11 (pvbatch view.py out.png
-// under xvfb-run, as `make figures` runs ParaView) on the default scene and
-// a 300-sphere pile.
+// under xvfb-run, as `make figures` runs ParaView) on the default scene, a
+// 300-sphere pile, and the polyhedra branch on the two cubes below.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -17,6 +17,9 @@
 #include <set>
 #include <sstream>
 #include <string>
+
+#include "output3.hpp"
+#include "polyhedron.hpp"
 
 namespace fs = std::filesystem;
 
@@ -57,7 +60,7 @@ void check(const fs::path& dir, const std::set<std::string>& opened) {
   for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it) {
     const std::string stem = (*it)[1];
     EXPECT_TRUE(stem == "shapes" || stem == "walls" || stem == "contacts" || stem == "particles" ||
-                stem == "spheres")
+                stem == "spheres" || stem == "polyhedra")
         << stem;
   }
 }
@@ -74,6 +77,26 @@ TEST(ViewScript, ThreeDimensionalRunGetsIt) {
                            "--set particles.n=27 --set time.duration=0.05 --set output.snapshot_interval=0.025");
   check(dir, {"spheres", "contacts"});
   EXPECT_FALSE(fs::exists(dir / "shapes.pvd"));  // the script's 3D branch is taken
+}
+
+// No scene places polyhedra yet: a world of two cubes on a floor, written
+// through the 3D snapshot writer as a run would, takes the script's
+// polyhedra branch.
+TEST(ViewScript, PolyhedraWorldGetsIt) {
+  cd::WorldParams3 p;
+  p.gravity = cd::Vec3(0, 0, -9.81);
+  cd::World3 w(p);
+  w.bodies.add_plane(cd::Vec3::Zero(), cd::Vec3(0, 0, 1));
+  const int cube = w.bodies.add_shape(cd::cuboid(0.02, 0.02, 0.02));
+  w.bodies.add_polyhedron(cd::Vec3(0, 0, 0.01), cube, 2600);
+  w.bodies.add_polyhedron(cd::Vec3(0.005, 0, 0.03), cube, 2600);
+  w.step();
+  const fs::path dir = fs::path(CDLAB_BINARY_DIR) / "test_view_script" / "polyhedra";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  cd::Snapshots3(dir.string()).write(w);
+  check(dir, {"polyhedra", "contacts"});
+  fs::remove_all(dir);
 }
 
 TEST(ViewScript, NoSnapshotsNoScript) {

@@ -31,20 +31,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-template <class A>
-vtkNew<A> make_array(const char* name, int comps, vtkIdType n) {
-  vtkNew<A> a;
-  a->SetName(name);
-  a->SetNumberOfComponents(comps);
-  a->SetNumberOfTuples(n);
-  return a;
-}
-
-template <class... A>
-void add_arrays(vtkFieldData* fd, A&... arrays) {
-  (fd->AddArray(arrays), ...);
-}
-
 vtkSmartPointer<vtkPolyData> particles(const World& w) {
   const Bodies& b = w.bodies;
   vtkIdType n = 0;

@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 #include <vtkCellArray.h>
@@ -28,20 +30,12 @@ void write_spheres_vtp(const World3& w, const std::string& path) {
   pts->SetDataTypeToDouble();
   pts->SetNumberOfPoints(n);
   vtkNew<vtkCellArray> verts;
-  auto array = [n](auto a, const char* name, int comps) {
-    a->SetName(name);
-    a->SetNumberOfComponents(comps);
-    a->SetNumberOfTuples(n);
-    return a;
-  };
-  vtkNew<vtkIntArray> id;
-  vtkNew<vtkDoubleArray> radius, vel, omega, orient, mass;
-  array(id.Get(), "id", 1);
-  array(radius.Get(), "radius", 1);
-  array(vel.Get(), "velocity", 3);
-  array(omega.Get(), "omega", 3);
-  array(orient.Get(), "orientation", 4);
-  array(mass.Get(), "mass", 1);
+  auto id = make_array<vtkIntArray>("id", 1, n);
+  auto radius = make_array<vtkDoubleArray>("radius", 1, n);
+  auto vel = make_array<vtkDoubleArray>("velocity", 3, n);
+  auto omega = make_array<vtkDoubleArray>("omega", 3, n);
+  auto orient = make_array<vtkDoubleArray>("orientation", 4, n);
+  auto mass = make_array<vtkDoubleArray>("mass", 1, n);
   vtkIdType k = 0;
   for (std::size_t i = 0; i < b.size(); ++i) {
     if (!b.is_dynamic(i) || b.shape[i] != Shape3::Sphere) continue;
@@ -58,10 +52,7 @@ void write_spheres_vtp(const World3& w, const std::string& path) {
   vtkNew<vtkPolyData> pd;
   pd->SetPoints(pts);
   pd->SetVerts(verts);
-  for (vtkDataArray* a : {static_cast<vtkDataArray*>(id.Get()), static_cast<vtkDataArray*>(radius.Get()),
-                          static_cast<vtkDataArray*>(vel.Get()), static_cast<vtkDataArray*>(omega.Get()),
-                          static_cast<vtkDataArray*>(orient.Get()), static_cast<vtkDataArray*>(mass.Get())})
-    pd->GetPointData()->AddArray(a);
+  add_arrays(pd->GetPointData(), id, radius, vel, omega, orient, mass);
   pd->GetPointData()->SetActiveScalars("radius");
 
   write_vtp(pd, path);
@@ -82,34 +73,34 @@ void write_contacts3_vtp(const World3& w, const std::string& path) {
   const double inv_dt = 1.0 / w.params().dt;
   vtkNew<vtkPoints> pts;
   pts->SetDataTypeToDouble();
-  pts->SetNumberOfPoints(2 * n);
   vtkNew<vtkCellArray> lines;
-  auto array = [n](auto a, const char* name, int comps) {
-    a->SetName(name);
-    a->SetNumberOfComponents(comps);
-    a->SetNumberOfTuples(n);
-    return a;
-  };
-  vtkNew<vtkDoubleArray> fn, ft, force, normal, gap;
-  vtkNew<vtkUnsignedCharArray> status;
-  vtkNew<vtkIntArray> b1, b2;
-  array(fn.Get(), "fn", 1);
-  array(ft.Get(), "ft", 3);
-  array(force.Get(), "force", 3);
-  array(normal.Get(), "normal", 3);
-  array(gap.Get(), "gap", 1);
-  array(status.Get(), "status", 1);
-  array(b1.Get(), "b1", 1);
-  array(b2.Get(), "b2", 1);
+  auto fn = make_array<vtkDoubleArray>("fn", 1, n);
+  auto ft = make_array<vtkDoubleArray>("ft", 3, n);
+  auto force = make_array<vtkDoubleArray>("force", 3, n);
+  auto normal = make_array<vtkDoubleArray>("normal", 3, n);
+  auto gap = make_array<vtkDoubleArray>("gap", 1, n);
+  auto status = make_array<vtkUnsignedCharArray>("status", 1, n);
+  auto b1 = make_array<vtkIntArray>("b1", 1, n);
+  auto b2 = make_array<vtkIntArray>("b2", 1, n);
+  auto kind = make_array<vtkUnsignedCharArray>("kind", 1, n);
+  auto branch = make_array<vtkDoubleArray>("branch", 3, n);
+  vtkIdType ids[3];
+  int np = 0;
+  const auto point = [&](const Vec3& x) { ids[np++] = pts->InsertNextPoint(x.x(), x.y(), x.z()); };
   for (vtkIdType k = 0; k < n; ++k) {
     const SphereRow& r = rows[k];
     const ContactInfo3& c = info[k];
-    const Vec3 x2 = b.pos[r.b2];
-    const Vec3 x1 = x2 - c.branch;  // a plane's branch ends at the sphere's foot on it
-    pts->SetPoint(2 * k, x1.x(), x1.y(), x1.z());
-    pts->SetPoint(2 * k + 1, x2.x(), x2.y(), x2.z());
-    const vtkIdType ids[2] = {2 * k, 2 * k + 1};
-    lines->InsertNextCell(2, ids);
+    np = 0;
+    if (c.kind == 0) {  // spheres: centre to centre; a plane's branch ends at the sphere's foot on it
+      const Vec3 x2 = b.pos[r.b2];
+      point(x2 - c.branch);
+      point(x2);
+    } else {  // a polyhedron's point: the row's lever arms, through the point
+      if (b.shape[r.b1] != Shape3::Plane) point(c.point - r.c1);
+      point(c.point);
+      point(c.point - r.c2);
+    }
+    lines->InsertNextCell(np, ids);
     const Vec3 t = (r.r[1] * r.t1 + r.r[2] * r.t2) * inv_dt;
     const Vec3 f = r.to_world(r.r) * inv_dt;
     fn->SetValue(k, r.r[0] * inv_dt);
@@ -120,16 +111,56 @@ void write_contacts3_vtp(const World3& w, const std::string& path) {
     status->SetValue(k, static_cast<unsigned char>(contact_status3(r)));
     b1->SetValue(k, r.b1);
     b2->SetValue(k, r.b2);
+    kind->SetValue(k, c.kind);
+    branch->SetTuple3(k, c.branch.x(), c.branch.y(), c.branch.z());
   }
   vtkNew<vtkPolyData> pd;
   pd->SetPoints(pts);
   pd->SetLines(lines);
-  for (vtkDataArray* a : {static_cast<vtkDataArray*>(fn.Get()), static_cast<vtkDataArray*>(ft.Get()),
-                          static_cast<vtkDataArray*>(force.Get()), static_cast<vtkDataArray*>(normal.Get()),
-                          static_cast<vtkDataArray*>(gap.Get()), static_cast<vtkDataArray*>(status.Get()),
-                          static_cast<vtkDataArray*>(b1.Get()), static_cast<vtkDataArray*>(b2.Get())})
-    pd->GetCellData()->AddArray(a);
+  add_arrays(pd->GetCellData(), fn, ft, force, normal, gap, status, b1, b2, kind, branch);
   pd->GetCellData()->SetActiveScalars("fn");
+  write_vtp(pd, path);
+}
+
+void write_polyhedra_vtp(const World3& w, const std::string& path) {
+  const Bodies3& b = w.bodies;
+  vtkIdType n = 0;  // faces
+  for (std::size_t i = 0; i < b.size(); ++i)
+    if (b.shape[i] == Shape3::Polyhedron) n += static_cast<vtkIdType>(b.polyhedron(i).faces().size());
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> polys;
+  auto id = make_array<vtkIntArray>("id", 1, n);
+  auto shape = make_array<vtkIntArray>("shape_id", 1, n);
+  auto radius = make_array<vtkDoubleArray>("radius", 1, n);
+  auto vel = make_array<vtkDoubleArray>("velocity", 3, n);
+  auto omega = make_array<vtkDoubleArray>("omega", 3, n);
+  std::vector<vtkIdType> cell;
+  vtkIdType k = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.shape[i] != Shape3::Polyhedron) continue;
+    const ConvexPolyhedron& s = b.polyhedron(i);
+    const vtkIdType first = pts->GetNumberOfPoints();
+    for (const Vec3& v : s.vertices()) {
+      const Vec3 x = b.pos[i] + b.orient[i] * v;
+      pts->InsertNextPoint(x.x(), x.y(), x.z());
+    }
+    for (const PolyFace& f : s.faces()) {
+      cell.assign(f.loop.begin(), f.loop.end());
+      for (vtkIdType& p : cell) p += first;
+      polys->InsertNextCell(static_cast<vtkIdType>(cell.size()), cell.data());
+      id->SetValue(k, static_cast<int>(i));
+      shape->SetValue(k, b.shape_id[i]);
+      radius->SetValue(k, b.radius[i]);
+      vel->SetTuple3(k, b.vel[i].v.x(), b.vel[i].v.y(), b.vel[i].v.z());
+      omega->SetTuple3(k, b.vel[i].w.x(), b.vel[i].w.y(), b.vel[i].w.z());
+      ++k;
+    }
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->SetPolys(polys);
+  add_arrays(pd->GetCellData(), id, shape, radius, vel, omega);
   write_vtp(pd, path);
 }
 
@@ -139,12 +170,15 @@ void Snapshots3::write(const World3& w) {
   const fs::path d(dir_);
   write_spheres_vtp(w, (d / ("spheres_" + num + ".vtp")).string());
   write_contacts3_vtp(w, (d / ("contacts_" + num + ".vtp")).string());
+  const bool poly = w.bodies.has_polyhedra();
+  if (poly) write_polyhedra_vtp(w, (d / ("polyhedra_" + num + ".vtp")).string());
   // The collections are rewritten only once all files of the frame are in
   // place, so they never list a missing file.
   if (n_ == 0) write_file_atomic((d / "view.py").string(), paraview_view_script());
   frames_.emplace_back(w.time, num);
-  for (const char* stem : {"spheres", "contacts"})
-    write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd_collection(frames_, stem));
+  for (const char* stem : {"spheres", "contacts", "polyhedra"})
+    if (poly || std::string_view(stem) != "polyhedra")
+      write_file_atomic((d / (std::string(stem) + ".pvd")).string(), pvd_collection(frames_, stem));
   ++n_;
 }
 

@@ -92,7 +92,7 @@ void clear_previous(const std::filesystem::path& dir) {
                       (e.path().extension() == ".vtp" &&
                        (f.starts_with("particles_") || f.starts_with("contacts_") ||
                         f.starts_with("walls_") || f.starts_with("shapes_") ||
-                        f.starts_with("spheres_")));
+                        f.starts_with("spheres_") || f.starts_with("polyhedra_")));
     if (ours) fs::remove(e.path());
   }
 }
