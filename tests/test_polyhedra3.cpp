@@ -289,6 +289,37 @@ TEST(Polyhedra3, TetrahedronDroppedOnAVertexRestsOnAFace) {
   EXPECT_NEAR(w.bodies.pos[b].z(), r / 3, 1e-9 * r);
 }
 
+namespace {
+
+// A row between two bodies with random lever arms, normal, masses, full
+// inverse inertia tensors (moments about (1, 2, 3), turned) and velocities.
+struct TwoBodies {
+  SphereRow row{};
+  BodyVel3 vel[2];
+  Mat3 J[2];
+};
+TwoBodies random_two_bodies(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> U(-1, 1);
+  TwoBodies t;
+  SphereRow& r = t.row;
+  r.b1 = 0;
+  r.b2 = 1;
+  r.n = Vec3(U(rng), U(rng), U(rng)).normalized();
+  orthonormal_basis(r.n, r.t1, r.t2);
+  r.c1 = Vec3(U(rng), U(rng), U(rng));
+  r.c2 = Vec3(U(rng), U(rng), U(rng));
+  for (int i = 0; i < 2; ++i) {
+    t.vel[i].inv_m = 1.0 + 0.5 * U(rng);
+    const Vec3 moments(1 + 0.5 * U(rng), 2 + U(rng), 3 + U(rng));
+    t.J[i] = world_inverse_inertia(moments, Quat(Eigen::AngleAxisd(3 * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized())));
+    t.vel[i].v = Vec3(U(rng), U(rng), U(rng));
+    t.vel[i].w = Vec3(U(rng), U(rng), U(rng));
+  }
+  return t;
+}
+
+}  // namespace
+
 // The block of a polyhedron's row (block_coupling3.hpp) against W = H^T
 // M^-1 H assembled from the two bodies' 6 dofs with their full inverse
 // inertia tensors, and the sweep's velocity and impulse against the same H.
@@ -296,22 +327,10 @@ TEST(Polyhedra3, BlockRowAgainstAssembledDelassus) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> U(-1, 1);
   for (int trial = 0; trial < 20; ++trial) {
-    SphereRow r{};
-    r.b1 = 0;
-    r.b2 = 1;
-    r.n = Vec3(U(rng), U(rng), U(rng)).normalized();
-    orthonormal_basis(r.n, r.t1, r.t2);
-    r.c1 = Vec3(U(rng), U(rng), U(rng));
-    r.c2 = Vec3(U(rng), U(rng), U(rng));
-    BodyVel3 vel[2];
-    Mat3 J[2];
-    for (int i = 0; i < 2; ++i) {
-      vel[i].inv_m = 0.5 + 0.5 * U(rng) + 0.5;
-      const Vec3 moments(1 + 0.5 * U(rng), 2 + U(rng), 3 + U(rng));
-      J[i] = world_inverse_inertia(moments, Quat(Eigen::AngleAxisd(3 * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized())));
-      vel[i].v = Vec3(U(rng), U(rng), U(rng));
-      vel[i].w = Vec3(U(rng), U(rng), U(rng));
-    }
+    const TwoBodies t = random_two_bodies(rng);
+    const SphereRow& r = t.row;
+    BodyVel3 vel[2] = {t.vel[0], t.vel[1]};
+    const Mat3* J = t.J;
     const BlockRow3 b = make_block_row3(r, vel, J);
     Eigen::Matrix3d F;
     F.row(0) = r.n;
@@ -498,21 +517,8 @@ TEST(Polyhedra3, WarmSlideFindsTheScansSlide) {
   std::uniform_real_distribution<double> U(-1, 1);
   int slides = 0;
   for (int trial = 0; trial < 400; ++trial) {
-    SphereRow r{};
-    r.b1 = 0;
-    r.b2 = 1;
-    r.n = Vec3(U(rng), U(rng), U(rng)).normalized();
-    orthonormal_basis(r.n, r.t1, r.t2);
-    r.c1 = Vec3(U(rng), U(rng), U(rng));
-    r.c2 = Vec3(U(rng), U(rng), U(rng));
-    BodyVel3 vel[2];
-    Mat3 J[2];
-    for (int i = 0; i < 2; ++i) {
-      vel[i].inv_m = 1.0 + 0.5 * U(rng);
-      const Vec3 moments(1 + 0.5 * U(rng), 2 + U(rng), 3 + U(rng));
-      J[i] = world_inverse_inertia(moments, Quat(Eigen::AngleAxisd(3 * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized())));
-    }
-    const Mat3 W = make_block_row3(r, vel, J).W;
+    const TwoBodies t = random_two_bodies(rng);
+    const Mat3 W = make_block_row3(t.row, t.vel, t.J).W;
     const Vec3 q(-0.5 - 0.5 * std::abs(U(rng)), U(rng), U(rng));
     const Cone3 cone = Cone3::round(0.4);
     Vec3 scan, warm;

@@ -55,6 +55,17 @@ double update_dof(CellDof3& d, BlockRow3* rows) {
 
 namespace {
 
+// The sweep's rows' impulses and b_n (the dofs move it) back into the problem's.
+template <class Row>
+void give_back(ContactProblem3& p, const std::vector<Row>& rows, int min_parallel) {
+  const int n = static_cast<int>(rows.size());
+#pragma omp parallel for schedule(static) if (n >= min_parallel)
+  for (int k = 0; k < n; ++k) {
+    p.rows[k].r = rows[k].r;
+    p.rows[k].bn = rows[k].bn;
+  }
+}
+
 // The problem of bodies with inverse inertia tensors: its rows as
 // block_coupling3.hpp's BlockRow3.
 SolveStats nlgs_solve_blocks3(ContactProblem3& p, const SolverParams& prm, const SweepObserver& observer) {
@@ -77,11 +88,7 @@ SolveStats nlgs_solve_blocks3(ContactProblem3& p, const SolverParams& prm, const
         return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
       },
       p.law);
-#pragma omp parallel for schedule(static) if (n >= prm.min_parallel)
-  for (int k = 0; k < n; ++k) {
-    p.rows[k].r = rows[k].r;
-    p.rows[k].bn = rows[k].bn;
-  }
+  give_back(p, rows, prm.min_parallel);
   return st;
 }
 
@@ -129,11 +136,7 @@ SolveStats nlgs_solve3(ContactProblem3& p, const SolverParams& prm, const SweepO
         return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
       },
       p.law);
-#pragma omp parallel for schedule(static) if (n >= prm.min_parallel)
-  for (int k = 0; k < n; ++k) {
-    p.rows[k].r = rows[k].r;
-    p.rows[k].bn = rows[k].bn;
-  }
+  give_back(p, rows, prm.min_parallel);
   return st;
 }
 
