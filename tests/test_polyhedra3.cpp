@@ -6,7 +6,8 @@
 // g (sin - mu cos) above), two cubes stacked, a free asymmetric body
 // (energy and |L| to round-off, L's direction to second order in dt), a
 // tetrahedron dropped on a vertex coming to rest on a face, the block
-// solve against the assembled W, and one thread against two.
+// solve against the assembled W, slide or tip of a tall block at mu
+// against b/H, and one thread against two.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -166,6 +167,74 @@ TEST(Polyhedra3, CubeOnInclineSticksThenSlides) {
   EXPECT_LT(g.w * a, 1e-9 * expect);
   EXPECT_NEAR(g.cop_downhill, 0.5 * a * mu, 1e-8 * a);
   EXPECT_LE(g.max_residual, 1e-10);
+}
+
+namespace {
+
+struct Block {
+  double v_along = 0, v_normal = 0, w_tip = 0, cop_downhill = 0, max_residual = 0;
+  double cop_to_edge = 0;  // from the centre of pressure down the slope to the lowest contact point
+};
+
+// A block of base b x b and height H released at rest on a plane tilted by
+// theta about y (its base on the plane), mu on the plane, `steps` steps.
+Block block_on_incline(double b, double H, double theta, double mu, int steps) {
+  World3 w(params(mu));
+  const Vec3 n(std::sin(theta), 0, std::cos(theta)), d(std::cos(theta), 0, -std::sin(theta));
+  w.bodies.add_plane(Vec3::Zero(), n);
+  const int shape = w.bodies.add_shape(cuboid(b, b, H));
+  const Quat q(Eigen::AngleAxisd(theta, Vec3::UnitY()));
+  const int c = w.bodies.add_polyhedron(0.5 * H * n, shape, kRho, q);
+  Block out;
+  for (int k = 0; k < steps; ++k) {
+    w.step();
+    out.max_residual = std::max(out.max_residual, w.last().solve.residual_max);
+  }
+  const BodyVel3& v = w.bodies.vel[c];
+  out.v_along = v.v.dot(d);
+  out.v_normal = v.v.dot(n);
+  out.w_tip = v.w.dot(n.cross(d));  // > 0: turning over its downhill edge
+  const Load l = load_on(w, c);
+  const Vec3 x = w.bodies.pos[c] - 0.5 * w.params().dt * v.v;
+  out.cop_downhill = l.normal > 0 ? (l.cop - (x - x.dot(n) * n)).dot(d) : 0.0;
+  double edge = -1e300;
+  for (const ContactInfo3& f : w.infos()) edge = std::max(edge, f.point.dot(d));
+  out.cop_to_edge = edge - l.cop.dot(d);
+  return out;
+}
+
+}  // namespace
+
+// Slide or tip: a block of base b and height H = 2b on an incline. Resting,
+// the plane's reaction passes through the centroid's vertical, so its
+// centre of pressure sits (H/2) tan(theta) downhill of the centroid's
+// foot; the block tips when that reaches the downhill edge, tan(theta) >
+// b/H = 0.5, and slides when tan(theta) > mu. Below both it rests (the
+// centre of pressure where the moments say); with mu = 0.3 < b/H it
+// slides at g (sin - mu cos) without turning (the centre of pressure at
+// (H/2) mu < b/2); with mu = 0.8 > tan(theta) = 0.6 > b/H it tips over its
+// downhill edge, the whole normal load on that edge.
+TEST(Polyhedra3, BlockOnInclineSlidesOrTipsAtMuAgainstBOverH) {
+  const double b = 0.01, H = 0.02, dt = 1e-3;
+  const double t_rest = std::atan(0.45);
+  const Block rest = block_on_incline(b, H, t_rest, 0.8, 200);
+  EXPECT_LT(std::abs(rest.v_along) + std::abs(rest.v_normal), 1e-12);
+  EXPECT_LT(std::abs(rest.w_tip), 1e-9);
+  EXPECT_NEAR(rest.cop_downhill, 0.5 * H * std::tan(t_rest), 1e-8 * H);
+  EXPECT_LE(rest.max_residual, 1e-10);
+
+  const double t_slide = std::atan(0.4), mu = 0.3;
+  const Block slide = block_on_incline(b, H, t_slide, mu, 200);
+  const double expect = kG * (std::sin(t_slide) - mu * std::cos(t_slide)) * dt * 200;
+  EXPECT_NEAR(slide.v_along, expect, 1e-9 * expect);
+  EXPECT_LT(std::abs(slide.w_tip) * H, 1e-9 * expect);
+  EXPECT_NEAR(slide.cop_downhill, 0.5 * H * mu, 1e-8 * H);
+
+  const double t_tip = std::atan(0.6);
+  const Block tip = block_on_incline(b, H, t_tip, 0.8, 100);
+  EXPECT_GT(tip.w_tip, 0.1);  // rad/s after 0.1 s: turning over its downhill edge
+  EXPECT_NEAR(tip.cop_to_edge, 0.0, 1e-9 * b);  // the load on the downhill edge alone
+  EXPECT_NEAR(rest.cop_to_edge, 0.5 * b - 0.5 * H * std::tan(t_rest), 1e-8 * H);  // resting: inside the base
 }
 
 // Two cubes stacked face to face on a plane, the upper one shifted by a/4
