@@ -103,24 +103,26 @@ TEST(Polyhedra3, CubeRestsOnPlaneWithFourPoints) {
 
 namespace {
 
-struct CubeIncline {
-  double v_along = 0, v_normal = 0, w = 0;
+struct Block {
+  double v_along = 0, v_normal = 0;
+  double w = 0, w_tip = 0;  // |omega|; omega about the downhill edge (> 0: turning over it)
   Load load;
   double cop_downhill = 0;  // centre of pressure from the centroid's foot, down the slope
+  double cop_to_edge = 0;   // from the centre of pressure down the slope to the lowest contact point
   double max_residual = 0;
   int steps = 0;
 };
 
-// A cube of side a released at rest on a plane tilted by theta about y.
-CubeIncline cube_incline(double theta, double mu, int steps) {
+// A block of base b x b and height H released at rest on a plane tilted by
+// theta about y (its base on the plane), mu on the plane, `steps` steps.
+Block block_on_incline(double b, double H, double theta, double mu, int steps) {
   World3 w(params(mu));
   const Vec3 n(std::sin(theta), 0, std::cos(theta)), d(std::cos(theta), 0, -std::sin(theta));
   w.bodies.add_plane(Vec3::Zero(), n);
-  const double a = 0.02;
-  const int shape = w.bodies.add_shape(cuboid(a, a, a));
+  const int shape = w.bodies.add_shape(cuboid(b, b, H));
   const Quat q(Eigen::AngleAxisd(theta, Vec3::UnitY()));  // a face on the plane
-  const int c = w.bodies.add_polyhedron(0.5 * a * n, shape, kRho, q);
-  CubeIncline out;
+  const int c = w.bodies.add_polyhedron(0.5 * H * n, shape, kRho, q);
+  Block out;
   for (int k = 0; k < steps; ++k) {
     w.step();
     out.max_residual = std::max(out.max_residual, w.last().solve.residual_max);
@@ -129,14 +131,20 @@ CubeIncline cube_incline(double theta, double mu, int steps) {
   out.v_along = v.v.dot(d);
   out.v_normal = v.v.dot(n);
   out.w = v.w.norm();
+  out.w_tip = v.w.dot(n.cross(d));
   out.load = load_on(w, c);
   // The contact points are the midpoint configuration's: the centroid there.
   const Vec3 x = w.bodies.pos[c] - 0.5 * w.params().dt * v.v;
-  const Vec3 foot = x - x.dot(n) * n;
-  out.cop_downhill = (out.load.cop - foot).dot(d);
+  out.cop_downhill = out.load.normal > 0 ? (out.load.cop - (x - x.dot(n) * n)).dot(d) : 0.0;
+  double edge = -1e300;
+  for (const ContactInfo3& f : w.infos()) edge = std::max(edge, f.point.dot(d));
+  out.cop_to_edge = edge - out.load.cop.dot(d);
   out.steps = steps;
   return out;
 }
+
+// A cube of side 0.02 on the incline.
+Block cube_incline(double theta, double mu, int steps) { return block_on_incline(0.02, 0.02, theta, mu, steps); }
 
 }  // namespace
 
@@ -150,7 +158,7 @@ TEST(Polyhedra3, CubeOnInclineSticksThenSlides) {
   const double mu = 0.4, dt = 1e-3, a = 0.02;
   const double m = kRho * a * a * a;
   const double t1 = std::atan(0.8 * mu);
-  const CubeIncline s = cube_incline(t1, mu, 300);
+  const Block s = cube_incline(t1, mu, 300);
   EXPECT_LT(std::abs(s.v_along), 1e-12);
   EXPECT_LT(std::abs(s.v_normal), 1e-12);
   EXPECT_LT(s.w, 1e-9);
@@ -160,7 +168,7 @@ TEST(Polyhedra3, CubeOnInclineSticksThenSlides) {
   EXPECT_LE(s.max_residual, 1e-10);
 
   const double t2 = std::atan(1.2 * mu);
-  const CubeIncline g = cube_incline(t2, mu, 300);
+  const Block g = cube_incline(t2, mu, 300);
   const double expect = kG * (std::sin(t2) - mu * std::cos(t2)) * dt * g.steps;
   EXPECT_NEAR(g.v_along, expect, 1e-9 * expect);
   EXPECT_LT(std::abs(g.v_normal), 1e-10 * expect);
@@ -168,42 +176,6 @@ TEST(Polyhedra3, CubeOnInclineSticksThenSlides) {
   EXPECT_NEAR(g.cop_downhill, 0.5 * a * mu, 1e-8 * a);
   EXPECT_LE(g.max_residual, 1e-10);
 }
-
-namespace {
-
-struct Block {
-  double v_along = 0, v_normal = 0, w_tip = 0, cop_downhill = 0, max_residual = 0;
-  double cop_to_edge = 0;  // from the centre of pressure down the slope to the lowest contact point
-};
-
-// A block of base b x b and height H released at rest on a plane tilted by
-// theta about y (its base on the plane), mu on the plane, `steps` steps.
-Block block_on_incline(double b, double H, double theta, double mu, int steps) {
-  World3 w(params(mu));
-  const Vec3 n(std::sin(theta), 0, std::cos(theta)), d(std::cos(theta), 0, -std::sin(theta));
-  w.bodies.add_plane(Vec3::Zero(), n);
-  const int shape = w.bodies.add_shape(cuboid(b, b, H));
-  const Quat q(Eigen::AngleAxisd(theta, Vec3::UnitY()));
-  const int c = w.bodies.add_polyhedron(0.5 * H * n, shape, kRho, q);
-  Block out;
-  for (int k = 0; k < steps; ++k) {
-    w.step();
-    out.max_residual = std::max(out.max_residual, w.last().solve.residual_max);
-  }
-  const BodyVel3& v = w.bodies.vel[c];
-  out.v_along = v.v.dot(d);
-  out.v_normal = v.v.dot(n);
-  out.w_tip = v.w.dot(n.cross(d));  // > 0: turning over its downhill edge
-  const Load l = load_on(w, c);
-  const Vec3 x = w.bodies.pos[c] - 0.5 * w.params().dt * v.v;
-  out.cop_downhill = l.normal > 0 ? (l.cop - (x - x.dot(n) * n)).dot(d) : 0.0;
-  double edge = -1e300;
-  for (const ContactInfo3& f : w.infos()) edge = std::max(edge, f.point.dot(d));
-  out.cop_to_edge = edge - l.cop.dot(d);
-  return out;
-}
-
-}  // namespace
 
 // Slide or tip: a block of base b and height H = 2b on an incline. Resting,
 // the plane's reaction passes through the centroid's vertical, so its
