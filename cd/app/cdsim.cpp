@@ -224,14 +224,15 @@ int main(int argc, char** argv) {
     // Everything is built and checked before anything is written.
     std::optional<cd::World> world;
     std::optional<cd::World3> world3;
-    if (three) world3.emplace(cd::build_world3(scene));
-    else world.emplace(cd::build_world(scene));
+    const cd::CompleteScene complete = cd::complete_scene(scene);
+    if (three) world3.emplace(cd::build_world3(complete));
+    else world.emplace(cd::build_world(complete));
     cd::check_output_dir(out);
     if (scene.threads > 0) omp_set_num_threads(scene.threads);
     warn_if_oversubscribed(three ? world3->bodies.size() : world->bodies.size());
 
     const std::vector<std::int64_t> dump_steps =
-        cd::dump_steps(dump_words, cd::plan_of(scene, cd::time_step(scene)).nsteps);
+        cd::dump_steps(dump_words, cd::plan_of(scene, complete.dt).nsteps);
     cd::RunOptions opt{out, scene.quiet, cd::resolved_toml(scene), fresh, dump_steps, max_steps};
     opt.progress_every = progress_every;
     return report(three ? cd::run3(*world3, scene, opt) : cd::run(*world, scene, opt), scene, out, max_steps);

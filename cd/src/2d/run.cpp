@@ -128,7 +128,7 @@ class Engine2 final : public RunEngine {
   Engine2(World& w, const Scene& s, const RunOptions& opt)
       : w_(w), s_(s), dir_(opt.out), dump_(opt.dump_steps), shear_(s.shear_mode != ShearMode::None),
         walls_(s.shear_mode == ShearMode::Walls),
-        d_mean_(mean_diameter(s)) {
+        d_mean_(w.params().d_ref) {
     // --dump-problem: the hook sees the problem of the step being taken
     // (w.steps + 1) just before its solve. Each file is written whole under
     // a temporary name and renamed (a failure is a WriteError naming it).

@@ -10,7 +10,6 @@
 #include "checkpoint.hpp"
 #include "continuation.hpp"
 #include "observables.hpp"
-#include "protocol.hpp"
 #include "start_hint.hpp"
 
 namespace cd {
@@ -23,85 +22,32 @@ std::string body_name(const Scene& s, int i, int first_generated) {
   return fmt::format("generated particle {}", i - first_generated);
 }
 
-// The protocol's rules are the scene layer's (scene/protocol.hpp); what is
-// left is the cell's size, which the placement below needs.
-void check_shear(const Scene& s) {
-  check_protocol(s);
-  if (s.shear_mode == ShearMode::None) return;
-  // 0 x 0: a cell sized for the generated particles (with_auto_cell) or the
-  // start sample's cell.
-  const bool auto_cell = s.cell_width == 0 && s.cell_height == 0 &&
-                         (s.n > 0 || (s.shear_mode == ShearMode::Periodic && !s.start.empty()));
-  if (!auto_cell && (s.cell_width <= 0 || s.cell_height <= 0))
-    throw SceneError(fmt::format("shear.mode = \"{}\" needs shear.width > 0 and shear.height > 0 (or both 0, "
-                                 "for a cell sized for the generated particles)",
-                                 name_of(s.shear_mode)));
-}
-
 }  // namespace
 
-// A cell given as 0 x 0 for generated particles, computed from the actual
-// size law, whatever the size ratio:
-// - periodic: the smallest square that holds them on the generator's loose
-//   lattice (pitch 1.02 d_max);
-// - walls: a sample about as wide as tall once the top wall has compacted
-//   it, the width that of a square of the grains' area at the packing
-//   fraction kWallsPhi (sheared 2D packings lie within 0.75-0.85 of it, so
-//   the sample is square to within 7 %, the walls' looser first layers
-//   aside); the height holds the loose lattice's rows between the walls'
-//   grains, and the top wall's first fall compacts it.
-constexpr double kWallsPhi = 0.8;
-Scene with_auto_cell(const Scene& s) {
-  if (s.shear_mode == ShearMode::None || s.cell_width != 0 || s.cell_height != 0 || !s.start.empty() || s.n <= 0)
-    return s;
-  const std::vector<double> d = generated_diameters(s);
-  const double pitch = 1.02 * *std::max_element(d.begin(), d.end());
-  Scene c = s;
-  if (s.shear_mode == ShearMode::Periodic) {
-    const double k = std::ceil(std::sqrt(static_cast<double>(s.n)));
-    c.cell_width = c.cell_height = pitch * k * (1 + 1e-9);  // floor(side / pitch) = k
-    return c;
-  }
-  double area = 0.0;  // the grains', each the mean over the listed shapes it is drawn from
-  for (const double di : d) {
-    double a = 0.0;
-    for (const double n : s.nsides) a += obs::particle_area(0.5 * di, static_cast<int>(n));
-    area += a / static_cast<double>(s.nsides.size());
-  }
-  c.cell_width = std::max(std::sqrt(area / kWallsPhi), pitch * (1 + 1e-9));
-  const double rows = std::ceil(static_cast<double>(s.n) / std::floor(c.cell_width / pitch));
-  // place_generated's region: a wall grain's clearance (1.01 d_mean) from each wall.
-  c.cell_height = pitch * rows * (1 + 1e-9) + 2 * 1.01 * s.d_mean;
-  return c;
-}
-
-WorldParams world_params(const Scene& s0) {
-  const Scene s = with_auto_cell(s0);
-  check_shear(s);
-  check_derived(s);
+WorldParams world_params(const CompleteScene& c) {
+  const Scene& s = c.scene;
   WorldParams p;
-  p.dt = time_step(s);
+  p.dt = c.dt;
   p.gravity = Vec2(s.gravity[0], s.gravity[1]);
   p.mu = s.mu;
   p.mu_wall = s.mu_w();
   p.e_n = s.e_n;
   p.e_t = s.e_t;
-  p.d_ref = mean_diameter(s);
+  p.d_ref = c.d_mean;
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
   p.overlap_projection = s.overlap_projection;
-  p.adhesion = pull_off_force(s);  // eta p d, d = p.d_ref
+  p.adhesion = c.adhesion;  // eta p d, d = p.d_ref
   p.debond = s.debond * p.d_ref;
   if (s.shear_mode != ShearMode::None) {
-    CellParams& c = p.cell;
-    c.mode = s.shear_mode == ShearMode::Periodic ? CellParams::Mode::LeesEdwards : CellParams::Mode::Walls;
-    c.width = s.cell_width;
-    c.pressure = imposed_pressure(s);  // 0 under volume control: the lengths stay
-    c.isotropic = s.isotropic;
-    c.shear_rate = shear_rate(s);
-    const double tp = pressure_time(s);
-    c.max_strain_rate = s.compaction_rate > 0 && tp > 0 ? s.compaction_rate / tp : 0.0;
-    // c.mass: set by build_world, which knows the particles' mass
+    CellParams& q = p.cell;
+    q.mode = s.shear_mode == ShearMode::Periodic ? CellParams::Mode::LeesEdwards : CellParams::Mode::Walls;
+    q.width = s.cell_width;
+    q.pressure = c.pressure;  // 0 under volume control: the lengths stay
+    q.isotropic = s.isotropic;
+    q.shear_rate = c.shear_rate;
+    q.max_strain_rate = s.compaction_rate > 0 && c.t_p > 0 ? s.compaction_rate / c.t_p : 0.0;
+    // q.mass: set by build_world, which knows the particles' mass
   }
   p.solver.tol = s.tol;
   p.solver.residual_tol = s.residual_tol;
@@ -116,7 +62,8 @@ namespace {
 // shear.start: the particles and the cell of a sample (a preparation's or a
 // shear run's checkpoint) into w, checked against the scene, its flow set
 // for the new run (core/continuation.hpp).
-void continue_sample(const Scene& s, const WorldParams& wp, World& w) {
+void continue_sample(const CompleteScene& c, const WorldParams& wp, World& w) {
+  const Scene& s = c.scene;
   Bodies& B = w.bodies;
   // The particles and the cell a preparation run reached; time, strain
   // and the cell's rates start from zero, and the shear starts from the
@@ -133,8 +80,7 @@ void continue_sample(const Scene& s, const WorldParams& wp, World& w) {
   if (w.cell.width <= 0 || w.cell.height <= 0)
     throw SceneError(fmt::format("shear.start: '{}' holds no periodic cell (not a periodic "
                                  "preparation run)", s.start));
-  if (!s.disks.empty() || s.n > 0)
-    throw SceneError("shear.start gives the particles: set particles.n = 0 and no [[disk]]");
+  // The particles come from the sample alone (complete_scene).
   // The shapes come with the sample, but the scene's "auto" settings were
   // chosen (config.cpp, before the sample is read) for the shapes
   // particles.nsides names: polygons take no Anderson mixing and their own
@@ -173,7 +119,7 @@ void continue_sample(const Scene& s, const WorldParams& wp, World& w) {
   // 0. Under volume control the lengths stay: their rates are 0.
   const bool sheared = w.cell.strain != 0.0;
   if (!sheared) w.cell.offset = w.cell.hdot = w.cell.wdot = 0.0;
-  if (imposed_pressure(s) <= 0) w.cell.hdot = w.cell.wdot = 0.0;
+  if (c.pressure <= 0) w.cell.hdot = w.cell.wdot = 0.0;
   if (s.volume_fraction > 0) {
     double area = 0;
     for (std::size_t i = 0; i < B.size(); ++i) area += obs::particle_area(B.radius[i], B.nsides[i]);
@@ -189,35 +135,15 @@ void continue_sample(const Scene& s, const WorldParams& wp, World& w) {
   continuation::check_mean_diameter(grains, wp.d_ref);
 }
 
-// particles.n grains on a loose jittered lattice in the region, the cell
-// (between the walls' grains) or the box.
-void place_generated(const Scene& s, Bodies& B) {
-  const bool shear = s.shear_mode != ShearMode::None, walls = s.shear_mode == ShearMode::Walls;
-  // Loose placement on a jittered square lattice of pitch 1.02 d_max: no
-  // overlap by construction, filled row by row from the bottom.
-  std::vector<double> region = s.region;
-  if (region.empty() && shear) {
-    // The cell; between the walls' grains, a grain's clearance away.
-    const double m = walls ? 1.0 * s.d_mean * 1.01 : 0.0;
-    region = {0.0, m, s.cell_width, s.cell_height - m};
-  }
-  if (region.empty()) {
-    if (s.box_width <= 0)
-      throw SceneError("particles.n > 0 needs particles.region or a [box] to place them in");
-    region = {0.0, 0.0, s.box_width, s.box_height};
-  }
-  const std::vector<double> d = generated_diameters(s);
-  const double dmax = *std::max_element(d.begin(), d.end());
-  const double pitch = 1.02 * dmax;
-  // Counted in doubles (a region of 1e10 pitches overflows an int), and
-  // no more columns than grains.
-  const double cols = std::floor((region[2] - region[0]) / pitch), rows = std::floor((region[3] - region[1]) / pitch);
-  if (!(cols * rows >= s.n))
-    throw SceneError(fmt::format(
-        "particles.n = {} does not fit in the region [{}, {}] x [{}, {}]: room for {:.0f} disks "
-        "of the largest diameter {:.4g} on a loose lattice; enlarge the region or the box",
-        s.n, region[0], region[2], region[1], region[3], std::max(0.0, cols * rows), dmax));
-  const int nx = static_cast<int>(std::min<double>(cols, s.n));
+// particles.n grains on the loose jittered lattice complete_scene laid out
+// (region, pitch, columns), filled row by row from the bottom: no overlap
+// by construction.
+void place_generated(const CompleteScene& c, Bodies& B) {
+  const Scene& s = c.scene;
+  const std::vector<double>& d = c.diameters;
+  const std::vector<double>& region = c.region;
+  const double pitch = c.pitch;
+  const int nx = c.columns;
   std::mt19937_64 g(s.seed + 1);
   std::mt19937_64 gs(s.seed + 2);  // shapes and orientations: their own stream, so a
                                    // disk-only scene places exactly as before
@@ -275,11 +201,11 @@ void check_initial_overlaps(const Scene& s, const World& w, int first_generated)
 
 }  // namespace
 
-World build_world(const Scene& s0) {
-  if (s0.dimension != 2)
-    throw SceneError(fmt::format("dimension = {}: build_world makes 2D worlds (3D: build_world3)", s0.dimension));
-  const Scene s = with_auto_cell(s0);
-  WorldParams wp = world_params(s);
+World build_world(const CompleteScene& c) {
+  const Scene& s = c.scene;
+  if (s.dimension != 2)
+    throw SceneError(fmt::format("dimension = {}: build_world makes 2D worlds (3D: build_world3)", s.dimension));
+  WorldParams wp = world_params(c);
   World w(wp);
   Bodies& B = w.bodies;
   const bool shear = s.shear_mode != ShearMode::None, walls = s.shear_mode == ShearMode::Walls;
@@ -287,23 +213,8 @@ World build_world(const Scene& s0) {
     w.cell.width = s.cell_width;
     w.cell.height = s.cell_height;
   }
-  if (!s.start.empty()) continue_sample(s, wp, w);
+  if (!s.start.empty()) continue_sample(c, wp, w);
 
-  // In a box, every body starts inside it: one outside would fall for ever
-  // (one across a wall is refused as an overlap below).
-  if (s.box_width > 0) {
-    const double W = s.box_width, H = s.box_height;
-    for (std::size_t i = 0; i < s.disks.size(); ++i) {
-      const auto& x = s.disks[i].pos;
-      if (!(x[0] > 0 && x[0] < W && x[1] > 0 && x[1] < H))
-        throw SceneError(fmt::format("disk[{}].pos = [{}, {}] is outside the box [0, {}] x [0, {}]: it would "
-                                     "never meet the walls", i, x[0], x[1], W, H));
-    }
-    const std::vector<double>& r = s.region;
-    if (r.size() == 4 && !(r[0] >= 0 && r[1] >= 0 && r[2] <= W && r[3] <= H))
-      throw SceneError(fmt::format("particles.region = [{}, {}, {}, {}] reaches outside the box [0, {}] x [0, {}]: "
-                                   "grains placed there would never meet the walls", r[0], r[1], r[2], r[3], W, H));
-  }
   for (const DiskSpec& d : s.disks) {
     const double rho = d.density > 0 ? d.density : s.density;
     const int i = d.nsides > 0 ? B.add_polygon({d.pos[0], d.pos[1]}, d.radius, d.nsides, d.angle,
@@ -314,7 +225,7 @@ World build_world(const Scene& s0) {
   }
   const int first_generated = static_cast<int>(B.size());
 
-  if (s.n > 0) place_generated(s, B);
+  if (s.n > 0) place_generated(c, B);
 
   if (walls) {
     // Rough walls: a row of touching grains of the mean diameter glued to

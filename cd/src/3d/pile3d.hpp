@@ -8,14 +8,11 @@
 #include <cstdint>
 #include <random>
 
+#include "derived.hpp"  // lattice_side3
 #include "world3.hpp"
 
 namespace cd {
 
-// n = ceil(N^(1/3)): the side of the smallest cube of lattice sites holding N.
-inline int lattice_side3(int n_spheres) {
-  return static_cast<int>(std::ceil(std::cbrt(static_cast<double>(n_spheres)) - 1e-9));
-}
 
 struct Pile3dParams {
   int n_spheres = 1000;

@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include "checkpoint3.hpp"
-#include "derived.hpp"
 #include "dump3.hpp"
 #include "output3.hpp"
 
@@ -103,7 +102,7 @@ class Engine3 final : public RunEngine {
  public:
   Engine3(World3& w, const Scene& s, const RunOptions& opt)
       : w_(w), dump_(w, opt.out, opt.dump_steps), cell_(w.cell_volume() > 0.0), density_(s.density),
-        d_mean_(mean_diameter(s)) {}
+        d_mean_(w.params().d_ref) {}
   void step() override {
     w_.step();
     last_ = w_.last();

@@ -13,71 +13,11 @@
 #include "detect3.hpp"
 #include "continuation.hpp"
 #include "pile3d.hpp"
-#include "protocol.hpp"
 #include "start_hint.hpp"
 
 namespace cd {
 
 namespace {
-
-[[noreturn]] void fail3(const std::string& m) { throw SceneError(m + " (dimension = 3; docs/3d.md)"); }
-
-// Pitch of the loose lattice of a periodic cell: 1.02 d_max, as 2D's.
-double cell_pitch3(const Scene& s) { return 1.02 * diameter_bounds(s).second; }
-
-// The tri-periodic cell (shear.mode = "periodic"): the keys that apply,
-// and the lattice fitting the cell.
-void check_cell3(const Scene& s) {
-  // The protocol's keys: the scene layer's rules (scene/protocol.hpp).
-  check_protocol(s);
-  if (!s.rotation) fail3("contact.rotation = false: the 3D engine always integrates rotations");
-  if (!s.disks.empty()) fail3("[[disk]]: explicit disks are 2D only");
-  if (!s.walls.empty()) fail3("[[wall]]: segment walls are 2D only");
-  if (s.nsides.size() != 1 || s.nsides[0] != 0) fail3("particles.nsides: 3D particles are spheres; use [0]");
-  if (!s.region.empty()) fail3("particles.region: the spheres fill the periodic cell; use []");
-  check_derived(s);
-  if (!s.start.empty()) {
-    // The spheres and the cell come from the sample (build_cell3).
-    if (s.n > 0 || !s.diameters.empty())
-      fail3("shear.start gives the spheres: set particles.n = 0 and no particles.diameters");
-    if (s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0)
-      fail3(fmt::format("shear.width, shear.height, shear.depth = {}, {}, {}: shear.start gives the cell; "
-                        "leave them at 0", s.cell_width, s.cell_height, s.cell_depth));
-    return;
-  }
-  if (s.n <= 0) fail3("particles.n = 0: a 3D periodic cell needs generated spheres (particles.n or particles.diameters)");
-  const bool given = s.cell_width > 0 || s.cell_height > 0 || s.cell_depth > 0;
-  if (given && !(s.cell_width > 0 && s.cell_height > 0 && s.cell_depth > 0))
-    fail3(fmt::format("shear.width = {}, shear.height = {}, shear.depth = {}: all three > 0, or all 0 (the "
-                      "cube that holds the spheres)", s.cell_width, s.cell_height, s.cell_depth));
-  // The spheres' masses: check_derived (above).
-  const double d_max = diameter_bounds(s).second;
-  if (!given) return;
-  // World3's bound: each periodic length >= 2 (2 r_max + alert), so that a
-  // pair meets through one image at most.
-  const double lmin = 2.0 * (d_max + s.alert * mean_diameter(s));
-  const std::pair<const char*, double> lengths[] = {
-      {"shear.width", s.cell_width}, {"shear.height", s.cell_height}, {"shear.depth", s.cell_depth}};
-  for (const auto& [key, L] : lengths)
-    if (!std::isfinite(L) || L < lmin)
-      fail3(fmt::format("{} = {}: a periodic length must be >= 2 (d_max + alert) = {:.4g} m", key, L, lmin));
-  const double pitch = cell_pitch3(s);
-  const long room = static_cast<long>(s.cell_width / pitch) * static_cast<long>(s.cell_height / pitch) *
-                    static_cast<long>(s.cell_depth / pitch);
-  if (room < s.n)
-    fail3(fmt::format("particles.n = {} does not fit in the cell {} x {} x {}: room for {} spheres of the "
-                      "largest diameter {:.4g} on a loose lattice (pitch 1.02 d_max); enlarge shear.width, "
-                      "shear.height or shear.depth", s.n, s.cell_width, s.cell_height, s.cell_depth, room, d_max));
-}
-
-// 0 x 0 x 0: the smallest cube that holds the spheres on the loose lattice.
-Scene with_auto_cell3(const Scene& s) {
-  if (s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0 || s.n <= 0 || !s.start.empty()) return s;
-  Scene c = s;
-  const double k = lattice_side3(s.n);
-  c.cell_width = c.cell_height = c.cell_depth = cell_pitch3(s) * k * (1 + 1e-9);  // floor(side / pitch) = k
-  return c;
-}
 
 // The cell's mass (the dofs' at imposed stress): shear.cell_mass times the
 // spheres' total mass, as 2D's.
@@ -92,70 +32,10 @@ void set_cell_mass3(const Scene& s, World3& w) {
 
 }  // namespace
 
-namespace {
-
-// What a polyhedra scene (particles.shape) cannot have yet, refused by key.
-void check_polyhedra3(const Scene& s) {
-  if (s.shape == Shape3d::Sphere) return;
-  const std::string what = fmt::format("particles.shape = \"{}\"", name_of(s.shape));
-  if (!s.start.empty())
-    fail3(fmt::format("shear.start: a started sample holds spheres; {} grains start from their own placement "
-                      "(shear.start = \"\")", what));
-  if (contact_stiffness(s) > 0)
-    fail3(fmt::format("contact.stiffness: compliant contacts need grains of scalar inertia (spheres); {} grains "
-                      "take rigid contacts (no contact.stiffness)", what));
-}
-
-}  // namespace
-
-void check_scene3(const Scene& s) {
-  const auto fail = fail3;
-  if (s.dimension != 3) fail(fmt::format("dimension = {}: not a 3D scene", s.dimension));
-  check_polyhedra3(s);
-  if (s.gravity.size() != 3) fail("gravity.g: a 3D scene needs [gx, gy, gz]");
-  // A setting that cannot act under the scene's law is refused, not ignored.
-  if (s.subspace > 0 && s.orthotropic())
-    fail(fmt::format("solver.subspace = {}: the subspace correction acts on the round cone only, and "
-                     "contact.{} = {} makes the cone orthotropic: give solver.subspace = 0 (solver.anderson "
-                     "accelerates any cone)",
-                     s.subspace, s.mu_b >= 0 ? "mu_b" : "mu_wall_b", s.mu_b >= 0 ? s.mu_b : s.mu_wall_b));
-  if (s.shear_mode == ShearMode::Periodic) {
-    check_derived(s);
-    return check_cell3(with_auto_cell3(s));
-  }
-  check_protocol(s);  // no protocol (a 3D scene has no walls protocol): no protocol key
-  if (!s.disks.empty()) fail("[[disk]]: explicit disks are 2D only");
-  if (!s.walls.empty()) fail("[[wall]]: segment walls are 2D only; the 3D box is [box] width and depth");
-  if (s.nsides.size() != 1 || s.nsides[0] != 0)
-    fail("particles.nsides: 3D particles are spheres; use [0]");
-  if (!s.region.empty()) fail("particles.region: 3D spheres are placed on the box's lattice; use []");
-  if (!s.rotation) fail("contact.rotation = false: the 3D engine always integrates rotations");
-  if (s.box_height != 0) fail(fmt::format("box.height = {}: the 3D box is open at the top; use 0", s.box_height));
-  if ((s.box_width > 0) != (s.box_depth > 0))
-    fail(fmt::format("box.width = {}, box.depth = {}: must be both 0 (fitted to the lattice) or both > 0",
-                     s.box_width, s.box_depth));
-  check_derived(s);
-  if (s.n <= 0) fail("particles.n = 0: a 3D scene needs generated spheres (particles.n or particles.diameters)");
-  const double r_max = 0.5 * diameter_bounds(s).second;
-  const int n = lattice_side3(s.n);
-  const double side = n * 2.2 * r_max;
-  // The spheres' masses: check_derived (above).
-  if (!std::isfinite(side))
-    fail(fmt::format("the lattice of {} spheres of diameter up to {} m has side {} m: it must be finite "
-                     "(particles.d_mean, particles.diameters)", s.n, 2 * r_max, side));
-  if (s.box_width > 0 && s.box_width < side)
-    fail(fmt::format("box.width = {}: the {} x {} lattice of {} spheres (pitch 1.1 d_max = {} m) needs >= {} m",
-                     s.box_width, n, n, s.n, 2.2 * r_max, side));
-  if (s.box_depth > 0 && s.box_depth < side)
-    fail(fmt::format("box.depth = {}: the {} x {} lattice of {} spheres (pitch 1.1 d_max = {} m) needs >= {} m",
-                     s.box_depth, n, n, s.n, 2.2 * r_max, side));
-}
-
-WorldParams3 world_params3(const Scene& s0) {
-  check_scene3(s0);
-  const Scene s = s0.shear_mode == ShearMode::Periodic ? with_auto_cell3(s0) : s0;
+WorldParams3 world_params3(const CompleteScene& c) {
+  const Scene& s = c.scene;
   WorldParams3 p;
-  p.dt = time_step(s);
+  p.dt = c.dt;
   p.gravity = Vec3(s.gravity[0], s.gravity[1], s.gravity[2]);
   p.mu = s.mu;
   p.mu_wall = s.mu_w();
@@ -168,13 +48,13 @@ WorldParams3 world_params3(const Scene& s0) {
     p.mu_b = s.mu_b >= 0 ? s.mu_b : s.mu;
     p.mu_wall_b = s.mu_wall_b >= 0 ? s.mu_wall_b : (s.mu_wall < 0 ? p.mu_b : s.mu_wall);
   }
-  p.d_ref = mean_diameter(s);
+  p.d_ref = c.d_mean;
   p.alert = s.alert * p.d_ref;
   p.overlap_correction = s.overlap_correction;
   p.overlap_projection = s.overlap_projection;
-  p.adhesion = pull_off_force(s);  // contact.adhesion, or eta p d^2 with d = p.d_ref
+  p.adhesion = c.adhesion;  // contact.adhesion, or eta p d^2 with d = p.d_ref
   p.debond = s.debond * p.d_ref;
-  p.stiffness = contact_stiffness(s);
+  p.stiffness = c.stiffness;
   p.stiffness_ratio = s.stiffness_ratio;
   p.e_n = s.e_n;  // restitution by mean velocities (method.md section 14)
   p.e_t = s.e_t;
@@ -188,11 +68,10 @@ WorldParams3 world_params3(const Scene& s0) {
     p.periodic = {true, true, true};
     // At imposed pressure: L_y a dof (sigma_yy = p); isotropic, all three.
     // cell_mass is set by build_cell3, which knows the spheres' mass.
-    p.pressure = imposed_pressure(s);  // 0 under volume control: the lengths stay
+    p.pressure = c.pressure;  // 0 under volume control: the lengths stay
     if (p.pressure > 0) p.cell_dof = {s.isotropic, true, s.isotropic};
-    p.shear_rate = shear_rate(s);  // I sqrt(p/rho)/d
-    const double tp = pressure_time(s);
-    p.max_strain_rate = s.compaction_rate > 0 && tp > 0 ? s.compaction_rate / tp : 0.0;
+    p.shear_rate = c.shear_rate;  // I sqrt(p/rho)/d
+    p.max_strain_rate = s.compaction_rate > 0 && c.t_p > 0 ? s.compaction_rate / c.t_p : 0.0;
   }
   return p;
 }
@@ -206,7 +85,8 @@ namespace {
 // where the spheres see them) and has its mean flow a + g y (least squares)
 // replaced. Either way the shear starts from the linear profile
 // gamma-dot (y - L_y/2) e_x, without a start-up transient.
-void load_start3(const Scene& s, World3& w) {
+void load_start3(const CompleteScene& cs, World3& w) {
+  const Scene& s = cs.scene;
   try {
     load_checkpoint3(s.start, w);
   } catch (const CheckpointError& e) {
@@ -233,7 +113,7 @@ void load_start3(const Scene& s, World3& w) {
     c.le_offset = 0.0;
     c.rate = Vec3::Zero();
   }
-  if (imposed_pressure(s) <= 0) c.rate = Vec3::Zero();  // volume control: the lengths stay
+  if (cs.pressure <= 0) c.rate = Vec3::Zero();  // volume control: the lengths stay
   if (s.volume_fraction > 0) {
     double volume = 0;
     for (std::size_t i = 0; i < B.size(); ++i) volume += obs::sphere_volume(B.radius[i]);
@@ -321,13 +201,13 @@ void make_polyhedra3(const Scene& s, World3& w) {
 
 }  // namespace
 
-World3 build_cell3(const Scene& s0) {
-  WorldParams3 p = world_params3(s0);
-  const Scene s = with_auto_cell3(s0);
+World3 build_cell3(const CompleteScene& c) {
+  const Scene& s = c.scene;
+  WorldParams3 p = world_params3(c);
   if (!s.start.empty()) {
     p.cell = Vec3::Ones();  // a placeholder: the sample's cell replaces it
     World3 w(p);
-    load_start3(s, w);
+    load_start3(c, w);
     check_start_overlaps3(s, w);
     set_cell_mass3(s, w);
     return w;
@@ -337,8 +217,8 @@ World3 build_cell3(const Scene& s0) {
   // rule): sphere k at site (k mod nx, (k / nx) mod ny, k / (nx ny)), its
   // centre moved uniformly by up to the slack (pitch - d_k)/2 per axis, so
   // no two spheres touch, through the cell's faces either. At rest.
-  const std::vector<double> d = generated_diameters(s);
-  const double pitch = cell_pitch3(s);
+  const std::vector<double>& d = c.diameters;
+  const double pitch = c.pitch;
   const int nx = static_cast<int>(s.cell_width / pitch), ny = static_cast<int>(s.cell_height / pitch);
   std::mt19937_64 g(s.seed + 1);
   std::uniform_real_distribution<double> U(-1.0, 1.0);
@@ -355,13 +235,13 @@ World3 build_cell3(const Scene& s0) {
   return w;
 }
 
-World3 build_world3(const Scene& s0) {
-  if (s0.shear_mode == ShearMode::Periodic) return build_cell3(s0);
-  const Scene& s = s0;
-  const WorldParams3 p = world_params3(s);
-  const std::vector<double> d = generated_diameters(s);
-  const double r_max = 0.5 * diameter_bounds(s).second;
-  World3 w = lattice_pile3d(p, static_cast<int>(d.size()), r_max, s.density, s.seed,
+World3 build_world3(const CompleteScene& c) {
+  const Scene& s = c.scene;
+  if (s.dimension != 3) throw SceneError(fmt::format("dimension = {}: not a 3D scene", s.dimension));
+  if (s.shear_mode == ShearMode::Periodic) return build_cell3(c);
+  const WorldParams3 p = world_params3(c);
+  const std::vector<double>& d = c.diameters;
+  World3 w = lattice_pile3d(p, static_cast<int>(d.size()), 0.5 * c.d_max, s.density, s.seed,
                             [&](std::mt19937_64&, int m) { return 0.5 * d[m]; }, s.box_width, s.box_depth);
   make_polyhedra3(s, w);
   return w;

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "cd/src/scene/derived.hpp"  // grain_area
+
 namespace cd::obs {
 
 template <int D>
@@ -144,10 +146,7 @@ Coordination coordination(std::span<const Link> links, std::span<const std::int3
   return r;
 }
 
-double particle_area(double r, int nsides) {
-  return nsides > 0 ? 0.5 * nsides * r * r * std::sin(2 * std::numbers::pi / nsides)
-                    : std::numbers::pi * r * r;
-}
+double particle_area(double r, int nsides) { return grain_area(r, nsides); }
 
 double sphere_volume(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }
 

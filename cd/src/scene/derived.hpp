@@ -6,7 +6,9 @@
 // run plan (core/run_plan.hpp) read them from here, so that a 2D and a 3D
 // scene with the same keys mean the same thing.
 #pragma once
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <random>
 #include <stdexcept>
 #include <utility>
@@ -26,6 +28,19 @@ struct SceneError : std::runtime_error {
 // unlike std::uniform_real_distribution (the size law's draws, and 2D's
 // placement).
 inline double uniform01(std::mt19937_64& g) { return static_cast<double>(g() >> 11) * 0x1.0p-53; }
+
+// Area of a disk (nsides = 0) or of a regular polygon of circumradius r
+// (the grains' area the automatic walls cell is sized from, and
+// obs::particle_area's).
+inline double grain_area(double r, int nsides = 0) {
+  return nsides > 0 ? 0.5 * nsides * r * r * std::sin(2 * std::numbers::pi / nsides) : std::numbers::pi * r * r;
+}
+
+// n = ceil(N^(1/3)): the side of the smallest cube of lattice sites holding
+// N (3D's placements, in a periodic cell and in the pile's box).
+inline int lattice_side3(int n_spheres) {
+  return static_cast<int>(std::ceil(std::cbrt(static_cast<double>(n_spheres)) - 1e-9));
+}
 
 // Mean diameter of the scene's particles (number mean), known before placement.
 double mean_diameter(const Scene& s);
