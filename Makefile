@@ -117,7 +117,7 @@ help:
 	$(call help_var,INERTIAL_I,the inertial numbers of campaign-inertial[-ladder])
 	$(call help_var,COHESIVE_ETA,cohesion numbers of campaign-cohesive)
 	$(call help_var,COHESIVE_I,its inertial numbers)
-	$(call help_var,COHESIVE_TOL,its solver.tol)
+	$(call help_var,COHESIVE_TOL,its solver.tol (empty: configs/shear-cohesive.toml's))
 	$(call help_var,ANGULAR_NS,polygon sides of campaign-angularity (0: disks))
 	$(call help_var,ANGULAR_I,its inertial number)
 	$(call help_var,VALIDATE,make validate-angularity's folder)
@@ -329,9 +329,12 @@ SHEAR_SCENE := configs/shear$(if $(dim3),3)-inertial.toml
 INERTIAL_I ?= 0.001 0.003 0.01 0.03 0.1 0.3
 COHESIVE_ETA ?= 0 1 10 100
 COHESIVE_I ?= 0.01 0.1
-# Cohesive networks converge slowly: at eta = 10, 1e-4 hit the sweep cap on
-# every step (configs/shear-cohesive.toml); the eta = 0 references use it too.
-COHESIVE_TOL ?= 1e-3
+# Cohesive networks converge slowly: the cohesive runs (and their eta = 0
+# references) take the solver.tol of configs/shear-cohesive.toml, where its
+# measurement is, as cdsim reads it; COHESIVE_TOL=x overrides it.
+COHESIVE_TOL ?=
+cohesive_tol = $(or $(COHESIVE_TOL),$(shell $(BUILD)/cd/cdsim configs/shear-cohesive.toml --print-scene \
+  | awk '$$1 == "tol" { print $$3; exit }'))
 ANGULAR_NS ?= 0 3 4 5 6 8 10 20 60
 ANGULAR_I ?= 0.01
 # Threads of each cdsim run: `make -jJ` runs J at once, so each gets nproc/J
@@ -554,7 +557,7 @@ $(CAMPAIGNS)/volume/phi_%/.done: $(CAMPAIGNS)/prep/ns_0/.done | $(CAMPAIGNS)/vol
 # eta_<eta>_I_<I>: f_a = eta p d (3D: eta p d^2); eta = 0 are the reference runs of the fit.
 $(CAMPAIGNS)/cohesive/eta_%/.done: $(CAMPAIGNS)/prep/ns_0/.done | $(CAMPAIGNS)/cohesive/.manifest-check
 	$(call shear_run,$(lastword $(subst _I_, ,$*)),0) --set contact.cohesion_number=$(firstword $(subst _I_, ,$*)) \
-	  --set solver.tol=$(COHESIVE_TOL)
+	  --set solver.tol=$(cohesive_tol)
 	touch $@
 
 $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done | $(CAMPAIGNS)/angularity/.manifest-check
