@@ -59,6 +59,10 @@ double boundary_approach(const Bodies& b, double alert) {
   return 4.0 * s;
 }
 
+// ---- no cell ------------------------------------------------------------
+
+void NoBoundary::detect(World& w) const { w.detect_through(nullptr); }
+
 // ---- Lees-Edwards cell --------------------------------------------------
 
 void LeesEdwardsCell::configure(World& w) const {
@@ -79,18 +83,9 @@ Vec2 LeesEdwardsCell::image_velocity(const World& w, const ContactInfo& f) const
   return {f.iy * w.prm_.cell.shear_rate * w.cm_.height + f.ix * w.cell.wdot, f.iy * w.cell.hdot};
 }
 
-void LeesEdwardsCell::build(World& w) const {
-  // The image of body 2 across the top moves at (gamma-dot H, dH/dt)
-  // relative to body 2, across a side at (dW/dt, 0).
-  for (std::size_t k = 0; k < w.prob_.rows.size(); ++k) {
-    const ContactInfo& f = w.info_[k];
-    if (f.ix == 0 && f.iy == 0) continue;
-    ContactRow& r = w.prob_.rows[k];
-    const Vec2 v = image_velocity(w, f);
-    r.bn += r.nx * v.x() + r.ny * v.y();
-    r.bt += -r.ny * v.x() + r.nx * v.y();
-  }
-}
+void LeesEdwardsCell::detect(World& w) const { w.detect_through(&w.pc_); }
+
+double LeesEdwardsCell::shear_rate(const World& w) const { return w.prm_.cell.shear_rate; }
 
 void LeesEdwardsCell::set_dofs(World& w) const {
   // One dof per controlled length: its velocity at the start of the step
@@ -230,6 +225,10 @@ void WallShear::begin_step(World& w) const {
 void WallShear::predict(World& w, double h) const {
   midpoint_cell(w.cm_, w.pc_, w.cell, h);
 }
+
+void WallShear::detect(World& w) const { w.detect_through(&w.pc_); }
+
+double WallShear::shear_rate(const World& w) const { return w.prm_.cell.shear_rate; }
 
 void WallShear::set_dofs(World& w) const {
   // The top wall's height: its velocity at the start of the step is in the

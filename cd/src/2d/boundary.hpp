@@ -10,7 +10,22 @@
 //   WallShear        periodic in x; grains glued to the bottom wall (fixed)
 //                    and to the top wall, which moves at gamma-dot x gap and
 //                    whose height is a dof at the imposed pressure.
-// Each hook is called by one stage of World::step (world.cpp), named after it.
+// The hooks, the same as 3D's (3d/boundary3.hpp), each called by the stage
+// of World::step named after it:
+//   configure         once, when the world's parameters are set
+//   begin_step        before the stages (a boundary's own imposed motion)
+//   predict, detect   the midpoint cell; detection through its images
+//   image_velocity    the velocity of the image of body 2 that contact f
+//                     touches, relative to body 2 (build: into the row's
+//                     offsets, with restitution into u-); asked only for a
+//                     contact through an image, and only of a boundary
+//                     with `moving_images`
+//   set_dofs, take_dofs   the boundary's dofs into the problem (solve), and
+//                     their solved velocities back
+//   integrate         the cell at the step's end
+//   pseudo_dofs, apply_pseudo_dofs   the dofs in the overlap projection
+//                     (unloaded, from rest) and their pseudo-displacement
+//   shear_rate        the protocol's shear rate (0 without one)
 #pragma once
 #include <variant>
 #include <vector>
@@ -31,7 +46,7 @@ class World;
 // without polygons.
 double boundary_approach(const Bodies& b, double alert);
 
-// `cell`: the protocol has a cell (a shear rate, a volume, a kinetic stress).
+// `cell`: the protocol has a cell (a volume, a kinetic stress).
 // `moving_images`: periodic images move relative to the bodies (their
 // velocity enters the rows that touch them).
 struct NoBoundary {
@@ -39,14 +54,14 @@ struct NoBoundary {
   void configure(World&) const {}
   void begin_step(World&) const {}
   void predict(World&, double /*h*/) const {}
-  bool images() const { return false; }
-  void build(World&) const {}
+  void detect(World& w) const;
   Vec2 image_velocity(const World&, const ContactInfo&) const { return Vec2::Zero(); }
   void set_dofs(World&) const {}
   void take_dofs(World&) const {}
   void integrate(World&, double /*h*/) const {}
   void pseudo_dofs(std::vector<BoundaryDof>& d) const { d.clear(); }
   void apply_pseudo_dofs(World&, const std::vector<BoundaryDof>&, double) const {}
+  double shear_rate(const World&) const { return 0.0; }
 };
 
 struct LeesEdwardsCell {
@@ -54,12 +69,11 @@ struct LeesEdwardsCell {
   void configure(World& w) const;
   void begin_step(World&) const {}
   void predict(World& w, double h) const;
-  bool images() const { return true; }
-  // The images' velocity into the offsets of the rows that touch them.
-  void build(World& w) const;
+  // Through the images at the midpoint offset.
+  void detect(World& w) const;
   // Velocity of the image of body 2 that a contact touches, relative to
   // body 2 ((gamma-dot H, dH/dt) per cell up, (dW/dt, 0) per cell right), at
-  // the step's start: in the offsets (build) and in u- (restitution).
+  // the step's start.
   Vec2 image_velocity(const World& w, const ContactInfo& f) const;
   void set_dofs(World& w) const;
   void take_dofs(World& w) const;
@@ -69,6 +83,7 @@ struct LeesEdwardsCell {
   // go into the midpoint cell.
   void pseudo_dofs(std::vector<BoundaryDof>& d) const;
   void apply_pseudo_dofs(World& w, const std::vector<BoundaryDof>& d, double dt) const;
+  double shear_rate(const World& w) const;
 };
 
 struct WallShear {
@@ -77,8 +92,8 @@ struct WallShear {
   // The shear rate, not the wall speed, is imposed: V = gamma-dot x gap.
   void begin_step(World& w) const;
   void predict(World& w, double h) const;
-  bool images() const { return true; }
-  void build(World&) const {}
+  // Through the images across x (the walls' grains are bodies).
+  void detect(World& w) const;
   Vec2 image_velocity(const World&, const ContactInfo&) const { return Vec2::Zero(); }
   void set_dofs(World& w) const;
   void take_dofs(World& w) const;
@@ -86,6 +101,7 @@ struct WallShear {
   // Overlap projection: the top wall is held (no dof).
   void pseudo_dofs(std::vector<BoundaryDof>& d) const { d.clear(); }
   void apply_pseudo_dofs(World&, const std::vector<BoundaryDof>&, double) const {}
+  double shear_rate(const World& w) const;
 };
 
 using Boundary = std::variant<NoBoundary, LeesEdwardsCell, WallShear>;

@@ -81,8 +81,11 @@ void World::predict() {
 }
 
 void World::detect_stage() {
-  const bool images = std::visit([](const auto& b) { return b.images(); }, boundary_);
-  detect(bodies, xm_, thm_, alert_, grid_, prob_.rows, info_, images ? &pc_ : nullptr);
+  std::visit([&](const auto& b) { b.detect(*this); }, boundary_);
+}
+
+void World::detect_through(const PeriodicCell* c) {
+  detect(bodies, xm_, thm_, alert_, grid_, prob_.rows, info_, c);
 }
 
 void World::build() {
@@ -104,7 +107,7 @@ void World::build() {
     r.bn = gap > 0.0 ? gap / dt : prm_.overlap_correction * gap / dt;
     r.bt = 0.0;
   }
-  std::visit([&](const auto& b) { b.build(*this); }, boundary_);
+  std::visit([&](const auto& b) { image_offsets(b); }, boundary_);
   if (adhesion_on_) {
     const double a = prm_.adhesion * dt;
     for (std::size_t k = 0; k < nr; ++k) prob_.rows[k].adh = info_[k].gap <= prm_.debond ? a : 0.0;
@@ -116,6 +119,22 @@ void World::build() {
     if (const auto* p = warm_.find(info_[k].key)) {
       prob_.rows[k].pn = p->first;
       prob_.rows[k].pt = p->second;
+    }
+  }
+}
+
+// The image of body 2 across the top moves at (gamma-dot H, dH/dt) relative
+// to body 2, across a side at (dW/dt, 0) (the boundary's image_velocity).
+template <class B>
+void World::image_offsets([[maybe_unused]] const B& b) {
+  if constexpr (B::moving_images) {
+    for (std::size_t k = 0; k < prob_.rows.size(); ++k) {
+      const ContactInfo& f = info_[k];
+      if (f.ix == 0 && f.iy == 0) continue;
+      ContactRow& r = prob_.rows[k];
+      const Vec2 v = b.image_velocity(*this, f);
+      r.bn += r.nx * v.x() + r.ny * v.y();
+      r.bt += -r.ny * v.x() + r.nx * v.y();
     }
   }
 }
@@ -309,9 +328,7 @@ void World::couple_dof(BoundaryDof& d, std::size_t k, double an, double at, doub
 }
 
 double World::shear_rate() const {
-  return std::visit([&](const auto& b) { return std::decay_t<decltype(b)>::cell; }, boundary_)
-             ? prm_.cell.shear_rate
-             : 0.0;
+  return std::visit([&](const auto& b) { return b.shear_rate(*this); }, boundary_);
 }
 
 Eigen::Matrix2d World::kinetic_stress() const {

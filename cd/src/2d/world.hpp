@@ -146,6 +146,7 @@ class World : public WorldShell<Bodies, ContactProblem, ContactInfo, std::pair<d
   ContactStatus status(std::size_t k) const;
 
  private:
+  friend struct NoBoundary;
   friend struct LeesEdwardsCell;
   friend struct WallShear;
   void configure();
@@ -158,6 +159,11 @@ class World : public WorldShell<Bodies, ContactProblem, ContactInfo, std::pair<d
   void integrate();
   void observe();
   void external();
+  // Detection at the midpoint, through the periodic cell c (null: none).
+  void detect_through(const PeriodicCell* c);
+  // The images' velocity into the offsets of the rows that touch them.
+  template <class B>
+  void image_offsets(const B& b);
   template <class B>
   void restitution_offsets(const B& b);
   // A boundary dof of mass cell.mass loaded by `load` (imposed stress x
@@ -174,7 +180,7 @@ class World : public WorldShell<Bodies, ContactProblem, ContactInfo, std::pair<d
   Boundary boundary_;
   bool gravity_on_ = false, restitution_on_ = false, adhesion_on_ = false;
   CellState cm_;           // cell at the midpoint configuration
-  PeriodicCell pc_;        // its periodic view for detection (boundary_.images())
+  PeriodicCell pc_;        // its periodic view for detection (the boundary's detect)
   std::vector<std::uint8_t> on_top_;  // WallShear: body is glued to the top wall
   bool forces_on_ = false, prepared_ = false;  // forces_on_: some body has an applied force
   double alert_ = 0.0;

@@ -37,7 +37,7 @@ struct World3::Projection {
     q.inv_inertia = w.prob_.inv_inertia;
     for (BodyVel3& v : q.vel) v.v = v.w = Vec3::Zero();
     q.dofs = w.prob_.dofs;
-    for (CellDof3& d : q.dofs) d.v0 = d.v = 0.0;
+    std::visit([&](const auto& b) { b.pseudo_dofs(q.dofs); }, w.boundary_);
   }
   void set_offset(std::size_t k, double bn) {
     SphereRow& r = q.rows[k];
@@ -62,7 +62,7 @@ struct World3::Projection {
     if (w.poly_)
       for (std::size_t i = 0; i < w.bodies.size(); ++i)
         if (w.bodies.shape[i] == Shape3::Polyhedron) w.qm_[i] = rotate_orientation(w.qm_[i], q.vel[i].w, dt);
-    for (const CellDof3& d : q.dofs) w.cm_[d.axis] += dt * d.v;
+    std::visit([&](const auto& b) { b.apply_pseudo_dofs(w, q.dofs, dt); }, w.boundary_);
   }
 };
 

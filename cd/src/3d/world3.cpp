@@ -77,6 +77,7 @@ void World3::configure() {
   // k_t = k: 0, the tangential springs take the normal compliance.
   prob_.compliance_t =
       prm_.stiffness > 0.0 && prm_.stiffness_ratio != 1.0 ? prob_.compliance / prm_.stiffness_ratio : 0.0;
+  std::visit([&](const auto& b) { b.configure(*this); }, boundary_);
 }
 
 PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const {
@@ -98,6 +99,7 @@ void World3::step() {
       {Stage::Integrate, &World3::integrate},
       {Stage::Observe, &World3::observe},
   }};
+  std::visit([&](const auto& b) { b.begin_step(*this); }, boundary_);
   run_stages(*this, kTable, times);
   count_step(prm_.dt);
 }
@@ -198,9 +200,8 @@ void World3::build_rows([[maybe_unused]] const B& b) {
     Vec3 vimg = Vec3::Zero();
     if constexpr (B::moving_images) {
       const ContactInfo3& f = info_[k];
-      if (b.image_moves(f, dofs_on_)) {
-        const Vec3& L = cell_.rate;
-        vimg = Vec3(f.iy * le_velocity_ + f.ix * L.x(), f.iy * L.y(), f.iz * L.z());
+      if (f.ix != 0 || f.iy != 0 || f.iz != 0) {
+        vimg = b.image_velocity(*this, f);
         r.bn += r.n.dot(vimg);
         if (x) {
           x->bt1 = r.t1.dot(vimg);
@@ -231,7 +232,7 @@ void World3::solve() {
   // The kinetic stress the imposed one balances, from the velocities at
   // the step's start (before gravity and the warm start).
   last_.floor_held = false;
-  if (dofs_on_) set_dofs(kinetic_stress());
+  std::visit([&](const auto& b) { b.set_dofs(*this); }, boundary_);
   if (gravity_on_) {
     const Vec3 dv = prm_.dt * prm_.gravity;
     for (std::size_t i = 0; i < bodies.size(); ++i)
@@ -241,7 +242,7 @@ void World3::solve() {
   // Warm-start impulses into the velocities (sequential: bodies are shared).
   apply_impulses(prob_.rows, V, prob_.inv_inertia);
   solve_problem(prm_.solver, [](ContactProblem3& p, const SolverParams& s) { return nlgs_solve3(p, s); });
-  for (const CellDof3& d : prob_.dofs) cell_.rate[d.axis] = d.v;
+  std::visit([&](const auto& b) { b.take_dofs(*this); }, boundary_);
   if (prm_.overlap_projection > 0.0) project_overlaps();
   // The impulses, in the world frame, for the next step's warm start.
   if (poly_) keep_polyhedra_memory3(prob_.rows, info_, poly_axes_, poly_memory_);

@@ -204,6 +204,7 @@ class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
 
  private:
   friend struct NoBoundary3;
+  friend struct CellDofs3;
   friend struct Cell3;
   friend struct LeesEdwardsCell3;
   void configure();
