@@ -405,6 +405,12 @@ std::vector<Mutant> mutants(const std::string& good) {
       }
     }
     const std::string base = a.name.substr(a.name.rfind('.') == 2 ? 3 : 0);  // without "3d."
+    if (base == "radius") {  // every grain grown: values the rules pass, overlaps the file did not record
+      b = good;
+      for (std::uint64_t e = 0; e < a.count; ++e)
+        put_at<double>(b, a.data + e * a.size, 1.5 * get_at<double>(good, a.data + e * a.size));
+      add(a.name + ": every radius x 1.5", b, a.name.substr(0, a.name.size() - base.size()) + "overlap");
+    }
     for (const std::uint64_t e : {std::uint64_t(0), a.count - 1}) {
       const std::size_t at = a.data + e * a.size;
       const std::string el = a.name + "[" + std::to_string(e) + "]";

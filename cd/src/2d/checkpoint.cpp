@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "detect.hpp"
 #include "output.hpp"
 #include "world_checkpoint.hpp"
 
@@ -122,12 +123,24 @@ void check_cell(const ckpt::Reader& in, const CellState& c, const Bodies& b, con
 
 constexpr ckpt::WorldFile kFile{2, "warm.keys", "warm.p"};
 
+// The largest overlap of bodies b in cell c (its periodic view as the
+// world's: both axes for the Lees-Edwards cell, x between walls).
+Overlap overlap_of(const Bodies& b, const CellState& c, const WorldParams& p) {
+  const CellParams::Mode mode = p.cell.mode;
+  const PeriodicCell pc{mode != CellParams::Mode::None, mode == CellParams::Mode::LeesEdwards, c.width, c.height,
+                        c.offset};
+  return largest_overlap(b, mode == CellParams::Mode::None ? nullptr : &pc);
+}
+
 }  // namespace
 
 void save_checkpoint(const std::string& path, const World& w, std::uint64_t scene_key,
                      const RunTotals& totals) {
   ckpt::save_world(path, w, kFile, kBodiesArrays, scene_key, totals,
-                   [&](ckpt::Writer& o) { o.array("cell", std::vector<CellState>{w.cell}); });
+                   [&](ckpt::Writer& o) {
+                     o.array("cell", std::vector<CellState>{w.cell});
+                     o.array("overlap", std::vector<double>{overlap_of(w.bodies, w.cell, w.params()).depth});
+                   });
 }
 
 std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* totals) {
@@ -138,6 +151,13 @@ std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* tota
         in.array("cell", cell);
         if (cell.size() != 1) in.fail(fmt::format("is corrupt: 'cell' holds {} elements (must be 1)", cell.size()));
         check_cell(in, cell[0], b, w.params());
+        ckpt::check_overlap(in, "overlap", w.params().d_ref, [&] {
+          try {
+            return overlap_of(b, cell[0], w.params());
+          } catch (const std::exception& e) {
+            in.fail(fmt::format("is corrupt: its bodies cannot be detected in its cell ({})", e.what()));
+          }
+        });
         return cell[0];
       },
       [](World& w, const CellState& c) { w.cell = c; });

@@ -459,4 +459,15 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
   }
 }
 
+Overlap largest_overlap(const Bodies& bodies, const PeriodicCell* cell) {
+  CellGrid grid;
+  std::vector<ContactRow> rows;
+  std::vector<ContactInfo> info;
+  detect(bodies, bodies.pos, bodies.angle, 0.0, grid, rows, info, cell);
+  Overlap o;
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    if (-info[k].gap > o.depth) o = {-info[k].gap, rows[k].b1, rows[k].b2};
+  return o;
+}
+
 }  // namespace cd

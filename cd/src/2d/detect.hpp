@@ -34,6 +34,15 @@ void detect(const Bodies& bodies, const std::vector<Vec2>& x, const std::vector<
             double alert, CellGrid& grid, std::vector<ContactRow>& rows,
             std::vector<ContactInfo>& info, const PeriodicCell* cell = nullptr);
 
+// The largest overlap among the bodies at their positions and angles (depth
+// 0 if none) and a pair that has it, through the periodic cell if given:
+// a state's consistency (a checkpoint's against the depth it recorded).
+struct Overlap {
+  double depth = 0.0;
+  std::int32_t b1 = -1, b2 = -1;
+};
+Overlap largest_overlap(const Bodies& bodies, const PeriodicCell* cell);
+
 // Narrow phase of one disk pair (i < j), frame from i to j. Returns false if
 // the gap exceeds alert.
 bool disk_disk(int i, int j, const Vec2& xi, const Vec2& xj, double ri, double rj, double alert,

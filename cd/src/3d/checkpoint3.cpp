@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <utility>
 
+#include "detect3.hpp"
 #include "world_checkpoint.hpp"
 
 namespace cd {
@@ -252,6 +253,17 @@ void check_cell3(const ckpt::Reader& in, const CellState3& c, const Bodies3& b, 
 
 constexpr ckpt::WorldFile kFile{3, "3d.warm.keys", "3d.warm.p"};
 
+// The largest overlap of spheres and planes b in cell c (polyhedra: none
+// recorded, their bounding spheres are not their shapes).
+Overlap3 overlap_of3(const Bodies3& b, const CellState3& c, const WorldParams3& p) {
+  PeriodicCell3 cell;
+  cell.origin = p.cell_origin;
+  cell.size = c.size;
+  cell.periodic = p.periodic;
+  cell.le_offset = c.le_offset;
+  return largest_overlap3(b, cell, p.solver.min_parallel);
+}
+
 }  // namespace
 
 void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t scene_key,
@@ -263,6 +275,8 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
                                            double(p.periodic[1]), double(p.periodic[2]), c.rate.x(), c.rate.y(),
                                            c.rate.z(), c.strain});
     write_poly3(o, w);
+    if (!w.bodies.has_polyhedra())
+      o.array("3d.overlap", std::vector<double>{overlap_of3(w.bodies, c, p).depth});
   });
 }
 
@@ -296,7 +310,15 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
         } catch (const std::invalid_argument& e) {
           in.fail(fmt::format("is corrupt: '3d.cell' holds a cell this scene cannot take ({})", e.what()));
         }
-        return std::pair{c, read_poly3(in, b, lib)};
+        PolyState3 poly = read_poly3(in, b, lib);
+        ckpt::check_overlap(in, "3d.overlap", p.d_ref, [&] {
+          try {
+            return overlap_of3(b, c, p);
+          } catch (const std::exception& e) {
+            in.fail(fmt::format("is corrupt: its bodies cannot be detected in its cell ({})", e.what()));
+          }
+        });
+        return std::pair{c, std::move(poly)};
       },
       [&](World3& w, const std::pair<CellState3, PolyState3>& own) {
         apply_poly3(w, own.second, std::move(lib));

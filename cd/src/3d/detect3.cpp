@@ -330,4 +330,16 @@ void detect3(const Bodies3& bodies, const std::vector<Vec3>& x, double alert, co
   plane_rows(bodies, x, alert, g.others, g.members, rows, info);
 }
 
+Overlap3 largest_overlap3(const Bodies3& bodies, const PeriodicCell3& cell, int min_parallel) {
+  CellGrid3 grid;
+  std::vector<SphereRow> rows;
+  std::vector<ContactInfo3> info;
+  if (cell.any()) detect3(bodies, bodies.pos, 0.0, cell, grid, rows, info, min_parallel);
+  else detect3(bodies, bodies.pos, 0.0, grid, rows, info, min_parallel);
+  Overlap3 o;
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    if (-info[k].gap > o.depth) o = {-info[k].gap, rows[k].b1, rows[k].b2};
+  return o;
+}
+
 }  // namespace cd

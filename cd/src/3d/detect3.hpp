@@ -53,6 +53,17 @@ void detect3(const Bodies3& bodies, const std::vector<Vec3>& x, double alert, co
              CellGrid3& grid, std::vector<SphereRow>& rows, std::vector<ContactInfo3>& info,
              int min_parallel);
 
+// The largest overlap among the spheres and planes at their positions (depth
+// 0 if none) and a pair that has it, through the periodic cell (if
+// cell.any()): a state's consistency (a checkpoint's against the depth it
+// recorded). Polyhedra are taken as their bounding spheres: for sphere
+// worlds only.
+struct Overlap3 {
+  double depth = 0.0;
+  std::int32_t b1 = -1, b2 = -1;
+};
+Overlap3 largest_overlap3(const Bodies3& bodies, const PeriodicCell3& cell, int min_parallel);
+
 // Narrow phase: spheres i, j (frame from i to j). False if the gap exceeds alert.
 bool sphere_sphere(int i, int j, const Vec3& xi, const Vec3& xj, double ri, double rj,
                    double alert, SphereRow& row, ContactInfo3& info);

@@ -144,24 +144,21 @@ void check_start_overlaps3(const Scene& s, const World3& w) {
   cell.size = c.size;
   cell.periodic = {true, true, true};
   cell.le_offset = c.le_offset;
-  CellGrid3 grid;
-  std::vector<SphereRow> rows;
-  std::vector<ContactInfo3> info;
+  Overlap3 o;
   try {
-    detect3(w.bodies, w.bodies.pos, 0.0, cell, grid, rows, info, w.params().solver.min_parallel);
+    o = largest_overlap3(w.bodies, cell, w.params().solver.min_parallel);
   } catch (const std::exception& e) {
     throw SceneError(fmt::format("shear.start: '{}': {}", s.start, e.what()));
   }
   const double d = w.params().d_ref;
-  for (std::size_t k = 0; k < rows.size(); ++k)
-    if (info[k].gap < -kStartOverlap * d)
-      throw SceneError(fmt::format("shear.start: spheres {} and {} of '{}' overlap by {:.3g} mean diameters{}; a "
-                                   "started sample may overlap by at most {}",
-                                   rows[k].b1, rows[k].b2, s.start, -info[k].gap / d,
-                                   s.volume_fraction > 0
-                                       ? fmt::format(" once scaled to shear.volume_fraction = {}", s.volume_fraction)
-                                       : std::string(),
-                                   kStartOverlap));
+  if (o.depth > kStartOverlap * d)
+    throw SceneError(fmt::format("shear.start: spheres {} and {} of '{}' overlap by {:.3g} mean diameters{}; a "
+                                 "started sample may overlap by at most {}",
+                                 o.b1, o.b2, s.start, o.depth / d,
+                                 s.volume_fraction > 0
+                                     ? fmt::format(" once scaled to shear.volume_fraction = {}", s.volume_fraction)
+                                     : std::string(),
+                                 kStartOverlap));
 }
 
 }  // namespace

@@ -4,11 +4,15 @@
 // engine's table, the warm-start memory, then the engine's own arrays (its
 // cell's state). A world is changed only if the whole file is valid.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
 #include <type_traits>
 #include <utility>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "checkpoint_io.hpp"
 
@@ -68,6 +72,28 @@ std::uint64_t load_world(const std::string& path, World& w, const WorldFile& f, 
   apply_own(w, std::move(own));
   if (totals) *totals = tot;
   return h.key;
+}
+
+// The largest overlap of the state when it was written (array `name`: one
+// depth in m, written by write_overlap) against the one its bodies have as
+// read, measure() (a struct with depth, b1, b2): a grain moved or resized
+// since (damage the checksum does not see and the value rules pass)
+// changes it, and is refused naming the pair. The depth is a function of
+// the positions alone, so the two agree to round-off; 1e-9 d_ref leaves
+// room for nothing else. A file without the array (an older build's, or a
+// state the engine does not measure) is not checked.
+template <class Measure>
+void check_overlap(Reader& in, std::string_view name, double d_ref, Measure&& measure) {
+  if (in.next_name(name) != name) return;
+  std::vector<double> rec;
+  in.array(name, rec);
+  if (rec.size() != 1) in.fail(fmt::format("is corrupt: '{}' holds {} numbers (must be 1)", name, rec.size()));
+  in.non_negative(name, 0, "", rec[0]);
+  const auto now = measure();
+  if (!(std::abs(now.depth - rec[0]) <= 1e-9 * d_ref))
+    in.fail(fmt::format("is corrupt: its bodies overlap by {:.6g} m at most (bodies {} and {}), but '{}' recorded "
+                        "{:.6g} m when it was written: a position or a size was changed since",
+                        now.depth, now.b1, now.b2, name, rec[0]));
 }
 
 }  // namespace cd::ckpt
