@@ -11,9 +11,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <set>
 
 #include <omp.h>
 
@@ -511,6 +513,73 @@ TEST(Polyhedra3, SceneMakesTheSolidsOfItsSizes) {
     EXPECT_NEAR(w.bodies.orient[i].norm(), 1.0, 1e-15);
   }
   EXPECT_EQ(cubes, 64);
+}
+
+// Cuboids of sides in the ratios particles.aspect (1 : 2 : 3) and
+// irregular grains (the hull of particles.vertices points on an ellipsoid),
+// each of the circumscribed radius of the sphere it replaces: the cuboid's
+// side s from its half-diagonal s sqrt(14) / 2 = r, its mass and principal
+// moments those of a (s, 2s, 3s) box, m (b^2 + c^2) / 12 and cyclic;
+// irregular grains each a shape of their own, of at most that many
+// vertices. Keys that cannot act on a shape are refused by name.
+TEST(Polyhedra3, SceneMakesCuboidsAndIrregularGrains) {
+  Scene s = small_polyhedra_pile(Shape3d::Cuboid);
+  s.aspect = {1.0, 2.0, 3.0};
+  const World3 w = build_world3(s);
+  const World3 spheres = build_world3(small_polyhedra_pile(Shape3d::Sphere));
+  ASSERT_EQ(w.bodies.size(), spheres.bodies.size());
+  int grains = 0;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    if (w.bodies.shape[i] == Shape3::Plane) continue;
+    ++grains;
+    const double r = spheres.bodies.radius[i], side = 2 * r / std::sqrt(14.0), m = w.bodies.mass[i];
+    EXPECT_NEAR(w.bodies.polyhedron(i).circumradius(), r, 1e-14 * r);
+    EXPECT_NEAR(m, 2600.0 * 6 * side * side * side, 1e-12 * m);
+    std::array<double, 3> got{w.bodies.moments[i].x(), w.bodies.moments[i].y(), w.bodies.moments[i].z()};
+    std::array<double, 3> box{m * 13 * side * side / 12, m * 10 * side * side / 12, m * 5 * side * side / 12};
+    std::sort(got.begin(), got.end());
+    std::sort(box.begin(), box.end());
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], box[c], 1e-12 * box[c]);
+  }
+  EXPECT_EQ(grains, 64);
+
+  s.shape = Shape3d::Irregular;
+  s.aspect = {1.0, 1.0, 2.0};
+  s.vertices = 10;
+  World3 irr = build_world3(s);
+  std::set<std::vector<double>> distinct;
+  for (std::size_t i = 0; i < irr.bodies.size(); ++i) {
+    if (irr.bodies.shape[i] == Shape3::Plane) continue;
+    const ConvexPolyhedron& p = irr.bodies.polyhedron(i);
+    EXPECT_NEAR(p.circumradius(), spheres.bodies.radius[i], 1e-14 * spheres.bodies.radius[i]);
+    EXPECT_GE(p.vertices().size(), 4u);
+    EXPECT_LE(p.vertices().size(), 10u);
+    EXPECT_NEAR(irr.bodies.mass[i], 2600.0 * p.volume(), 1e-12 * irr.bodies.mass[i]);
+    std::vector<double> v;
+    for (const Vec3& x : p.vertices()) v.insert(v.end(), {x.x(), x.y(), x.z()});
+    distinct.insert(v);
+  }
+  EXPECT_EQ(distinct.size(), 64u);
+  for (int k = 0; k < 30; ++k) irr.step();
+  EXPECT_GT(irr.last().contacts, 0);
+
+  const auto refused = [](Scene t, const std::string& key) {
+    try {
+      build_world3(t);
+      ADD_FAILURE() << key << " was not refused";
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
+  Scene t = small_polyhedra_pile(Shape3d::Cube);
+  t.aspect = {1.0, 2.0, 3.0};
+  refused(t, "particles.aspect");
+  t = small_polyhedra_pile(Shape3d::Cuboid);
+  t.vertices = 20;
+  refused(t, "particles.vertices");
+  t.vertices = 12;
+  t.aspect = {1.0, 1.0, 200.0};
+  refused(t, "particles.aspect");
 }
 
 // A run of polyhedra resumes from its checkpoint bit for bit: 60 steps, a

@@ -165,15 +165,30 @@ void check_start_overlaps3(const Scene& s, const World3& w) {
 
 namespace {
 
-// A polyhedra scene (particles.shape): each generated sphere becomes the
-// scene's Platonic solid of the same circumscribed radius, centred where
-// the sphere was (so the placement's no-overlap rules hold), at a uniformly
+// A polyhedra scene (particles.shape): each generated sphere becomes a
+// convex polyhedron of the same circumscribed radius, centred where the
+// sphere was (so the placement's no-overlap rules hold), at a uniformly
 // random orientation (Shoemake's three uniforms, from a stream of its own
 // seeded by particles.seed: the placement draws stay those of spheres).
-// One shape per distinct size. Bodies keep their order and velocities.
+// A Platonic solid or a cuboid (sides in the ratios particles.aspect): one
+// shape per distinct size; an irregular grain: a shape of its own, the hull
+// of particles.vertices points on the ellipsoid of semi-axes in those
+// ratios, seeded by particles.seed and the grain's index. Bodies keep their
+// order and velocities.
+ConvexPolyhedron grain_shape(const Scene& s, double r, std::size_t grain) {
+  const Vec3 a(s.aspect[0], s.aspect[1], s.aspect[2]);
+  switch (s.shape) {
+    case Shape3d::Cuboid:
+      return cuboid(a.x(), a.y(), a.z()).scaled_to_circumradius(r);
+    case Shape3d::Irregular:
+      return random_polyhedron(s.vertices, a, s.seed * 0x9e3779b97f4a7c15ull + grain).scaled_to_circumradius(r);
+    default:
+      return platonic(static_cast<Platonic>(static_cast<int>(s.shape) - 1), r);
+  }
+}
+
 void make_polyhedra3(const Scene& s, World3& w) {
   if (s.shape == Shape3d::Sphere) return;
-  const Platonic kind = static_cast<Platonic>(static_cast<int>(s.shape) - 1);
   const Bodies3& B = w.bodies;
   Bodies3 out;
   std::map<double, int> shapes;
@@ -185,13 +200,19 @@ void make_polyhedra3(const Scene& s, World3& w) {
       continue;
     }
     const double r = B.radius[i];
-    auto it = shapes.find(r);
-    if (it == shapes.end()) it = shapes.emplace(r, out.add_shape(platonic(kind, r))).first;
+    int id;
+    if (s.shape == Shape3d::Irregular) {
+      id = out.add_shape(grain_shape(s, r, i));
+    } else {
+      auto it = shapes.find(r);
+      if (it == shapes.end()) it = shapes.emplace(r, out.add_shape(grain_shape(s, r, i))).first;
+      id = it->second;
+    }
     const double u1 = U(g), u2 = U(g), u3 = U(g);
     const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1), t2 = 2 * std::numbers::pi * u2,
                  t3 = 2 * std::numbers::pi * u3;
     const Quat q(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));
-    out.add_polyhedron(B.pos[i], it->second, s.density, q, B.vel[i].v, B.vel[i].w);
+    out.add_polyhedron(B.pos[i], id, s.density, q, B.vel[i].v, B.vel[i].w);
   }
   w.bodies = std::move(out);
 }

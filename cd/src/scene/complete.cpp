@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "protocol.hpp"
 
@@ -190,6 +191,11 @@ void check_polyhedra3(const Scene& s) {
   if (contact_stiffness(s) > 0)
     fail3(fmt::format("contact.stiffness: compliant contacts need grains of scalar inertia (spheres); {} grains "
                       "take rigid contacts (no contact.stiffness)", what));
+  const auto [lo, hi] = std::minmax_element(s.aspect.begin(), s.aspect.end());
+  if (!(*lo > 0) || !(*hi <= 100 * *lo))
+    fail3(fmt::format("particles.aspect = [{}]: each ratio > 0 and the largest at most 100 times the smallest "
+                      "(a flatter grain is a plate the contact detection does not resolve)",
+                      fmt::join(s.aspect, ", ")));
 }
 
 // Every quantity the engines build from, of a checked scene.

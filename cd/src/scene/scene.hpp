@@ -30,12 +30,15 @@ inline constexpr std::array<std::string_view, 2> kShearControlNames = {"pressure
 enum class SizeDist { Uniform, UniformArea };
 inline constexpr std::array<std::string_view, 2> kSizeDistNames = {"uniform", "uniform_area"};
 
-// particles.shape: the generated grains' shape in 3D: spheres, or a
-// Platonic solid whose circumscribed diameter is the grain's size (the
-// engine's convex polyhedra, docs/3d.md).
-enum class Shape3d { Sphere, Tetrahedron, Cube, Octahedron, Dodecahedron, Icosahedron };
-inline constexpr std::array<std::string_view, 6> kShape3dNames = {"sphere", "tetrahedron", "cube",
-                                                                  "octahedron", "dodecahedron", "icosahedron"};
+// particles.shape: the generated grains' shape in 3D: spheres, or a convex
+// polyhedron whose circumscribed diameter is the grain's size (the
+// engine's, docs/3d.md): a Platonic solid, a cuboid of sides in the ratios
+// particles.aspect, or an irregular polyhedron, each grain its own: the
+// hull of particles.vertices random points on the ellipsoid of semi-axes in
+// those ratios.
+enum class Shape3d { Sphere, Tetrahedron, Cube, Octahedron, Dodecahedron, Icosahedron, Cuboid, Irregular };
+inline constexpr std::array<std::string_view, 8> kShape3dNames = {
+    "sphere", "tetrahedron", "cube", "octahedron", "dodecahedron", "icosahedron", "cuboid", "irregular"};
 
 // The names of an enum's values (config.cpp reads and writes every enum key
 // through this overload; a new enum adds its names here and its member type
@@ -121,6 +124,10 @@ struct Scene {
   std::vector<double> nsides{0.0};
   // 3D: the generated grains' shape (sizes then circumscribed diameters)
   Shape3d shape = Shape3d::Sphere;
+  // cuboid: side ratios; irregular: the ellipsoid's semi-axis ratios
+  std::vector<double> aspect{1.0, 1.0, 1.0};
+  // irregular: the number of random points whose hull is a grain
+  int vertices = 12;
   // generation region [xmin, ymin, xmax, ymax]; empty: inside the box
   std::vector<double> region;
 
