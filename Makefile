@@ -234,10 +234,12 @@ test: build
 # UndefinedBehaviorSanitizer (CDLAB_SANITIZE: -O1, assertions on, no
 # recovery) in their own folder, then ctest as make test runs it: the tests
 # that run cdsim, cdproblem or cdanalysis run the sanitized ones of that
-# folder. Every report of every process (a test, or a program it runs,
-# whose stderr the test may keep to itself) goes to a file in
-# SANITIZE_BUILD/sanitizer-logs/ and aborts that process; any such file
-# fails the target, which prints them. LeakSanitizer is on (it runs here);
+# folder. Every report aborts its process (SIGABRT, exit 134), which fails
+# a test that checks the exit status. An ASan or LSan report of any process
+# (a test, or a program it runs, whose stderr the test may keep to itself)
+# also goes to a file in SANITIZE_BUILD/sanitizer-logs/; any such file
+# fails the target, which prints them. UBSan's go to stderr only (GCC's
+# runtime ignores UBSAN_OPTIONS' log_path when ASan is linked in). LeakSanitizer is on (it runs here);
 # tests/lsan.supp holds its suppressions. Timeouts are 4 times make test's
 # (tests/CMakeLists.txt). ThreadSanitizer is not offered: Debian's libgomp
 # is not built with it, so every OpenMP barrier would be reported as a race.
