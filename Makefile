@@ -42,6 +42,8 @@ help:
 	@echo "  make build (= make all)  build everything: cdsim, cdanalysis, cdproblem, tests, benchmarks"
 	@echo "  make run             build cdsim only and run SCENE into OUT (SET: overrides)"
 	@echo "  make test            build everything and run the test suite (ctest)"
+	@echo "  make test-sanitize   the same suite built with ASan and UBSan in SANITIZE_BUILD (any report fails it;"
+	@echo "                       not part of make test; tests/README.md)"
 	@echo "  make clean           remove the build folder"
 	@echo "  make scene-doc       regenerate docs/scene-parameters.md from cdsim --help-scene=md (test_help_scene checks it)"
 	@echo "  make figures         regenerate docs/figures/ (installs ParaView's pvbatch and xvfb if missing; not part of make test)"
@@ -99,6 +101,7 @@ help:
 	$(call help_var,SET,scene overrides for make run: SET="--set k=v --set k2=v2")
 	$(call help_var,BUILD,the build folder)
 	$(call help_var,JOBS,parallel compile jobs)
+	$(call help_var,SANITIZE_BUILD,make test-sanitize's build folder (ASan, UBSan))
 	$(call help_var,THREADS,threads of each campaign run; empty: nproc / the -j of make)
 	$(call help_var,DIM,2 (disks/polygons) or 3 (spheres) for campaigns and analyses)
 	$(call help_var,CAMPAIGNS,the campaigns' folder)
@@ -225,6 +228,40 @@ test: build
 	@git ls-files --others --exclude-standard > $(BUILD)/untracked-before.txt 2>/dev/null || : > $(BUILD)/untracked-before.txt
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 900
 	cmake -DROOT=$(CURDIR) -DBEFORE=$(BUILD)/untracked-before.txt -P tests/check_tree.cmake
+
+# ---- The suite under sanitizers (tests/README.md; not part of make test) ----
+# The programs and every test built with AddressSanitizer and
+# UndefinedBehaviorSanitizer (CDLAB_SANITIZE: -O1, assertions on, no
+# recovery) in their own folder, then ctest as make test runs it: the tests
+# that run cdsim, cdproblem or cdanalysis run the sanitized ones of that
+# folder. Every report aborts its process (SIGABRT, exit 134), which fails
+# a test that checks the exit status. An ASan or LSan report of any process
+# (a test, or a program it runs, whose stderr the test may keep to itself)
+# also goes to a file in SANITIZE_BUILD/sanitizer-logs/; any such file
+# fails the target, which prints them. UBSan's go to stderr only (GCC's
+# runtime ignores UBSAN_OPTIONS' log_path when ASan is linked in). LeakSanitizer is on (it runs here);
+# tests/lsan.supp holds its suppressions. Timeouts are 4 times make test's
+# (tests/CMakeLists.txt). ThreadSanitizer is not offered: Debian's libgomp
+# is not built with it, so every OpenMP barrier would be reported as a race.
+SANITIZE_BUILD ?= build-sanitize
+san_logs = $(abspath $(SANITIZE_BUILD))/sanitizer-logs
+san_common = halt_on_error=1:abort_on_error=1:print_stacktrace=1
+.PHONY: test-sanitize
+test-sanitize: deps
+	@[ -f $(SANITIZE_BUILD)/CMakeCache.txt ] || { echo "make test-sanitize: configuring $(SANITIZE_BUILD)/ (ASan, UBSan)"; \
+	  cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Debug -DCDLAB_SANITIZE=ON -DCDLAB_BENCH=OFF \
+	    -DCMAKE_TARGET_MESSAGES=OFF --log-level=WARNING; }
+	nice -n 10 cmake --build $(SANITIZE_BUILD) -j $(JOBS)
+	@git ls-files --others --exclude-standard > $(SANITIZE_BUILD)/untracked-before.txt 2>/dev/null || : > $(SANITIZE_BUILD)/untracked-before.txt
+	@rm -rf $(san_logs) && mkdir -p $(san_logs)
+	cd $(SANITIZE_BUILD) && \
+	  ASAN_OPTIONS=$(san_common):detect_leaks=1:log_path=$(san_logs)/asan \
+	  UBSAN_OPTIONS=$(san_common):log_path=$(san_logs)/ubsan \
+	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
+	  nice -n 10 ctest --output-on-failure -j $(JOBS) --timeout 3600; rc=$$?; \
+	  if [ -n "$$(ls -A $(san_logs))" ]; then echo "make test-sanitize: sanitizer reports in $(san_logs):"; \
+	    head -n 60 $(san_logs)/*; exit 1; fi; exit $$rc
+	cmake -DROOT=$(CURDIR) -DBEFORE=$(SANITIZE_BUILD)/untracked-before.txt -P tests/check_tree.cmake
 
 # docs/scene-parameters.md is generated: a fixed header, then exactly what
 # `cdsim --help-scene` prints (tests/test_help_scene.cpp fails when they differ).

@@ -132,7 +132,9 @@ struct Reader {
                        "another build?)", name, size, sizeof(T)));
     if (n > rest.size() / sizeof(T)) fail(fmt::format("is truncated (it ends inside {})", name));
     v.resize(n);
-    std::memcpy(static_cast<void*>(v.data()), rest.data(), n * sizeof(T));
+    // An empty array: v.data() may be null, which memcpy may not be given
+    // even for 0 bytes (UBSan, make test-sanitize).
+    if (n > 0) std::memcpy(static_cast<void*>(v.data()), rest.data(), n * sizeof(T));
     rest.remove_prefix(n * sizeof(T));
   }
   // The name of the next array, left unread: for an array whose name
