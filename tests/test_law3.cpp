@@ -70,6 +70,25 @@ TEST(Law3, OpenStickSlideClosedForm) {
   EXPECT_EQ(r, Vec3(1, 0, 0));
 }
 
+// Adhesion widens the cone: a contact holding a pull-off impulse a sticks
+// while |r_t| <= mu (r_n + a), so a stick trial g with mu g_n < |g_t| <=
+// mu (g_n + a) sticks with r = g, through the sphere rows' projection and
+// the block solve alike; without adhesion the same trial slides onto
+// |r_t| = mu g_n (method.md section 14: the cohesive law's shifted cone).
+TEST(Law3, AdhesionShiftsTheConeOfTheStick) {
+  const double mu = 0.5, a = 0.4;
+  const Vec3 g(1.0, 0.6, 0.0);  // mu g_n = 0.5 < |g_t| = 0.6 <= mu (g_n + a) = 0.7
+  Vec3 r;
+  EXPECT_EQ(cd::project_sphere3(g, mu, a, r), Branch3::Stick);
+  EXPECT_NEAR((r - g).norm(), 0.0, 1e-15);  // r_n = (g_n + a) - a, to round-off
+  // The block solve of W = I with q = -g (its stick trial is g).
+  EXPECT_EQ(cd::solve_local3(Mat3::Identity(), -g, Cone3::round(mu), a, r), Branch3::Stick);
+  EXPECT_NEAR((r - g).norm(), 0.0, 1e-15);
+  // Without adhesion the trial is outside the cone: r_t = mu g_n g_t/|g_t|.
+  EXPECT_EQ(cd::project_sphere3(g, mu, 0.0, r), Branch3::Slide);
+  EXPECT_NEAR((r - Vec3(1.0, 0.5, 0.0)).norm(), 0.0, 1e-15);
+}
+
 TEST(Law3, OrthotropicSlidingIsNormalToTheEllipse) {
   // W = I, mu_a = 0.8, mu_b = 0.2, q = (-1, -1, -1): r_n = 1 and the
   // tangential impulse maximises the dissipation -r_t.u_t over the ellipse
