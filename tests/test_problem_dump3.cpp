@@ -59,8 +59,13 @@ Eigen::Matrix3d frame(const cd::SphereRow& r) {
   return F;
 }
 
+// Body b's world inverse inertia: its tensor (polyhedra), else inv_I 1.
+Eigen::Matrix3d inverse_inertia(const cd::ContactProblem3& p, int b) {
+  return p.inv_inertia.empty() ? Eigen::Matrix3d(p.vel[b].inv_I * Eigen::Matrix3d::Identity()) : p.inv_inertia[b];
+}
+
 // W = H^T M^-1 H, dense: for each pair of rows and each body they share,
-// F_k (s_k s_l) (inv_m I - inv_I [c_k]x [c_l]x) F_l^T (the velocity at k
+// F_k (s_k s_l) (inv_m I - [c_k]x J [c_l]x) F_l^T (the velocity at k
 // that an impulse at l gives through that body), and for each cell dof
 // inv_mass a_k a_l^T.
 Eigen::MatrixXd assembled_W(const cd::ContactProblem3& p) {
@@ -78,7 +83,8 @@ Eigen::MatrixXd assembled_W(const cd::ContactProblem3& p) {
         const double sb = body == b.b2 ? 1.0 : -1.0;
         const cd::Vec3 cb = body == b.b2 ? b.c2 : b.c1;
         const cd::BodyVel3& V = p.vel[body];
-        blk += sa * sb * (V.inv_m * Eigen::Matrix3d::Identity() - V.inv_I * cross(ca) * cross(cb));
+        const Eigen::Matrix3d J = inverse_inertia(p, body);
+        blk += sa * sb * (V.inv_m * Eigen::Matrix3d::Identity() - cross(ca) * J * cross(cb));
       }
       W.block<3, 3>(3 * k, 3 * l) = frame(a) * blk * frame(b).transpose();
     }
@@ -96,9 +102,9 @@ Eigen::VectorXd free_q(const cd::ContactProblem3& p) {
   for (const cd::SphereRow& r : p.rows) {
     const cd::Vec3 P = r.to_world(r.r);
     v[r.b2].v -= v[r.b2].inv_m * P;
-    v[r.b2].w -= v[r.b2].inv_I * r.c2.cross(P);
+    v[r.b2].w -= inverse_inertia(p, r.b2) * r.c2.cross(P);
     v[r.b1].v += v[r.b1].inv_m * P;
-    v[r.b1].w += v[r.b1].inv_I * r.c1.cross(P);
+    v[r.b1].w += inverse_inertia(p, r.b1) * r.c1.cross(P);
   }
   Eigen::VectorXd q(3 * p.rows.size());
   for (std::size_t k = 0; k < p.rows.size(); ++k) {
@@ -107,6 +113,54 @@ Eigen::VectorXd free_q(const cd::ContactProblem3& p) {
     q.segment<3>(3 * k) = frame(r) * cd::relative_velocity(r, v[r.b1], v[r.b2]) + b;
   }
   return q;
+}
+
+// `cdproblem solve` on the .cdp3, on one and two threads: the step's
+// impulses, byte for byte.
+void expect_replays(const fs::path& cdp, const fs::path& imp, const fs::path& dir) {
+  for (int t : {1, 2}) {
+    const fs::path out = dir / ("replay" + std::to_string(t) + ".txt");
+    const auto r = cdtest::run_command("OMP_NUM_THREADS=" + std::to_string(t) + " " + kCdproblem + " solve " +
+                                       cdp.string() + " --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(slurp(out), slurp(imp)) << "threads " << t;
+  }
+}
+
+// The FCLib file of the step whose .cdp3 is p: W against the assembly, q
+// against the free velocities, mu, and the stored solution the step's
+// impulses to the bit, meeting the law on (W, q) to `residual_max` (in
+// mean |r|); a wrong sign in q or a frame would leave O(1).
+void expect_fclib_is_the_step(const cd::ContactProblem3& p, const fs::path& h5, const fs::path& imp,
+                              double residual_max) {
+  const int nc = static_cast<int>(p.rows.size());
+  const cd::Fclib3 f = cd::read_fclib(h5.string());
+  ASSERT_FALSE(f.global);
+  ASSERT_EQ(f.problem.nc, nc);
+  // W: the same matrix to round-off (sums in another order).
+  const Eigen::MatrixXd W = assembled_W(p), Wf = Eigen::MatrixXd(f.problem.W);
+  const double wscale = W.cwiseAbs().maxCoeff();
+  EXPECT_LT((W - Wf).cwiseAbs().maxCoeff(), 1e-13 * wscale);
+  // q: the free velocities' scale is the bodies' speeds (cancellation in
+  // taking the warm start out costs a few ulps of them).
+  const Eigen::VectorXd q = free_q(p);
+  double vscale = 0;
+  for (const cd::BodyVel3& v : p.vel) vscale = std::max(vscale, v.v.norm());
+  EXPECT_LT((q - f.problem.q).cwiseAbs().maxCoeff(), 1e-12 * vscale);
+  for (int k = 0; k < nc; ++k) EXPECT_EQ(f.problem.mu[k], p.rows[k].mu);
+  ASSERT_EQ(f.r_ref.size(), 3 * nc);
+  std::istringstream in(slurp(imp));
+  for (int k = 0; k < 3 * nc; ++k) {
+    std::string s;
+    in >> s;
+    const double v = std::strtod(s.c_str(), nullptr);
+    EXPECT_EQ(std::memcmp(&v, &f.r_ref[k], sizeof v), 0) << "impulse " << k;
+  }
+  const cd::Residual res = cd::problem_residual(f.problem, f.r_ref);
+  std::printf("[ dump3 ] %d rows: step's impulses on the FCLib problem: law residual max %.2e, Siconos error %.2e\n",
+              nc, res.max, cd::siconos_error(f.problem, f.r_ref));
+  EXPECT_LT(res.max, residual_max);
+  EXPECT_LT(cd::siconos_error(f.problem, f.r_ref), 1e-4);
 }
 
 }  // namespace
@@ -135,56 +189,69 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
   // A run with the correction says what it cost (cdsim's summary).
   EXPECT_NE(r.out.find("cdsim: subspace corrections: "), std::string::npos) << r.out;
 
-  // The replay, on one and two threads: the same bytes.
-  for (int t : {1, 2}) {
-    const fs::path out = dir / ("replay" + std::to_string(t) + ".txt");
-    r = cdtest::run_command("OMP_NUM_THREADS=" + std::to_string(t) + " " + kCdproblem + " solve " + cdp.string() +
-                            " --out " + out.string());
-    ASSERT_EQ(r.code, 0) << r.out;
-    EXPECT_EQ(slurp(out), slurp(imp)) << "threads " << t;
-  }
+  expect_replays(cdp, imp, dir);
 
   cd::SolverParams prm;
   const cd::ContactProblem3 p = cd::read_contact_problem3(cdp.string(), prm);
   EXPECT_EQ(prm.subspace, 10);
-  const int nc = static_cast<int>(p.rows.size());
-  ASSERT_GT(nc, 100);
+  ASSERT_GT(p.rows.size(), 100u);
   ASSERT_EQ(p.dofs.size(), 1u);
   ASSERT_GT(p.dofs[0].rows.size(), 5u);
+  // tol 1e-4 in rms |dp|/|p|: law residuals of a few 1e-3 of mean |r|.
+  expect_fclib_is_the_step(p, h5, imp, 2e-2);
+}
 
-  const cd::Fclib3 f = cd::read_fclib(h5.string());
-  ASSERT_FALSE(f.global);
-  ASSERT_EQ(f.problem.nc, nc);
-  // W: the same matrix to round-off (sums in another order).
-  const Eigen::MatrixXd W = assembled_W(p), Wf = Eigen::MatrixXd(f.problem.W);
-  const double wscale = W.cwiseAbs().maxCoeff();
-  EXPECT_LT((W - Wf).cwiseAbs().maxCoeff(), 1e-13 * wscale);
-  // q: the free velocities' scale is the bodies' speeds (cancellation in
-  // taking the warm start out costs a few ulps of them).
-  const Eigen::VectorXd q = free_q(p);
-  double vscale = 0;
-  for (const cd::BodyVel3& v : p.vel) vscale = std::max(vscale, v.v.norm());
-  EXPECT_LT((q - f.problem.q).cwiseAbs().maxCoeff(), 1e-12 * vscale);
-  for (int k = 0; k < nc; ++k) EXPECT_EQ(f.problem.mu[k], p.rows[k].mu);
+// A step of polyhedra (27 blocks of sides 1 : 1.5 : 2 settling on the
+// floor, 4 points a face contact, every body's inverse inertia a full
+// tensor): the .cdp3 (version
+// 4, the tensors after the bodies) replays bit for bit on 1 and 2 threads,
+// and the FCLib file holds W = H^T M^-1 H with the tensors' angular blocks,
+// checked against the assembly above; a tensor that is not positive
+// semidefinite is refused, by line.
+TEST(ProblemDump3, PolyhedraStepReplaysExactlyAndItsFclibFileIsTheStep) {
+  const fs::path dir = cdtest::scratch_dir("problem_dump3", "polyhedra");
+  const auto r = cdtest::run_command(kCdsim + " " + kConfigs +
+                                     "pile-polyhedra.toml --set particles.n=27 --set time.duration=0.2 "
+                                     "--set particles.shape=cuboid --set particles.aspect=[1,1.5,2] "
+                                     "--set output.snapshot_interval=0 --quiet --dump-problem 150 --out " +
+                                     dir.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const fs::path cdp = dir / "problem_150.cdp3", h5 = dir / "problem_150.hdf5", imp = dir / "problem_150.impulses";
+  ASSERT_TRUE(fs::exists(cdp) && fs::exists(h5) && fs::exists(imp)) << r.out;
+  const std::string text = slurp(cdp);
+  EXPECT_EQ(text.rfind("cdlab-contact-problem3 4\n", 0), 0u);
+  expect_replays(cdp, imp, dir);
 
-  // The stored solution is the step's impulses, to the bit, and they meet
-  // the law on (W, q) to the residual the step stopped at (tol 1e-4 in
-  // rms |dp|/|p|: law residuals of a few 1e-3 of mean |r|); a wrong sign in
-  // q or a frame would leave O(1).
-  ASSERT_EQ(f.r_ref.size(), 3 * nc);
-  std::istringstream in(slurp(imp));
-  for (int k = 0; k < 3 * nc; ++k) {
-    std::string s;
-    in >> s;
-    const double v = std::strtod(s.c_str(), nullptr);
-    EXPECT_EQ(std::memcmp(&v, &f.r_ref[k], sizeof v), 0) << "impulse " << k;
+  cd::SolverParams prm;
+  const cd::ContactProblem3 p = cd::read_contact_problem3(cdp.string(), prm);
+  ASSERT_EQ(p.inv_inertia.size(), p.vel.size());
+  // Resting blocks: more rows than bodies (face contacts of 4 points), and
+  // tensors that are not multiples of the identity (a cube's would be).
+  ASSERT_GT(p.rows.size(), p.vel.size());
+  int anisotropic = 0;
+  for (const cd::Mat3& J : p.inv_inertia) {
+    const cd::Mat3 dev = J - J.trace() / 3 * cd::Mat3::Identity();
+    anisotropic += dev.norm() > 0.1 * J.norm();
   }
-  const cd::Residual res = cd::problem_residual(f.problem, f.r_ref);
-  std::printf("[ dump3 ] %d rows, %zu dof rows: step's impulses on the FCLib problem: law residual max %.2e, "
-              "Siconos error %.2e\n",
-              nc, p.dofs[0].rows.size(), res.max, cd::siconos_error(f.problem, f.r_ref));
-  EXPECT_LT(res.max, 2e-2);
-  EXPECT_LT(cd::siconos_error(f.problem, f.r_ref), 1e-4);
+  EXPECT_GE(anisotropic, 20);
+  // The pile's tolerance 1e-4 (rms |dp|/|p|); hyperstatic face contacts
+  // leave a larger law residual than spheres' at the same tol.
+  expect_fclib_is_the_step(p, h5, imp, 5e-2);
+
+  // A tensor with a negative eigenvalue, named with its line.
+  const std::size_t at = text.find("inertia\n");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t line_end = text.find('\n', at + 8);
+  const std::string bad = text.substr(0, at + 8) + "-0x1p+0 0x0p+0 0x0p+0 0x1p+0 0x0p+0 0x1p+0" + text.substr(line_end);
+  std::istringstream in(bad);
+  cd::SolverParams s;
+  try {
+    cd::read_contact_problem3(in, "bad.cdp3", s);
+    ADD_FAILURE() << "accepted a negative inverse inertia";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not positive semidefinite"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bad.cdp3:"), std::string::npos) << e.what();
+  }
 }
 
 // A dump that cannot be written is a write failure (exit 4, "could not
@@ -316,14 +383,15 @@ TEST(ProblemDump3, MalformedFileNamesTheLine) {
   std::istringstream law("cdlab-contact-problem3 1\nlaw sticky\n");
   EXPECT_THROW(cd::read_contact_problem3(law, "law.cdp3", s), std::runtime_error);
   // Version 2 needs its compliance line, a finite number >= 0; version 3
-  // its compliance_t line too, a finite number > 0; there is no version 4.
+  // its compliance_t line too, a finite number > 0; version 4 its inertia
+  // tensors after the bodies; there is no version 5.
   for (const char* bad : {"cdlab-contact-problem3 2\nlaw coulomb\ntol 0x1p-10\n",
                           "cdlab-contact-problem3 2\nlaw coulomb\ncompliance -0x1p+0\n",
                           "cdlab-contact-problem3 2\nlaw coulomb\ncompliance inf\n",
                           "cdlab-contact-problem3 3\nlaw coulomb\n",
                           "cdlab-contact-problem3 3\nlaw coulomb\ncompliance 0x1p+0\ntol 0x1p-10\n",
                           "cdlab-contact-problem3 3\nlaw coulomb\ncompliance 0x1p+0\ncompliance_t 0x0p+0\n",
-                          "cdlab-contact-problem3 4\nlaw coulomb\n"}) {
+                          "cdlab-contact-problem3 5\nlaw coulomb\n"}) {
     std::istringstream v(bad);
     try {
       cd::read_contact_problem3(v, "v.cdp3", s);

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
 #include "cell_dof.hpp"
@@ -173,18 +174,30 @@ Vec3 vec3(TextReader& rd, const std::string& what) {
 }  // namespace
 
 void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, std::ostream& out) {
-  if (!p.inv_inertia.empty())
-    throw std::invalid_argument(
-        "3D contact problem: a problem of bodies with inertia tensors (polyhedra) has no .cdp3 form yet");
-  // Version 1: rigid; 2: compliant, k_t = k; 3: compliant, k_t != k.
+  const bool tensors = !p.inv_inertia.empty();
+  if (tensors && p.compliance > 0)
+    throw std::invalid_argument("3D contact problem: compliant contacts need bodies of scalar inertia (spheres)");
+  if (tensors && p.inv_inertia.size() != p.vel.size())
+    throw std::invalid_argument(fmt::format("3D contact problem: {} inverse inertia tensors for {} bodies",
+                                            p.inv_inertia.size(), p.vel.size()));
+  // Version 1: rigid; 2: compliant, k_t = k; 3: compliant, k_t != k; 4:
+  // rigid, every body's world inverse inertia tensor after the bodies
+  // (polyhedra).
   const bool split = p.tangential_compliance() != p.compliance;
-  out << "cdlab-contact-problem3 " << (p.compliance > 0 ? (split ? 3 : 2) : 1) << "\n";
+  out << "cdlab-contact-problem3 " << (tensors ? 4 : p.compliance > 0 ? (split ? 3 : 2) : 1) << "\n";
   out << "law " << law_name3(p.law) << "\n";
   if (p.compliance > 0) out << "compliance " << x(p.compliance) << "\n";
   if (p.compliance > 0 && split) out << "compliance_t " << x(p.tangential_compliance()) << "\n";
   problem_file::write_solver(out, prm);
   out << "bodies " << p.vel.size() << "\n";
   for (const BodyVel3& v : p.vel) out << fmt::format("{} {} {} {}\n", x3(v.v), x3(v.w), x(v.inv_m), x(v.inv_I));
+  if (tensors) {
+    // The upper triangle (xx xy xz yy yz zz): the tensors are symmetric.
+    out << "inertia\n";
+    for (const Mat3& J : p.inv_inertia)
+      out << fmt::format("{} {} {} {} {} {}\n", x(J(0, 0)), x(J(0, 1)), x(J(0, 2)), x(J(1, 1)), x(J(1, 2)),
+                         x(J(2, 2)));
+  }
   problem_file::write_colouring(out, p.colouring);
   out << "rows " << p.rows.size() << "\n";
   for (const SphereRow& r : p.rows)
@@ -200,10 +213,10 @@ void write_contact_problem(const ContactProblem3& p, const SolverParams& prm, st
 ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name, SolverParams& prm) {
   TextReader rd(in, name);
   rd.expect("cdlab-contact-problem3", "at the start (not a cdlab 3D problem file)");
-  const long long version = rd.integer("the format version", 1, 3);
+  const long long version = rd.integer("the format version", 1, 4);
   ContactProblem3 p;
   p.law = problem_file::read_law<LocalLaw3>(rd, [](const LocalLaw3& l) { return law_name3(l); });
-  if (version >= 2) {
+  if (version == 2 || version == 3) {
     rd.expect("compliance", fmt::format("after the law (format version {})", version));
     p.compliance = rd.number("the compliance");
     if (!(p.compliance >= 0) || !std::isfinite(p.compliance))
@@ -228,6 +241,23 @@ ContactProblem3 read_contact_problem3(std::istream& in, const std::string& name,
     v.inv_m = rd.number("inv_m" + w);
     v.inv_I = rd.number("inv_I" + w);
     if (v.inv_m < 0 || v.inv_I < 0) rd.fail(fmt::format("negative inverse mass or inertia{}", w));
+  }
+  if (version == 4) {
+    rd.expect("inertia", "after the bodies (format version 4)");
+    p.inv_inertia.resize(nb);
+    for (long long i = 0; i < nb; ++i) {
+      const std::string w = fmt::format(" of body {}", i);
+      Mat3& J = p.inv_inertia[i];
+      static constexpr int kRow[6] = {0, 0, 0, 1, 1, 2}, kCol[6] = {0, 1, 2, 1, 2, 2};
+      for (int e = 0; e < 6; ++e)
+        J(kRow[e], kCol[e]) = J(kCol[e], kRow[e]) =
+            rd.number(fmt::format("inverse inertia ({},{}){}", kRow[e], kCol[e], w));
+      // Positive semidefinite (zero for a driven body), to round-off.
+      const double lmin = Eigen::SelfAdjointEigenSolver<Mat3>(J, Eigen::EigenvaluesOnly).eigenvalues()[0];
+      if (!(lmin >= -1e-12 * J.cwiseAbs().maxCoeff()))
+        rd.fail(fmt::format("the inverse inertia tensor{} is not positive semidefinite (least eigenvalue {})", w,
+                            lmin));
+    }
   }
   p.colouring = problem_file::read_colouring(rd, 1 << 16, "after the bodies");
   const long long nr = problem_file::read_row_count(rd, p.colouring, 3);  // b1, b2 and numbers

@@ -314,8 +314,6 @@ Problem3 to_matrix(const ContactProblem3& cp) {
     throw std::invalid_argument("a cohesive problem (adhesion impulse > 0) has no FCLib matrix form");
   if (cp.compliance > 0)
     throw std::invalid_argument("a problem with compliant contacts (compliance > 0) has no FCLib matrix form");
-  if (!cp.inv_inertia.empty())
-    throw std::invalid_argument("a problem of bodies with inertia tensors (polyhedra) has no FCLib matrix form yet");
   const auto& rows = cp.rows;
   const auto& V = cp.vel;
   const int nc = static_cast<int>(rows.size()), nb = static_cast<int>(V.size());
@@ -324,7 +322,13 @@ Problem3 to_matrix(const ContactProblem3& cp) {
   // t2); body b's rows 6b..6b+2 its velocity, 6b+3..6b+5 its angular
   // velocity (u_k,j = e_j.(v2 - v1) + w2.(c2 x e_j) - w1.(c1 x e_j)), then
   // one row per cell dof (u_k,j += a_j v). MH = M^-1 H keeps only what has
-  // an inverse mass, so W = H^T MH has no structural entry through a wall.
+  // an inverse mass, so W = H^T MH has no structural entry through a wall;
+  // with inertia tensors (polyhedra), a body's angular block of M^-1 is its
+  // world inverse inertia J (zero for a driven body).
+  const bool tensors = !cp.inv_inertia.empty();
+  if (tensors && cp.inv_inertia.size() != cp.vel.size())
+    throw std::invalid_argument(fmt::format("3D contact problem: {} inverse inertia tensors for {} bodies",
+                                            cp.inv_inertia.size(), cp.vel.size()));
   matrix_form::Triplets h, mh;
   h.reserve(36 * static_cast<std::size_t>(nc));
   mh.reserve(36 * static_cast<std::size_t>(nc));
@@ -333,7 +337,11 @@ Problem3 to_matrix(const ContactProblem3& cp) {
       h.emplace_back(6 * b + i, col, lin[i]);
       h.emplace_back(6 * b + 3 + i, col, ang[i]);
       if (V[b].inv_m != 0.0) mh.emplace_back(6 * b + i, col, V[b].inv_m * lin[i]);
-      if (V[b].inv_I != 0.0) mh.emplace_back(6 * b + 3 + i, col, V[b].inv_I * ang[i]);
+      if (!tensors && V[b].inv_I != 0.0) mh.emplace_back(6 * b + 3 + i, col, V[b].inv_I * ang[i]);
+    }
+    if (tensors && !cp.inv_inertia[b].isZero(0.0)) {
+      const Vec3 Ja = cp.inv_inertia[b] * ang;
+      for (int i = 0; i < 3; ++i) mh.emplace_back(6 * b + 3 + i, col, Ja[i]);
     }
   };
   for (int k = 0; k < nc; ++k) {
