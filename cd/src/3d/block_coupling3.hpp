@@ -152,10 +152,70 @@ struct BlockCoupling3 {
     r.r += d;
     push_impulse(r, d, vel);
   }
-  // No subspace correction (its products are the sphere rows').
+  // For the sweep's subspace correction (core/sweep.hpp, Subspace), as
+  // coupling3.hpp's sphere rows: the laws with the round cone (or none),
+  // with or without adhesion; the products W p go through a copy of the
+  // bodies (nbodies: the size of vel), W's diagonal is the blocks'.
+  int nbodies = 0;
   template <class L>
-  static constexpr bool kSubspaceLaw = false;
-  using Scratch = int;
+  static constexpr bool kSubspaceLaw = !L::orthotropic;
+  using Scratch = std::vector<BodyVel3>;
+  Scratch subspace_scratch() const { return Scratch(vel, vel + nbodies); }
+  // A closed row (r_n + a > 0) is free in its normal component, and in its
+  // tangential ones too when it sticks (|r_t| below mu (r_n + a) by more
+  // than round-off: the local solve puts a sliding impulse on the cone).
+  template <class L>
+  void subspace_row(const BlockRow3& r, double* free, double* diag, double* u) const {
+    const Vec3 v = velocity(r);
+    for (int j = 0; j < 3; ++j) {
+      u[j] = v[j];
+      diag[j] = r.W(j, j);
+    }
+    const double sn = r.r[0] + (L::cohesive ? r.adh : 0.0);
+    const bool closed = sn > 0;
+    const bool sticks =
+        L::tangential && closed && std::sqrt(r.r[1] * r.r[1] + r.r[2] * r.r[2]) < (1.0 - 1e-9) * r.mu * sn;
+    free[0] = closed ? 1.0 : 0.0;
+    free[1] = free[2] = sticks ? 1.0 : 0.0;
+  }
+  // y = W p on the rows listed in live, through s (no offsets, no b_n);
+  // the other rows' p is zero and their y is not read.
+  void subspace_apply(const BlockRow3* R, const std::vector<int>& live, const double* p, double* y,
+                      Scratch& s) const {
+    for (BodyVel3& b : s) {
+      b.v.setZero();
+      b.w.setZero();
+    }
+    for (const int i : live) push_impulse<true>(R[i], Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), s.data());
+    for (const int i : live) {
+      const BlockRow3& r = R[i];
+      const BodyVel3& A = s[r.b1];
+      const BodyVel3& B = s[r.b2];
+      const Vec3 dv = B.v - A.v;
+      y[3 * i] = r.n.dot(dv) + r.a2[0].dot(B.w) - r.a1[0].dot(A.w);
+      y[3 * i + 1] = r.t1.dot(dv) + r.a2[1].dot(B.w) - r.a1[1].dot(A.w);
+      y[3 * i + 2] = r.t2.dot(dv) + r.a2[2].dot(B.w) - r.a1[2].dot(A.w);
+    }
+  }
+  // r <- the cone's projection of r + d (a sliding row's tangential
+  // impulse held in direction and scaled with the shifted normal one, so
+  // that it stays on the cone's edge), the bodies following.
+  template <class L>
+  void subspace_put(BlockRow3& r, const double* d, bool sticking) const {
+    const double a = L::cohesive ? r.adh : 0.0;
+    Vec3 y(r.r[0] + d[0], r.r[1], r.r[2]);
+    if (sticking) {
+      y[1] += d[1];
+      y[2] += d[2];
+    } else if (L::tangential) {
+      y.tail<2>() *= std::max(y[0] + a, 0.0) / (r.r[0] + a);
+    }
+    Vec3 out;
+    project_sphere3(y, L::tangential ? r.mu : 0.0, a, out);
+    const Vec3 dr = out - r.r;
+    r.r = out;
+    push_impulse(r, dr, vel);
+  }
 
   // One row update: the free velocity q = u - W r, the exact local solve,
   // the change into the bodies (body 1 only when Write1).

@@ -85,7 +85,7 @@ SolveStats nlgs_solve_blocks3(ContactProblem3& p, const SolverParams& prm, const
   const SolveStats st = std::visit(
       [&](auto law) {
         using L = decltype(law);
-        sweep::BlockCoupling3 c{p.vel.data(), extra, rows.data()};
+        sweep::BlockCoupling3 c{p.vel.data(), extra, rows.data(), static_cast<int>(p.vel.size())};
         return sweep::solve<L>(rows, p.colouring, c, prm, dofs, observer);
       },
       p.law);

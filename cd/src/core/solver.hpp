@@ -39,7 +39,8 @@ struct SolverParams {
   // sliding rows is solved by at most this many conjugate-gradient
   // iterations and put into the rows, until a stall (the Anderson rule)
   // stops them for the rest of the solve. Needs a coupling and law that
-  // take it (3D spheres with the round cone, adhesion or not); 0: off.
+  // take it (3D spheres and polyhedra with the round cone, adhesion or
+  // not); 0: off.
   int subspace = defaults::subspace;
 };
 
