@@ -57,6 +57,8 @@ struct PolyState3 {
   std::vector<std::int32_t> axis;     // per pair: kind, a, b, count
   std::vector<std::uint64_t> feature; // per pair: PolyPairMemory3::kMaxRows
   std::vector<Vec3> p;                // per pair: PolyPairMemory3::kMaxRows
+  std::vector<std::int32_t> vertex_count;  // per shape (absent in files written before)
+  std::vector<Vec3> vertices;              // the shapes' vertices, shape after shape
 };
 
 // FNV-1a over the library's vertices, faces and circumradii: two libraries
@@ -92,18 +94,58 @@ void write_poly3(ckpt::Writer& o, const World3& w) {
   o.array("3d.poly.memory.axis", axis);
   o.array("3d.poly.memory.feature", feature);
   o.array("3d.poly.memory.p", p);
+  std::vector<std::int32_t> count;
+  std::vector<Vec3> vertices;
+  for (const ConvexPolyhedron& c : b.polyhedra) {
+    count.push_back(static_cast<std::int32_t>(c.vertices().size()));
+    vertices.insert(vertices.end(), c.vertices().begin(), c.vertices().end());
+  }
+  o.array("3d.poly.vertex_count", count);
+  o.array("3d.poly.vertices", vertices);
+}
+
+// The library a file's vertices give (Bodies3::add_shape's frames), or a
+// failure naming the shape.
+std::vector<ConvexPolyhedron> file_shapes(ckpt::Reader& in, const PolyState3& ps) {
+  if (ps.vertex_count.empty() && ps.shapes.size() == 2 && ps.shapes[0] > 0)
+    in.fail("holds polyhedra without their shapes' vertices (written before they were stored): it can resume its "
+            "own run, not start another");
+  if (ps.shapes.size() != 2 || ps.vertex_count.size() != ps.shapes[0])
+    in.fail(fmt::format("is corrupt: '3d.poly.vertex_count' holds {} shapes, '3d.poly.shapes' says {}",
+                        ps.vertex_count.size(), ps.shapes.size() == 2 ? ps.shapes[0] : 0));
+  Bodies3 lib;
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < ps.vertex_count.size(); ++k) {
+    const std::int32_t m = ps.vertex_count[k];
+    if (m < 4 || static_cast<std::size_t>(m) > ps.vertices.size() - at)
+      in.bad("3d.poly.vertex_count", k, "", fmt::format("is {} (at least 4, and the vertices left: {})", m,
+                                                        ps.vertices.size() - at));
+    std::vector<Vec3> v(ps.vertices.begin() + static_cast<std::ptrdiff_t>(at),
+                        ps.vertices.begin() + static_cast<std::ptrdiff_t>(at + static_cast<std::size_t>(m)));
+    at += static_cast<std::size_t>(m);
+    try {
+      lib.add_shape(ConvexPolyhedron(v));
+    } catch (const std::invalid_argument& e) {
+      in.fail(fmt::format("is corrupt: shape {} of '3d.poly.vertices' is not a convex polyhedron ({})", k, e.what()));
+    }
+  }
+  if (at != ps.vertices.size())
+    in.fail(fmt::format("is corrupt: '3d.poly.vertices' holds {} vertices, the counts {}", ps.vertices.size(), at));
+  return lib.polyhedra;
 }
 
 // The polyhedra section if the checkpoint has one, checked against the
 // bodies and the scene's shape library `lib`.
-PolyState3 read_poly3(ckpt::Reader& in, const Bodies3& b, const std::vector<ConvexPolyhedron>& lib) {
+PolyState3 read_poly3(ckpt::Reader& in, const Bodies3& b, std::vector<ConvexPolyhedron>& lib, Shapes shapes) {
   PolyState3 ps;
   const bool has = in.next_name("3d.poly.shapes") == "3d.poly.shapes";
   bool any_poly = false;
   for (std::size_t i = 0; i < b.size(); ++i) any_poly |= b.shape[i] == Shape3::Polyhedron;
   if (!has) {
     if (any_poly) in.fail("is corrupt: it has polyhedra (3d.shape 2) but no '3d.poly' arrays");
-    if (!lib.empty()) in.fail("holds spheres; this scene's grains are polyhedra (particles.shape)");
+    if (!lib.empty() && shapes == Shapes::Scene)
+      in.fail("holds spheres; this scene's grains are polyhedra (particles.shape)");
+    if (shapes == Shapes::File) lib.clear();
     return ps;
   }
   in.array("3d.poly.shapes", ps.shapes);
@@ -113,7 +155,12 @@ PolyState3 read_poly3(ckpt::Reader& in, const Bodies3& b, const std::vector<Conv
   in.array("3d.poly.memory.axis", ps.axis);
   in.array("3d.poly.memory.feature", ps.feature);
   in.array("3d.poly.memory.p", ps.p);
-  if (ps.shapes.size() != 2 || ps.shapes[0] != lib.size() || ps.shapes[1] != shapes_fingerprint(lib))
+  if (in.next_name("3d.poly.vertex_count") == "3d.poly.vertex_count") {
+    in.array("3d.poly.vertex_count", ps.vertex_count);
+    in.array("3d.poly.vertices", ps.vertices);
+  }
+  if (shapes == Shapes::File) lib = file_shapes(in, ps);
+  else if (ps.shapes.size() != 2 || ps.shapes[0] != lib.size() || ps.shapes[1] != shapes_fingerprint(lib))
     in.fail(fmt::format("holds polyhedra of other shapes than this scene's ({} shapes; particles.shape and the "
                         "sizes make them)", lib.size()));
   const std::size_t n = b.size(), np = ps.keys.size();
@@ -280,8 +327,9 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
   });
 }
 
-std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals) {
-  // The shapes are the scene's: those of the world built from it.
+std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals, Shapes shapes) {
+  // The shapes are the scene's, those of the world built from it, or the
+  // file's (read_poly3 replaces them).
   std::vector<ConvexPolyhedron> lib = w.bodies.polyhedra;
   return ckpt::load_world(
       path, w, kFile, kBodies3Arrays, totals, check_bodies3,
@@ -310,7 +358,7 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
         } catch (const std::invalid_argument& e) {
           in.fail(fmt::format("is corrupt: '3d.cell' holds a cell this scene cannot take ({})", e.what()));
         }
-        PolyState3 poly = read_poly3(in, b, lib);
+        PolyState3 poly = read_poly3(in, b, lib, shapes);
         ckpt::check_overlap(in, "3d.overlap", p.d_ref, [&] {
           try {
             return overlap_of3(b, c, p);

@@ -28,6 +28,15 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
 // checkpoint's; a checkpoint whose periodic axes differ from w's is refused. Returns the
 // stored scene key; with `totals`, also the run's totals. w is changed only if the
 // whole file is valid; otherwise throws CheckpointError naming the file.
-std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals = nullptr);
+//
+// Polyhedra: the file stores the shape library's vertices besides its count
+// and fingerprint. Shapes::Scene (a run's own restart) takes w's library,
+// the scene's, and refuses a file whose fingerprint is not its; with
+// Shapes::File (a started sample, shear.start) the library is the file's,
+// rebuilt from its vertices (to round-off), each body checked against its
+// shape's circumradius and moments.
+enum class Shapes : std::uint8_t { Scene, File };
+std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* totals = nullptr,
+                               Shapes shapes = Shapes::Scene);
 
 }  // namespace cd

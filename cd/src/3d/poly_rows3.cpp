@@ -133,4 +133,18 @@ void keep_polyhedra_memory3(const std::vector<SphereRow>& rows, const std::vecto
   }
 }
 
+Overlap3 largest_polyhedra_overlap3(const Bodies3& bodies, const PeriodicCell3& cell, int min_parallel) {
+  CellGrid3 grid;
+  std::vector<SphereRow> rows;
+  std::vector<ContactInfo3> info;
+  std::vector<PolyPairAxis3> axes;
+  if (cell.any()) detect3(bodies, bodies.pos, 0.0, cell, grid, rows, info, min_parallel);
+  else detect3(bodies, bodies.pos, 0.0, grid, rows, info, min_parallel);
+  polyhedra_rows3(bodies, bodies.pos, bodies.orient, 0.0, PolyMemory3{}, rows, info, axes, min_parallel);
+  Overlap3 o;
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    if (-info[k].gap > o.depth) o = {-info[k].gap, rows[k].b1, rows[k].b2};
+  return o;
+}
+
 }  // namespace cd

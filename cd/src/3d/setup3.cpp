@@ -13,6 +13,7 @@
 #include "detect3.hpp"
 #include "continuation.hpp"
 #include "pile3d.hpp"
+#include "poly_rows3.hpp"
 #include "start_hint.hpp"
 
 namespace cd {
@@ -88,22 +89,27 @@ namespace {
 void load_start3(const CompleteScene& cs, World3& w) {
   const Scene& s = cs.scene;
   try {
-    load_checkpoint3(s.start, w);
+    load_checkpoint3(s.start, w, nullptr, Shapes::File);
   } catch (const CheckpointError& e) {
     throw SceneError(fmt::format("shear.start: {}{}", e.what(), missing_start_hint(s)));
   }
   Bodies3& B = w.bodies;
   for (std::size_t i = 0; i < B.size(); ++i)
-    if (B.shape[i] != Shape3::Sphere || !B.is_dynamic(i))
-      throw SceneError(fmt::format("shear.start: '{}' holds a plane or a driven sphere (body {}); a periodic "
-                                   "run starts from a periodic run's spheres", s.start, i));
-  // The spheres (all dynamic: checked above) to core/continuation.hpp.
+    if (B.shape[i] == Shape3::Plane || !B.is_dynamic(i))
+      throw SceneError(fmt::format("shear.start: '{}' holds a plane or a driven grain (body {}); a periodic "
+                                   "run starts from a periodic run's grains", s.start, i));
+  // A grain's volume: a sphere's, or its polyhedron's.
+  const auto volume = [&](std::size_t i) {
+    return B.shape[i] == Shape3::Polyhedron ? B.polyhedron(i).volume() : obs::sphere_volume(B.radius[i]);
+  };
+  // The grains (all dynamic: checked above) to core/continuation.hpp; a
+  // polyhedron's diameter is its circumscribed one, as the scene's sizes.
   continuation::Grains grains{B.size(),
                               [&](std::size_t i) { return B.pos[i].y(); },
                               [&](std::size_t i) -> double& { return B.vel[i].v.x(); },
                               [&](std::size_t i) { return 2 * B.radius[i]; },
-                              [&](std::size_t i) { return B.mass[i] / obs::sphere_volume(B.radius[i]); },
-                              "spheres",
+                              [&](std::size_t i) { return B.mass[i] / volume(i); },
+                              B.has_polyhedra() ? "grains" : "spheres",
                               "kg/m^3"};
   continuation::check_density(grains, s.density);
   continuation::check_mean_diameter(grains, w.params().d_ref);
@@ -115,9 +121,9 @@ void load_start3(const CompleteScene& cs, World3& w) {
   }
   if (cs.pressure <= 0) c.rate = Vec3::Zero();  // volume control: the lengths stay
   if (s.volume_fraction > 0) {
-    double volume = 0;
-    for (std::size_t i = 0; i < B.size(); ++i) volume += obs::sphere_volume(B.radius[i]);
-    const double f = continuation::volume_scale(volume, c.size.prod(), s.volume_fraction, 3);
+    double solids = 0;
+    for (std::size_t i = 0; i < B.size(); ++i) solids += volume(i);
+    const double f = continuation::volume_scale(solids, c.size.prod(), s.volume_fraction, 3);
     const Vec3 o = w.params().cell_origin;
     for (Vec3& x : B.pos) x = o + f * (x - o);
     c.size *= f;
@@ -146,13 +152,15 @@ void check_start_overlaps3(const Scene& s, const World3& w) {
   cell.le_offset = c.le_offset;
   Overlap3 o;
   try {
-    o = largest_overlap3(w.bodies, cell, w.params().solver.min_parallel);
+    const int mp = w.params().solver.min_parallel;
+    o = w.bodies.has_polyhedra() ? largest_polyhedra_overlap3(w.bodies, cell, mp)
+                                 : largest_overlap3(w.bodies, cell, mp);
   } catch (const std::exception& e) {
     throw SceneError(fmt::format("shear.start: '{}': {}", s.start, e.what()));
   }
   const double d = w.params().d_ref;
   if (o.depth > kStartOverlap * d)
-    throw SceneError(fmt::format("shear.start: spheres {} and {} of '{}' overlap by {:.3g} mean diameters{}; a "
+    throw SceneError(fmt::format("shear.start: grains {} and {} of '{}' overlap by {:.3g} mean diameters{}; a "
                                  "started sample may overlap by at most {}",
                                  o.b1, o.b2, s.start, o.depth / d,
                                  s.volume_fraction > 0
@@ -187,9 +195,7 @@ ConvexPolyhedron grain_shape(const Scene& s, double r, std::size_t grain) {
   }
 }
 
-void make_polyhedra3(const Scene& s, World3& w) {
-  if (s.shape == Shape3d::Sphere) return;
-  const Bodies3& B = w.bodies;
+Bodies3 polyhedra_of(const Scene& s, const Bodies3& B) {
   Bodies3 out;
   std::map<double, int> shapes;
   std::mt19937_64 g(s.seed ^ 0x9e3779b97f4a7c15ull);
@@ -214,7 +220,11 @@ void make_polyhedra3(const Scene& s, World3& w) {
     const Quat q(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));
     out.add_polyhedron(B.pos[i], id, s.density, q, B.vel[i].v, B.vel[i].w);
   }
-  w.bodies = std::move(out);
+  return out;
+}
+
+void make_polyhedra3(const Scene& s, World3& w) {
+  if (s.shape != Shape3d::Sphere) w.bodies = polyhedra_of(s, w.bodies);
 }
 
 }  // namespace

@@ -139,7 +139,10 @@ void check_cell3(const Scene& s) {
   if (!s.start.empty()) {
     // The spheres and the cell come from the sample (build_cell3).
     if (s.n > 0 || !s.diameters.empty())
-      fail3("shear.start gives the spheres: set particles.n = 0 and no particles.diameters");
+      fail3("shear.start gives the grains: set particles.n = 0 and no particles.diameters");
+    if (s.shape != Shape3d::Sphere)
+      fail3(fmt::format("particles.shape = \"{}\": shear.start gives the grains, their shapes too (a sample "
+                        "of polyhedra stores them); leave particles.shape out", name_of(s.shape)));
     if (s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0)
       fail3(fmt::format("shear.width, shear.height, shear.depth = {}, {}, {}: shear.start gives the cell; "
                         "leave them at 0", s.cell_width, s.cell_height, s.cell_depth));
@@ -185,9 +188,6 @@ Scene with_auto_cell3(const Scene& s) {
 void check_polyhedra3(const Scene& s) {
   if (s.shape == Shape3d::Sphere) return;
   const std::string what = fmt::format("particles.shape = \"{}\"", name_of(s.shape));
-  if (!s.start.empty())
-    fail3(fmt::format("shear.start: a started sample holds spheres; {} grains start from their own placement "
-                      "(shear.start = \"\")", what));
   if (contact_stiffness(s) > 0)
     fail3(fmt::format("contact.stiffness: compliant contacts need grains of scalar inertia (spheres); {} grains "
                       "take rigid contacts (no contact.stiffness)", what));
