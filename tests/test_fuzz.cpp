@@ -332,6 +332,9 @@ std::string shown_name(const CkptArray& a) { return a.name.substr(0, a.name.find
 bool all_doubles(const std::string& name) {
   for (const char* n : {"shape", "nsides", "driven", "warm.keys"})
     if (name == n || name == std::string("3d.") + n) return false;
+  for (const char* n : {"3d.poly.shapes", "3d.poly.shape_id", "3d.poly.memory.keys", "3d.poly.memory.axis",
+                        "3d.poly.memory.feature", "3d.poly.vertex_count"})
+    if (name == n) return false;
   return true;
 }
 
@@ -354,6 +357,8 @@ std::vector<Mutant> mutants(const std::string& good) {
   const auto add = [&](std::string what, std::string b, std::string field) {
     m.push_back({std::move(what), with_checksum(std::move(b)), std::move(field)});
   };
+  bool poly = false;  // a checkpoint of polyhedra
+  for (const CkptArray& a : ckpt_arrays(good)) poly |= a.name == "3d.poly.shapes";
   {
     std::string b = good;
     put_at<std::int64_t>(b, 24, -1);
@@ -409,7 +414,15 @@ std::vector<Mutant> mutants(const std::string& good) {
       b = good;
       for (std::uint64_t e = 0; e < a.count; ++e)
         put_at<double>(b, a.data + e * a.size, 1.5 * get_at<double>(good, a.data + e * a.size));
-      add(a.name + ": every radius x 1.5", b, a.name.substr(0, a.name.size() - base.size()) + "overlap");
+      // (a polyhedron's radius is its shape's circumradius: that check comes first)
+      add(a.name + ": every radius x 1.5", b,
+          poly ? a.name : a.name.substr(0, a.name.size() - base.size()) + "overlap");
+    }
+    if (poly && a.name == "3d.orient") {  // every body turned to the identity: valid, but not the recorded overlap
+      b = good;
+      for (std::uint64_t e = 0; e < a.count; ++e)
+        for (int c = 0; c < 4; ++c) put_at<double>(b, a.data + e * a.size + 8 * c, c == 3 ? 1.0 : 0.0);
+      add(a.name + ": every body at the identity orientation", b, "3d.overlap");
     }
     for (const std::uint64_t e : {std::uint64_t(0), a.count - 1}) {
       const std::size_t at = a.data + e * a.size;
@@ -464,11 +477,11 @@ void corrupt_systematically(const std::string& label, const std::string& cmd, co
   ASSERT_EQ(with_checksum(good), good) << "the test's parser does not know the file's frame";
   const std::vector<CkptArray> arrays = ckpt_arrays(good);
   ASSERT_GE(arrays.size(), 12u);
-  for (const CkptArray& a : arrays) {
-    if (a.name.find("warm.p") != std::string::npos) {
-      ASSERT_GT(a.count, 0u) << "no contacts: warm start untested";
-    }
-  }
+  // The warm start: spheres' impulses by key, or polyhedra's pair memory.
+  bool warm = false;
+  for (const CkptArray& a : arrays)
+    warm |= (a.name.ends_with("warm.p") || a.name.ends_with("memory.p")) && a.count > 0;
+  ASSERT_TRUE(warm) << "no contacts: warm start untested";
   const std::map<std::string, std::string> before = folder(out);
   std::vector<Mutant> ms = systematic ? mutants(good) : std::vector<Mutant>{};
   ms.insert(ms.end(), more.begin(), more.end());
@@ -515,6 +528,19 @@ TEST(Fuzz, CheckpointsWithAValidChecksumAreStillValidated3D) {
                           (dir / "out").string();
   ASSERT_EQ(cdtest::run_command(cmd + " --max-steps 20").code, 0);
   corrupt_systematically("3D pile", cmd, dir / "out");
+}
+
+// Polyhedra add their arrays (shape ids, moments, pair memory, the shapes'
+// vertices) and an overlap measured through the narrow phase: 8 cubes
+// resting in the pile's box.
+TEST(Fuzz, CheckpointsWithAValidChecksumAreStillValidatedPolyhedra) {
+  const fs::path dir = cdtest::scratch_dir("fuzz", "systematic_poly");
+  const std::string cmd = kTimeout + kBin + "/cd/cdsim " + CDLAB_SOURCE_DIR "/configs/pile-polyhedra.toml" +
+                          " -q --threads 1 --set particles.n=8 --set time.duration=0.04 --set gravity.g=[0,0,-2000]"
+                          " --set output.series_interval=0.002 --set output.checkpoint_interval=0.01 --out " +
+                          (dir / "out").string();
+  ASSERT_EQ(cdtest::run_command(cmd + " --max-steps 20").code, 0);
+  corrupt_systematically("3D polyhedra pile", cmd, dir / "out");
 }
 
 // A periodic cell's state against its grains: lengths the detection cannot

@@ -151,13 +151,7 @@ std::uint64_t load_checkpoint(const std::string& path, World& w, RunTotals* tota
         in.array("cell", cell);
         if (cell.size() != 1) in.fail(fmt::format("is corrupt: 'cell' holds {} elements (must be 1)", cell.size()));
         check_cell(in, cell[0], b, w.params());
-        ckpt::check_overlap(in, "overlap", w.params().d_ref, [&] {
-          try {
-            return overlap_of(b, cell[0], w.params());
-          } catch (const std::exception& e) {
-            in.fail(fmt::format("is corrupt: its bodies cannot be detected in its cell ({})", e.what()));
-          }
-        });
+        ckpt::check_overlap(in, "overlap", w.params().d_ref, [&] { return overlap_of(b, cell[0], w.params()); });
         return cell[0];
       },
       [](World& w, const CellState& c) { w.cell = c; });

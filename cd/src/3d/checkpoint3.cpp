@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "detect3.hpp"
+#include "poly_rows3.hpp"
 #include "world_checkpoint.hpp"
 
 namespace cd {
@@ -159,25 +160,54 @@ PolyState3 read_poly3(ckpt::Reader& in, const Bodies3& b, std::vector<ConvexPoly
     in.array("3d.poly.vertex_count", ps.vertex_count);
     in.array("3d.poly.vertices", ps.vertices);
   }
-  if (shapes == Shapes::File) lib = file_shapes(in, ps);
-  else if (ps.shapes.size() != 2 || ps.shapes[0] != lib.size() || ps.shapes[1] != shapes_fingerprint(lib))
-    in.fail(fmt::format("holds polyhedra of other shapes than this scene's ({} shapes; particles.shape and the "
-                        "sizes make them)", lib.size()));
+  if (shapes == Shapes::File) {
+    lib = file_shapes(in, ps);
+  } else {
+    if (ps.shapes.size() != 2 || ps.shapes[0] != lib.size() || ps.shapes[1] != shapes_fingerprint(lib))
+      in.fail(fmt::format("holds polyhedra of other shapes than this scene's ('3d.poly.shapes' does not give its {} "
+                          "shapes and their fingerprint; particles.shape and the sizes make them)", lib.size()));
+    // The stored vertices, when there are, are the library's, bit for bit
+    // (a sample started from this file takes its shapes from them).
+    if (!ps.vertex_count.empty() || !ps.vertices.empty()) {
+      std::size_t at = 0;
+      bool same = ps.vertex_count.size() == lib.size();
+      for (std::size_t k = 0; same && k < lib.size(); ++k) {
+        const std::vector<Vec3>& v = lib[k].vertices();
+        same = ps.vertex_count[k] == static_cast<std::int32_t>(v.size()) && at + v.size() <= ps.vertices.size() &&
+               std::equal(v.begin(), v.end(), ps.vertices.begin() + static_cast<std::ptrdiff_t>(at));
+        at += v.size();
+      }
+      if (!same || at != ps.vertices.size())
+        in.fail("is corrupt: '3d.poly.vertex_count' and '3d.poly.vertices' are not the vertices of the shapes "
+                "'3d.poly.shapes' fingerprints");
+    }
+  }
   const std::size_t n = b.size(), np = ps.keys.size();
   if (ps.shape_id.size() != n || ps.moments.size() != n)
     in.fail(fmt::format("is corrupt: '3d.poly.shape_id' and '3d.poly.moments' hold {} and {} elements for {} bodies",
                         ps.shape_id.size(), ps.moments.size(), n));
   constexpr std::size_t R = PolyPairMemory3::kMaxRows;
   if (ps.axis.size() != 4 * np || ps.feature.size() != R * np || ps.p.size() != R * np)
-    in.fail(fmt::format("is corrupt: the '3d.poly.memory' arrays are not 4 (axis) and {} per pair of its {} pairs",
-                        R, np));
+    in.fail(fmt::format("is corrupt: '3d.poly.memory.keys' holds {} pairs, '3d.poly.memory.axis' {} values (4 a "
+                        "pair), '3d.poly.memory.feature' and '3d.poly.memory.p' {} and {} ({} a pair)",
+                        np, ps.axis.size(), ps.feature.size(), ps.p.size(), R));
   for (std::size_t i = 0; i < n; ++i) {
     const bool poly = b.shape[i] == Shape3::Polyhedron;
     const std::int32_t id = ps.shape_id[i];
     if (poly ? !(id >= 0 && static_cast<std::size_t>(id) < lib.size()) : id != -1)
       in.bad("3d.poly.shape_id", i, "", fmt::format("is {} ({})", id, poly ? fmt::format("a shape of the {} "
                                                     "of this scene", lib.size()) : "-1 for a sphere or a plane"));
-    if (!poly) continue;
+    if (!poly) {
+      // A sphere's moments are its scalar inertia, a plane's zero
+      // (restore_derived).
+      const Vec3 expect = b.shape[i] == Shape3::Sphere ? Vec3::Constant(b.inertia[i]) : Vec3::Zero();
+      for (int k = 0; k < 3; ++k)
+        if (!(ps.moments[i][k] == expect[k]))
+          in.bad("3d.poly.moments", i, std::string(1, "xyz"[k]),
+                 fmt::format("is {:.17g}, not {:.17g} (a sphere's inertia, a plane's 0)", ps.moments[i][k],
+                             expect[k]));
+      continue;
+    }
     const ConvexPolyhedron& c = lib[static_cast<std::size_t>(id)];
     if (!(std::abs(b.radius[i] - c.circumradius()) <= 1e-12 * c.circumradius()))
       in.bad("3d.radius", i, "", fmt::format("is {:.17g}, but its shape's circumradius is {:.17g}", b.radius[i],
@@ -241,8 +271,10 @@ void check_bodies3(const ckpt::Reader& in, const Bodies3& b) {
       in.bad("3d.shape", i, "", fmt::format("is {} (0 sphere, 1 plane, 2 polyhedron)", shape));
     // A polyhedron's inertia is its moments (3d.poly.moments): no scalar.
     const bool poly = b.shape[i] == Shape3::Polyhedron;
-    if (poly && (b.inertia[i] != 0 || b.vel[i].inv_I != 0))
+    if (poly && b.inertia[i] != 0)
       in.bad("3d.inertia", i, "", "is not 0 for a polyhedron (its inertia is its principal moments)");
+    if (poly && b.vel[i].inv_I != 0)
+      in.bad("3d.vel", i, "inv_I", "is not 0 for a polyhedron (its inertia is its principal moments)");
     if (b.driven[i] > 1) in.bad("3d.driven", i, "", fmt::format("is {} (0 or 1)", b.driven[i]));
     const bool plane = b.shape[i] == Shape3::Plane;
     if (plane && !b.driven[i]) in.bad("3d.driven", i, "", "is 0 for a plane (planes are driven)");
@@ -300,15 +332,11 @@ void check_cell3(const ckpt::Reader& in, const CellState3& c, const Bodies3& b, 
 
 constexpr ckpt::WorldFile kFile{3, "3d.warm.keys", "3d.warm.p"};
 
-// The largest overlap of spheres and planes b in cell c (polyhedra: none
-// recorded, their bounding spheres are not their shapes).
+// The largest overlap of bodies b in cell c (polyhedra: by the narrow
+// phase, their bounding spheres are not their shapes).
 Overlap3 overlap_of3(const Bodies3& b, const CellState3& c, const WorldParams3& p) {
-  PeriodicCell3 cell;
-  cell.origin = p.cell_origin;
-  cell.size = c.size;
-  cell.periodic = p.periodic;
-  cell.le_offset = c.le_offset;
-  return largest_overlap3(b, cell, p.solver.min_parallel);
+  const PeriodicCell3 cell = periodic_cell3(p, c.le_offset, c.size);
+  return deepest_overlap3(b, cell, p.solver.min_parallel);
 }
 
 }  // namespace
@@ -322,8 +350,7 @@ void save_checkpoint3(const std::string& path, const World3& w, std::uint64_t sc
                                            double(p.periodic[1]), double(p.periodic[2]), c.rate.x(), c.rate.y(),
                                            c.rate.z(), c.strain});
     write_poly3(o, w);
-    if (!w.bodies.has_polyhedra())
-      o.array("3d.overlap", std::vector<double>{overlap_of3(w.bodies, c, p).depth});
+    o.array("3d.overlap", std::vector<double>{overlap_of3(w.bodies, c, p).depth});
   });
 }
 
@@ -360,11 +387,11 @@ std::uint64_t load_checkpoint3(const std::string& path, World3& w, RunTotals* to
         }
         PolyState3 poly = read_poly3(in, b, lib, shapes);
         ckpt::check_overlap(in, "3d.overlap", p.d_ref, [&] {
-          try {
-            return overlap_of3(b, c, p);
-          } catch (const std::exception& e) {
-            in.fail(fmt::format("is corrupt: its bodies cannot be detected in its cell ({})", e.what()));
-          }
+          if (poly.shapes.empty()) return overlap_of3(b, c, p);
+          Bodies3 shaped = b;  // the polyhedra as the world will hold them
+          shaped.polyhedra = lib;
+          shaped.shape_id = poly.shape_id;
+          return overlap_of3(shaped, c, p);
         });
         return std::pair{c, std::move(poly)};
       },

@@ -133,7 +133,8 @@ void keep_polyhedra_memory3(const std::vector<SphereRow>& rows, const std::vecto
   }
 }
 
-Overlap3 largest_polyhedra_overlap3(const Bodies3& bodies, const PeriodicCell3& cell, int min_parallel) {
+Overlap3 deepest_overlap3(const Bodies3& bodies, const PeriodicCell3& cell, int min_parallel) {
+  if (!bodies.has_polyhedra()) return largest_overlap3(bodies, cell, min_parallel);
   CellGrid3 grid;
   std::vector<SphereRow> rows;
   std::vector<ContactInfo3> info;

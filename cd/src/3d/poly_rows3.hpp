@@ -65,11 +65,12 @@ void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const st
                      double alert, const PolyMemory3& memory, std::vector<SphereRow>& rows,
                      std::vector<ContactInfo3>& info, std::vector<PolyPairAxis3>& axes, int min_parallel);
 
-// The largest overlap of a world with polyhedra (the depth of its deepest
-// contact point; 0 if none) and a pair that has it, through the periodic
-// cell (if cell.any()): detect3's bounding-sphere candidates at alert 0,
-// then the narrow phase at the bodies' own positions and orientations.
-Overlap3 largest_polyhedra_overlap3(const Bodies3& bodies, const PeriodicCell3& cell, int min_parallel);
+// The largest overlap of any world (the depth of its deepest contact
+// point; 0 if none) and a pair that has it, through the periodic cell (if
+// cell.any()): detect3's largest_overlap3 for spheres and planes; with
+// polyhedra, detect3's bounding-sphere candidates at alert 0, then the
+// narrow phase at the bodies' own positions and orientations.
+Overlap3 deepest_overlap3(const Bodies3& bodies, const PeriodicCell3& cell, int min_parallel);
 
 // The impulse remembered for a row (its pair's key and its feature), world
 // frame, or null.

@@ -145,16 +145,10 @@ void load_start3(const CompleteScene& cs, World3& w) {
 void check_start_overlaps3(const Scene& s, const World3& w) {
   constexpr double kStartOverlap = 0.05;
   const CellState3& c = w.cell();
-  PeriodicCell3 cell;
-  cell.origin = w.params().cell_origin;
-  cell.size = c.size;
-  cell.periodic = {true, true, true};
-  cell.le_offset = c.le_offset;
+  const PeriodicCell3 cell = periodic_cell3(w.params(), c.le_offset, c.size);
   Overlap3 o;
   try {
-    const int mp = w.params().solver.min_parallel;
-    o = w.bodies.has_polyhedra() ? largest_polyhedra_overlap3(w.bodies, cell, mp)
-                                 : largest_overlap3(w.bodies, cell, mp);
+    o = deepest_overlap3(w.bodies, cell, w.params().solver.min_parallel);
   } catch (const std::exception& e) {
     throw SceneError(fmt::format("shear.start: '{}': {}", s.start, e.what()));
   }

@@ -80,14 +80,16 @@ void World3::configure() {
   std::visit([&](const auto& b) { b.configure(*this); }, boundary_);
 }
 
-PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const {
+PeriodicCell3 periodic_cell3(const WorldParams3& p, double offset, const Vec3& size) {
   PeriodicCell3 c;
-  c.origin = prm_.cell_origin;
+  c.origin = p.cell_origin;
   c.size = size;
-  c.periodic = prm_.periodic;
+  c.periodic = p.periodic;
   c.le_offset = offset;
   return c;
 }
+
+PeriodicCell3 World3::cell_at(double offset, const Vec3& size) const { return periodic_cell3(prm_, offset, size); }
 
 void World3::step() {
   static constexpr StageTable<World3> kTable = {{

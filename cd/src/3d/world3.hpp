@@ -143,6 +143,10 @@ struct CellState3 {
 // shared with the 2D World. The warm-start memory holds the impulses in the
 // world frame, on body 2: re-projected on the new frame when reused, so
 // that a turning frame does not rotate the remembered friction.
+// The periodic cell of parameters p (origin, periodic axes) with lengths
+// `size` at the Lees-Edwards offset `offset`.
+PeriodicCell3 periodic_cell3(const WorldParams3& p, double offset, const Vec3& size);
+
 class World3 : public WorldShell<Bodies3, ContactProblem3, ContactInfo3, Vec3> {
  public:
   // The cell starts from the parameters' lengths and offset, at rest.

@@ -89,7 +89,15 @@ void check_overlap(Reader& in, std::string_view name, double d_ref, Measure&& me
   in.array(name, rec);
   if (rec.size() != 1) in.fail(fmt::format("is corrupt: '{}' holds {} numbers (must be 1)", name, rec.size()));
   in.non_negative(name, 0, "", rec[0]);
-  const auto now = measure();
+  const auto now = [&] {
+    try {
+      return measure();
+    } catch (const CheckpointError&) {
+      throw;
+    } catch (const std::exception& e) {
+      in.fail(fmt::format("is corrupt: its bodies cannot be detected in its cell ({})", e.what()));
+    }
+  }();
   if (!(std::abs(now.depth - rec[0]) <= 1e-9 * d_ref))
     in.fail(fmt::format("is corrupt: its bodies overlap by {:.6g} m at most (bodies {} and {}), but '{}' recorded "
                         "{:.6g} m when it was written: a position or a size was changed since",
