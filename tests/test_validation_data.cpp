@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -127,15 +128,18 @@ TEST(ValidationData, StoredFitsHoldTheirChiSquare) {
 // run's stress and the mean over the last contact snapshots recomputed from
 // the contact forces by cdanalysis. They must agree within 3 combined
 // standard errors. The stress-fabric relation q/p ~ (a_c + a_n + a_t)/2
-// drops products of anisotropies (of order a^2/2 ~ 0.1 for a ~ 0.4): the
-// tensor sum is held to 10 % of q/p.
+// drops products of anisotropies, each with a coefficient of at most 1/2:
+// the tensor sum is held to a relative a^2/2 of q/p, a the largest of a_c,
+// a_fn, a_ft (0.04 for disks to 0.13 for pentagons, whose sum is 10.5 %
+// above q/p, about a_c a_fn / 2).
 TEST(ValidationData, StressFromSeriesSnapshotsAndFabricAgree) {
   const Table t = table("periodic");
   for (std::size_t i = 0; i < t.rows(); ++i) {
     SCOPED_TRACE("ns " + std::to_string(static_cast<int>(t.column("ns")[i])));
     const double mu = t.column("mu")[i], snap = t.column("q_over_p_snap")[i];
     EXPECT_LE(std::abs(mu - snap), 3 * combined(t.column("mu_err")[i], t.column("q_over_p_snap_err")[i]));
-    EXPECT_LE(std::abs(t.column("sum_half_tensor")[i] / snap - 1), 0.10);
+    const double a = std::max({t.column("a_c")[i], t.column("a_fn")[i], t.column("a_ft")[i]});
+    EXPECT_LE(std::abs(t.column("sum_half_tensor")[i] / snap - 1), 0.5 * a * a);
     // Disks have no sides: no side-side contact.
     if (t.column("ns")[i] == 0) {
       EXPECT_EQ(t.column("ss_share")[i], 0);
