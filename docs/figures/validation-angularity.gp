@@ -24,7 +24,7 @@ set grid
 set xrange [-0.1:2.3]
 set xlabel "angularity α = 2π/n_s"
 set x2range [-0.1:2.3]
-set x2tics ("disks" 0, "20" 2*pi/20, "6" 2*pi/6, "4" 2*pi/4, "3" 2*pi/3)
+set x2tics ("disks" 0, "20" 2*pi/20, "6" 2*pi/6, "5" 2*pi/5, "4" 2*pi/4, "3" 2*pi/3)
 set x2tics font ",10"
 set multiplot layout 1,3
 set ylabel "μ* = q/p"
