@@ -33,6 +33,7 @@
 #include "contact3.hpp"
 #include "law3.hpp"
 #include "law_parts3.hpp"
+#include "subspace3.hpp"
 
 namespace cd {
 
@@ -161,9 +162,7 @@ struct BlockCoupling3 {
   static constexpr bool kSubspaceLaw = !L::orthotropic;
   using Scratch = std::vector<BodyVel3>;
   Scratch subspace_scratch() const { return Scratch(vel, vel + nbodies); }
-  // A closed row (r_n + a > 0) is free in its normal component, and in its
-  // tangential ones too when it sticks (|r_t| below mu (r_n + a) by more
-  // than round-off: the local solve puts a sliding impulse on the cone).
+  // The row's free components (subspace3.hpp), its velocity, W's diagonal.
   template <class L>
   void subspace_row(const BlockRow3& r, double* free, double* diag, double* u) const {
     const Vec3 v = velocity(r);
@@ -171,12 +170,7 @@ struct BlockCoupling3 {
       u[j] = v[j];
       diag[j] = r.W(j, j);
     }
-    const double sn = r.r[0] + (L::cohesive ? r.adh : 0.0);
-    const bool closed = sn > 0;
-    const bool sticks =
-        L::tangential && closed && std::sqrt(r.r[1] * r.r[1] + r.r[2] * r.r[2]) < (1.0 - 1e-9) * r.mu * sn;
-    free[0] = closed ? 1.0 : 0.0;
-    free[1] = free[2] = sticks ? 1.0 : 0.0;
+    subspace3::free_components<L>(r.r, r.mu, r.adh, free);
   }
   // y = W p on the rows listed in live, through s (no offsets, no b_n);
   // the other rows' p is zero and their y is not read.
@@ -197,21 +191,13 @@ struct BlockCoupling3 {
       y[3 * i + 2] = r.t2.dot(dv) + r.a2[2].dot(B.w) - r.a1[2].dot(A.w);
     }
   }
-  // r <- the cone's projection of r + d (a sliding row's tangential
-  // impulse held in direction and scaled with the shifted normal one, so
-  // that it stays on the cone's edge), the bodies following.
+  // r <- the cone's projection of the trial r + d (subspace3.hpp), the
+  // bodies following.
   template <class L>
   void subspace_put(BlockRow3& r, const double* d, bool sticking) const {
-    const double a = L::cohesive ? r.adh : 0.0;
-    Vec3 y(r.r[0] + d[0], r.r[1], r.r[2]);
-    if (sticking) {
-      y[1] += d[1];
-      y[2] += d[2];
-    } else if (L::tangential) {
-      y.tail<2>() *= std::max(y[0] + a, 0.0) / (r.r[0] + a);
-    }
+    const Vec3 y = subspace3::trial<L>(r.r, r.adh, d, sticking);
     Vec3 out;
-    project_sphere3(y, L::tangential ? r.mu : 0.0, a, out);
+    project_sphere3(y, L::tangential ? r.mu : 0.0, L::cohesive ? r.adh : 0.0, out);
     const Vec3 dr = out - r.r;
     r.r = out;
     push_impulse(r, dr, vel);

@@ -14,6 +14,7 @@
 #include "contact3.hpp"
 #include "law3.hpp"
 #include "law_parts3.hpp"
+#include "subspace3.hpp"
 #include "sweep.hpp"
 
 namespace cd {
@@ -172,10 +173,7 @@ struct BodyCouplingT3 {
   static constexpr bool kSubspaceLaw = !L::orthotropic;
   using Scratch = std::vector<BodyVel3>;
   Scratch subspace_scratch() const { return Scratch(vel, vel + nbodies); }
-  // A closed row (shifted normal impulse s_n = r_n + a > 0, a the adhesion)
-  // is free in its normal component, and in its tangential ones too when it
-  // sticks (|r_t| below mu s_n by more than round-off: the local solve puts
-  // a sliding impulse on the cone itself).
+  // The row's free components (subspace3.hpp), its velocity, W's diagonal.
   template <class L>
   void subspace_row(const SweepRow3& r, double* free, double* diag, double* u) const {
     const Vec3 v = law_velocity(r);
@@ -184,14 +182,7 @@ struct BodyCouplingT3 {
     u[2] = v[2];
     diag[0] = 1.0 / r.iwnn;  // compliant: W_nn + rho (the row's iwnn)
     diag[1] = diag[2] = 1.0 / r.iwtt;
-    const double sn = r.r[0] + (L::cohesive ? r.adh : 0.0);
-    const bool closed = sn > 0;
-    // |r_t| as law3's project_sphere3 takes it (sqrt, not the libm hypot:
-    // 3.6 % of a dense shear run's time went here).
-    const bool sticks =
-        L::tangential && closed && std::sqrt(r.r[1] * r.r[1] + r.r[2] * r.r[2]) < (1.0 - 1e-9) * r.mu * sn;
-    free[0] = closed ? 1.0 : 0.0;
-    free[1] = free[2] = sticks ? 1.0 : 0.0;
+    subspace3::free_components<L>(r.r, r.mu, r.adh, free);
   }
   // y = W p on the rows listed in live, through s (offsets and b_n left
   // out; compliant: (W + diag(rho, rho_t, rho_t)) p); the other rows' p is
@@ -219,19 +210,11 @@ struct BodyCouplingT3 {
       }
     }
   }
-  // r <- the law's projection of r + d (its local solve's, L::solve): a
-  // sliding row's tangential impulse held in direction and scaled with the
-  // shifted normal one (it stays on the cone's edge).
+  // r <- the law's projection (its local solve's, L::solve) of the trial
+  // r + d (subspace3.hpp).
   template <class L>
   void subspace_put(SweepRow3& r, const double* d, bool sticking) const {
-    Vec3 y(r.r[0] + d[0], r.r[1], r.r[2]);
-    if (sticking) {
-      y[1] += d[1];
-      y[2] += d[2];
-    } else if (L::tangential) {
-      const double a = L::cohesive ? r.adh : 0.0;
-      y.tail<2>() *= std::max(y[0] + a, 0.0) / (r.r[0] + a);
-    }
+    const Vec3 y = subspace3::trial<L>(r.r, r.adh, d, sticking);
     Vec3 out;
     L::solve(r, extra_of(r), y, out);
     const Vec3 dr = out - r.r;
