@@ -176,11 +176,7 @@ struct BlockCoupling3 {
   // the other rows' p is zero and their y is not read.
   void subspace_apply(const BlockRow3* R, const std::vector<int>& live, const double* p, double* y,
                       Scratch& s) const {
-    for (BodyVel3& b : s) {
-      b.v.setZero();
-      b.w.setZero();
-    }
-    for (const int i : live) push_impulse<true>(R[i], Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), s.data());
+    subspace3::scatter(R, live, p, s);
     for (const int i : live) {
       const BlockRow3& r = R[i];
       const BodyVel3& A = s[r.b1];

@@ -189,11 +189,7 @@ struct BodyCouplingT3 {
   // zero and their y is not read.
   [[gnu::flatten]] void subspace_apply(const SweepRow3* R, const std::vector<int>& live, const double* p, double* y,
                                        Scratch& s) const {
-    for (BodyVel3& b : s) {
-      b.v.setZero();
-      b.w.setZero();
-    }
-    for (const int i : live) push_impulse<true>(R[i], Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), s.data());
+    subspace3::scatter(R, live, p, s);
     for (const int i : live) {
       const SweepRow3& r = R[i];
       const BodyVel3& A = s[r.b1];

@@ -5,6 +5,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "vec3.hpp"
 
@@ -39,6 +40,17 @@ inline Vec3 trial(const Vec3& r, double adh, const double* d, bool sticking) {
     y.tail<2>() *= std::max(y[0] + a, 0.0) / (r[0] + a);
   }
   return y;
+}
+
+// The scatter of a product W p: the bodies' copy s zeroed, then every
+// listed row's p pushed into it (the row kind's push_impulse, both bodies).
+template <class Row, class Bodies>
+inline void scatter(const Row* R, const std::vector<int>& live, const double* p, Bodies& s) {
+  for (auto& b : s) {
+    b.v.setZero();
+    b.w.setZero();
+  }
+  for (const int i : live) push_impulse<true>(R[i], Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), s.data());
 }
 
 }  // namespace cd::subspace3
