@@ -76,6 +76,21 @@ std::uint64_t shapes_fingerprint(const std::vector<ConvexPolyhedron>& lib) {
   return h;
 }
 
+// A library as the file holds it: each shape's vertex count, then all
+// the vertices, shape after shape.
+struct FlatShapes3 {
+  std::vector<std::int32_t> count;
+  std::vector<Vec3> vertices;
+};
+FlatShapes3 flat_shapes(const std::vector<ConvexPolyhedron>& lib) {
+  FlatShapes3 f;
+  for (const ConvexPolyhedron& c : lib) {
+    f.count.push_back(static_cast<std::int32_t>(c.vertices().size()));
+    f.vertices.insert(f.vertices.end(), c.vertices().begin(), c.vertices().end());
+  }
+  return f;
+}
+
 void write_poly3(ckpt::Writer& o, const World3& w) {
   const Bodies3& b = w.bodies;
   if (!b.has_polyhedra()) return;
@@ -95,14 +110,9 @@ void write_poly3(ckpt::Writer& o, const World3& w) {
   o.array("3d.poly.memory.axis", axis);
   o.array("3d.poly.memory.feature", feature);
   o.array("3d.poly.memory.p", p);
-  std::vector<std::int32_t> count;
-  std::vector<Vec3> vertices;
-  for (const ConvexPolyhedron& c : b.polyhedra) {
-    count.push_back(static_cast<std::int32_t>(c.vertices().size()));
-    vertices.insert(vertices.end(), c.vertices().begin(), c.vertices().end());
-  }
-  o.array("3d.poly.vertex_count", count);
-  o.array("3d.poly.vertices", vertices);
+  const FlatShapes3 f = flat_shapes(b.polyhedra);
+  o.array("3d.poly.vertex_count", f.count);
+  o.array("3d.poly.vertices", f.vertices);
 }
 
 // The library a file's vertices give (Bodies3::add_shape's frames), or a
@@ -169,15 +179,8 @@ PolyState3 read_poly3(ckpt::Reader& in, const Bodies3& b, std::vector<ConvexPoly
     // The stored vertices, when there are, are the library's, bit for bit
     // (a sample started from this file takes its shapes from them).
     if (!ps.vertex_count.empty() || !ps.vertices.empty()) {
-      std::size_t at = 0;
-      bool same = ps.vertex_count.size() == lib.size();
-      for (std::size_t k = 0; same && k < lib.size(); ++k) {
-        const std::vector<Vec3>& v = lib[k].vertices();
-        same = ps.vertex_count[k] == static_cast<std::int32_t>(v.size()) && at + v.size() <= ps.vertices.size() &&
-               std::equal(v.begin(), v.end(), ps.vertices.begin() + static_cast<std::ptrdiff_t>(at));
-        at += v.size();
-      }
-      if (!same || at != ps.vertices.size())
+      const FlatShapes3 f = flat_shapes(lib);
+      if (f.count != ps.vertex_count || f.vertices != ps.vertices)
         in.fail("is corrupt: '3d.poly.vertex_count' and '3d.poly.vertices' are not the vertices of the shapes "
                 "'3d.poly.shapes' fingerprints");
     }
