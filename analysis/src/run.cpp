@@ -171,6 +171,48 @@ RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume,
   return f;
 }
 
+namespace {
+
+// The anisotropies of a subset of contacts, or nothing when there is none
+// or the forms do not fit them (a few dozen contacts may not).
+std::optional<Anisotropy3> anisotropy3_of(const ContactSet3& cs) {
+  if (cs.empty()) return std::nullopt;
+  try {
+    return anisotropy3(cs);
+  } catch (const AnalysisError&) {
+    return std::nullopt;
+  }
+}
+
+ContactSet3 rows_where(const ContactSet3& cs, bool (*keep)(const Contact3&)) {
+  ContactSet3 out;
+  for (const auto& c : cs)
+    if (keep(c)) out.push_back(c);
+  return out;
+}
+
+bool is_face_face(const Contact3& c) { return c.kind == static_cast<int>(Kind3::FaceFace); }
+bool is_other_polyhedra(const Contact3& c) { return c.kind > 0 && !is_face_face(c); }
+
+}  // namespace
+
+double RunFabric3::kind_share(Kind3 k) const {
+  if (!polyhedra || physical_contacts == 0) return std::nan("");
+  return static_cast<double>(by_kind[static_cast<std::size_t>(k)]) / static_cast<double>(physical_contacts);
+}
+
+double RunFabric3::q_over_p_face_face() const {
+  if (!polyhedra) return std::nan("");
+  const auto ps = principal(stress.s);
+  double e1se1 = 0, e3se3 = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      e1se1 += ps.dir[0][i] * stress_face_face.s[i][j] * ps.dir[0][j];
+      e3se3 += ps.dir[2][i] * stress_face_face.s[i][j] * ps.dir[2][j];
+    }
+  return (e1se1 - e3se3) / 3 / stress.p();
+}
+
 RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double mu, double sliding_tol,
                        double force_rel) {
   RunFabric3 f;
@@ -179,8 +221,17 @@ RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double 
   f.contacts = raw.size();
   const auto forces = as_forces(raw);
   const double f_eps = cd::obs::force_threshold<3>(forces, force_rel);
+  // One contact per force-bearing pair (a pair bears force when one of its
+  // rows does, cdsim's z): a sphere pair's row, a polyhedra pair's points
+  // merged (forces summed), so that the anisotropies weigh each contact once
+  // with its whole force.
+  const ContactSet3 merged = merge_points3(raw);
+  std::map<std::pair<int, int>, const Contact3*> poly;
+  for (const auto& m : merged)
+    if (m.kind > 0) poly.emplace(std::make_pair(m.c.b1, m.c.b2), &m);
   ContactSet3 bearing;
-  for (const auto i : cd::obs::force_bearing_points<3>(forces, f_eps)) bearing.push_back(raw[i]);
+  for (const auto i : cd::obs::force_bearing_points<3>(forces, f_eps))
+    bearing.push_back(raw[i].kind > 0 ? *poly.at({raw[i].c.b1, raw[i].c.b2}) : raw[i]);
   f.physical_contacts = bearing.size();
   if (bearing.empty()) throw AnalysisError(fmt::format("'{}' has no force-bearing contact", f.file));
   try {
@@ -189,17 +240,34 @@ RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double 
     f.aniso_problem = fmt::format("'{}': {}", f.file, e.what());
   }
   f.has_volume = volume > 0;
-  f.stress = contact_stress3(raw, f.has_volume ? volume : 1.0);
+  const double V = f.has_volume ? volume : 1.0;
+  f.stress = contact_stress3(raw, V);
   f.fabric = cd::obs::fabric_tensor<3>(forces, f_eps);
   std::size_t flag = 0, coulomb = 0;
   for (const auto& c : bearing) {
     flag += c.status == 2;
     coulomb += c.c.ft_norm() >= mu * c.c.fn * (1 - sliding_tol);
+    ++f.by_kind[static_cast<std::size_t>(c.kind)];
+    f.polyhedra = f.polyhedra || c.kind > 0;
   }
   const double nb = static_cast<double>(bearing.size());
   f.sliding = static_cast<double>(flag) / nb;
   if (mu > 0) f.sliding_coulomb = static_cast<double>(coulomb) / nb;
-  if (const auto pfile = companion_snapshot(f.file, "spheres")) f.connectivity = connectivity(raw, read_particles(*pfile), f_eps);
+  if (f.polyhedra) {
+    f.aniso_face_face = anisotropy3_of(rows_where(bearing, is_face_face));
+    f.aniso_other = anisotropy3_of(rows_where(bearing, is_other_polyhedra));
+    f.stress_face_face = contact_stress3(rows_where(raw, is_face_face), V);
+    f.stress_other = contact_stress3(rows_where(raw, [](const Contact3& c) { return !is_face_face(c); }), V);
+  }
+  // The bodies for rattlers and z: the spheres and the polyhedra snapshots
+  // with the same number (a polyhedra run writes both, its spheres empty).
+  const auto spheres = companion_snapshot(f.file, "spheres"), polyhedra = companion_snapshot(f.file, "polyhedra");
+  if (spheres || polyhedra) {
+    ParticleSet bodies = spheres ? read_particles(*spheres) : ParticleSet{};
+    if (polyhedra)
+      for (const auto& p : read_polyhedra(*polyhedra)) bodies.push_back(p);
+    f.connectivity = connectivity(raw, bodies, f_eps);
+  }
   return f;
 }
 
@@ -348,8 +416,11 @@ Val window_rate_min(const std::string& run_dir, const Table& series, const std::
   }
 }
 
-const std::vector<std::string> kFabric3Columns = {"a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p",
-                                                  "q_vm_over_p", "mu", "sliding", "z", "non_floating"};
+const std::vector<std::string> kFabric3Columns = {
+    "a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p", "q_vm_over_p", "mu", "sliding", "z", "non_floating",
+    // polyhedra only (nan for spheres): RunFabric3's shares and face-face parts
+    "face_face_share", "edge_face_share", "vertex_face_share", "edge_edge_share", "q_over_p_face_face",
+    "a_c_face_face", "a_n_face_face", "a_t_face_face", "a_c_other", "a_n_other", "a_t_other"};
 
 const Val& WindowFabric3::of(const std::string& column) const {
   const auto i = std::find(kFabric3Columns.begin(), kFabric3Columns.end(), column);
@@ -396,7 +467,16 @@ WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, co
                                    f.stress.q_over_p(), f.stress.q_vm() / f.stress.p(),
                                    f.stress.mu(), f.sliding,
                                    f.connectivity ? f.connectivity->z : nan,
-                                   f.connectivity ? f.connectivity->non_floating : nan};
+                                   f.connectivity ? f.connectivity->non_floating : nan,
+                                   f.kind_share(Kind3::FaceFace), f.kind_share(Kind3::EdgeFace),
+                                   f.kind_share(Kind3::VertexFace), f.kind_share(Kind3::EdgeEdge),
+                                   f.q_over_p_face_face(),
+                                   f.aniso_face_face ? f.aniso_face_face->a_c() : nan,
+                                   f.aniso_face_face ? f.aniso_face_face->a_n() : nan,
+                                   f.aniso_face_face ? f.aniso_face_face->a_t() : nan,
+                                   f.aniso_other ? f.aniso_other->a_c() : nan,
+                                   f.aniso_other ? f.aniso_other->a_n() : nan,
+                                   f.aniso_other ? f.aniso_other->a_t() : nan};
     for (std::size_t i = 0; i < v.size(); ++i) per[i].push_back(v[i]);
     diff.push_back(v[3] - v[5]);  // sum_2_5 - q_over_p
     r.files.push_back(fs::path(f.file).filename().string());

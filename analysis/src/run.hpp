@@ -2,6 +2,7 @@
 // the reader to the steady-state and fabric measurements, so the command
 // line and the report share one path.
 #pragma once
+#include <array>
 #include <cmath>
 #include <optional>
 #include <span>
@@ -101,6 +102,18 @@ struct RunFabric3 {
   double sliding_coulomb = std::nan("");       // |f_t| >= mu f_n (1 - tol), when mu > 0
   Mat3 fabric{};                               // <n n>, cd::obs::fabric_tensor<3>
   std::optional<Connectivity> connectivity;
+  // Polyhedra (rows of kind > 0): the force-bearing physical contacts by
+  // kind (Kind3), the anisotropies of the face-face ones and of the others
+  // (empty when there are none or the forms do not fit them), and the
+  // stress their rows carry (stress = stress_face_face + stress_other).
+  bool polyhedra = false;
+  std::array<std::size_t, kKinds3> by_kind{};
+  std::optional<Anisotropy3> aniso_face_face, aniso_other;
+  Stress3 stress_face_face, stress_other;
+  double kind_share(Kind3 k) const;  // of physical_contacts; NaN without polyhedra
+  // q carried by the face-face rows over p: (e1.s_ff e1 - e3.s_ff e3)/3 / p
+  // on the whole stress's principal axes e1, e3, so that the parts add up to q/p.
+  double q_over_p_face_face() const;
 };
 RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double mu = 0,
                        double sliding_tol = 1e-4, double force_rel = cd::obs::kForceEpsRel);

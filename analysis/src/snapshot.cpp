@@ -75,6 +75,32 @@ ContactSet merge_side_side(const ContactSet& cs) {
   return out;
 }
 
+const char* kind3_name(int kind) {
+  static constexpr const char* names[kKinds3] = {"sphere", "vertex-face", "edge-face", "face-face", "edge-edge"};
+  return kind >= 0 && kind < kKinds3 ? names[kind] : "unknown";
+}
+
+ContactSet3 merge_points3(const ContactSet3& cs) {
+  ContactSet3 out;
+  std::map<std::pair<int, int>, std::size_t> pairs;  // (b1, b2) -> index in out
+  for (const auto& c : cs) {
+    if (c.kind == 0) {
+      out.push_back(c);
+      continue;
+    }
+    const auto [it, first] = pairs.emplace(std::make_pair(c.c.b1, c.c.b2), out.size());
+    if (first) {
+      out.push_back(c);
+      continue;
+    }
+    auto& m = out[it->second];
+    m.c.fn += c.c.fn;
+    for (int a = 0; a < 3; ++a) m.c.ft[a] += c.c.ft[a];
+    m.status = std::max(m.status, c.status);
+  }
+  return out;
+}
+
 namespace {
 
 // VTK's messages while a file is read: counted, the first kept. VTK 9 sends
@@ -241,10 +267,17 @@ ContactSet3 read_contacts3(const std::string& path) {
   auto* b1 = need(cd, "b1", 1, path);
   auto* b2 = need(cd, "b2", 1, path);
   vtkDataArray* branch = cd->GetArray("branch");
+  vtkDataArray* kind = cd->GetArray("kind");  // absent before polyhedra: every row a sphere's
   cs.reserve(static_cast<std::size_t>(n));
   vtkNew<vtkIdList> ids;
   for (vtkIdType i = 0; i < n; ++i) {
     Contact3 c;
+    if (kind) {
+      const double k = kind->GetTuple1(i);
+      if (!(k >= 0 && k < kKinds3) || k != std::floor(k))
+        throw InputError(fmt::format("'{}': contact cell {} has kind {} (0 to {} expected)", path, i, k, kKinds3 - 1));
+      c.kind = static_cast<int>(k);
+    }
     const double* nv = normal->GetTuple(i);
     const double nn = std::sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
     if (std::abs(nn - 1) > 1e-6)
@@ -271,6 +304,37 @@ ContactSet3 read_contacts3(const std::string& path) {
     cs.push_back(c);
   }
   return cs;
+}
+
+ParticleSet read_polyhedra(const std::string& path) {
+  auto pd = read_polydata(path);
+  ParticleSet ps;
+  const vtkIdType n = pd->GetNumberOfCells();
+  if (n == 0) return ps;
+  auto* cd = pd->GetCellData();
+  auto* id = need(cd, "id", 1, path);
+  auto* radius = need(cd, "radius", 1, path);
+  auto* centre = need(cd, "centre", 3, path);
+  vtkDataArray* vel = cd->GetArray("velocity");
+  std::map<int, std::size_t> seen;
+  for (vtkIdType i = 0; i < n; ++i) {
+    const int b = static_cast<int>(id->GetTuple1(i));
+    if (!seen.emplace(b, ps.size()).second) continue;
+    Particle p;
+    p.id = b;
+    const double* x = centre->GetTuple(i);
+    p.x = x[0];
+    p.y = x[1];
+    p.z = x[2];
+    p.radius = radius->GetTuple1(i);
+    if (vel && vel->GetNumberOfComponents() >= 3) {
+      p.vx = vel->GetComponent(i, 0);
+      p.vy = vel->GetComponent(i, 1);
+      p.vz = vel->GetComponent(i, 2);
+    }
+    ps.push_back(p);
+  }
+  return ps;
 }
 
 ParticleSet read_particles(const std::string& path) {
@@ -358,7 +422,8 @@ void write_contacts3(const std::string& path, const ContactSet3& cs, const Parti
   vtkNew<vtkCellArray> lines;
   auto fn = darr("fn", 1), ft = darr("ft", 3), force = darr("force", 3), normal = darr("normal", 3),
        gap = darr("gap", 1);
-  auto status = iarr("status"), b1 = iarr("b1"), b2 = iarr("b2");
+  auto status = iarr("status"), b1 = iarr("b1"), b2 = iarr("b2"), kind = iarr("kind");
+  const bool kinds = std::any_of(cs.begin(), cs.end(), [](const Contact3& k) { return k.kind != 0; });
   for (const auto& k : cs) {
     const auto& c = k.c;
     double x2[3] = {0, 0, 0};
@@ -380,12 +445,14 @@ void write_contacts3(const std::string& path, const ContactSet3& cs, const Parti
     status->InsertNextValue(k.status);
     b1->InsertNextValue(c.b1);
     b2->InsertNextValue(c.b2);
+    kind->InsertNextValue(k.kind);
   }
   vtkNew<vtkPolyData> pd;
   pd->SetPoints(pts);
   pd->SetLines(lines);
   for (auto& a : {fn, ft, force, normal, gap}) pd->GetCellData()->AddArray(a);
   for (auto& a : {status, b1, b2}) pd->GetCellData()->AddArray(a);
+  if (kinds) pd->GetCellData()->AddArray(kind);
   write_polydata(path, pd);
 }
 

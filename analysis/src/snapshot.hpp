@@ -53,17 +53,31 @@ ContactSet merge_side_side(const ContactSet& cs);
 // force-bearing and coordination definitions shared with cdsim.
 std::vector<cd::obs::Contact<2>> as_forces(const ContactSet& cs);
 
-// A contact of a 3D snapshot (cd/src/3d/output3.cpp, docs/3d.md): the
-// shared observables' contact (bodies, unit normal n from body 1 to body 2,
-// fn, the tangential force vector ft on body 2, the branch vector l) and the
-// status flag (0 open, 1 stick, 2 slide). Spheres only: one point per body
-// pair. A wall contact's branch runs from the contact point on the wall to
-// the sphere's centre.
+// A contact row of a 3D snapshot (cd/src/3d/output3.cpp, docs/outputs.md):
+// the shared observables' contact (bodies, unit normal n from body 1 to
+// body 2, fn, the tangential force vector ft on body 2, the branch vector l),
+// the status flag (0 open, 1 stick, 2 slide) and the kind (the `kind`
+// array, 0 when absent). A sphere pair is one row; a polyhedra pair is one
+// row per contact point (1 to 4), the points sharing the pair's normal and
+// branch. A wall contact's branch runs from the wall to the grain's centre.
 struct Contact3 {
   cd::obs::Contact<3> c;
   int status = 0;
+  int kind = 0;
 };
 using ContactSet3 = std::vector<Contact3>;
+
+// The kinds of the `kind` array: a sphere's row, then a polyhedron's
+// contact by the features that touch (1 + cd's PolyContactKind).
+enum class Kind3 { Sphere = 0, VertexFace = 1, EdgeFace = 2, FaceFace = 3, EdgeEdge = 4 };
+inline constexpr int kKinds3 = 5;
+const char* kind3_name(int kind);  // "sphere", "vertex-face", ...; "unknown" out of range
+
+// The points of a polyhedra pair (same bodies, kind > 0) merged into one
+// physical contact: forces summed, normal, branch and kind of the first
+// point, sliding if any point slides (2D's merge_side_side in 3D). Sphere
+// rows are copied as they are. The order is the first points' order.
+ContactSet3 merge_points3(const ContactSet3& cs);
 std::vector<cd::obs::Contact<3>> as_forces(const ContactSet3& cs);
 
 // Readers. Throw AnalysisError naming the file when it is missing, unreadable,
@@ -75,6 +89,10 @@ std::vector<cd::obs::Contact<3>> as_forces(const ContactSet3& cs);
 ContactSet read_contacts(const std::string& vtp_path);
 ContactSet3 read_contacts3(const std::string& vtp_path);
 ParticleSet read_particles(const std::string& vtp_path);
+// The bodies of a 3D polyhedra snapshot (polyhedra_NNNNN.vtp: one cell per
+// face), one per body in the order of their first face: id, centre (the
+// `centre` array), circumradius, velocity.
+ParticleSet read_polyhedra(const std::string& vtp_path);
 
 // Writers of the same format, for synthetic fixtures (tests, examples).
 // Contact lines start at the centre of body b1 (from `centres`, the origin

@@ -48,6 +48,22 @@ std::string bearing_label(const Opt& o) {
   return fmt::format("force-bearing: |f_n| + |f_t| > {:g} <|f_n|>", o.force_rel);
 }
 
+// Polyhedra: the contacts' kinds and what the face-face ones carry.
+void print_kinds3(const RunFabric3& f) {
+  fmt::print("kinds      face-face {:.4f}  edge-face {:.4f}  vertex-face {:.4f}  edge-edge {:.4f}",
+             f.kind_share(Kind3::FaceFace), f.kind_share(Kind3::EdgeFace), f.kind_share(Kind3::VertexFace),
+             f.kind_share(Kind3::EdgeEdge));
+  if (f.by_kind[0] > 0) fmt::print("  sphere {:.4f}", f.kind_share(Kind3::Sphere));
+  fmt::print(" of the force-bearing contacts\n");
+  fmt::print("face-face  carry q/p {:.4f} of the {:.4f}\n", f.q_over_p_face_face(), f.stress.q_over_p());
+  for (const auto& [name, a] : {std::pair{"face-face", &f.aniso_face_face}, std::pair{"others", &f.aniso_other}}) {
+    if (*a)
+      fmt::print("{:<10} a_c {:.4f}  a_n {:.4f}  a_t {:.4f}\n", name, (*a)->a_c(), (*a)->a_n(), (*a)->a_t());
+    else
+      fmt::print("{:<10} no harmonics (too few contacts, or the forms do not fit them)\n", name);
+  }
+}
+
 void fabric3(const Opt& o) {
   if (!o.out.empty())
     throw AnalysisError(fmt::format("fabric --out (polar plots of the angular profiles) is 2D only: '{}' is "
@@ -75,6 +91,7 @@ void fabric3(const Opt& o) {
     fmt::print("harmonics  none: {}\n", f.aniso_problem);
   }
   fmt::print("sliding    {:.4f} of force-bearing contacts (status flag)\n", f.sliding);
+  if (f.polyhedra) print_kinds3(f);
   print_connectivity(f.connectivity, "spheres");
 }
 

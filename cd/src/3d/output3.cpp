@@ -135,6 +135,7 @@ void write_polyhedra_vtp(const World3& w, const std::string& path) {
   auto radius = make_array<vtkDoubleArray>("radius", 1, n);
   auto vel = make_array<vtkDoubleArray>("velocity", 3, n);
   auto omega = make_array<vtkDoubleArray>("omega", 3, n);
+  auto centre = make_array<vtkDoubleArray>("centre", 3, n);  // the body's centroid (the analysis' body list)
   std::vector<vtkIdType> cell;
   vtkIdType k = 0;
   for (std::size_t i = 0; i < b.size(); ++i) {
@@ -154,13 +155,14 @@ void write_polyhedra_vtp(const World3& w, const std::string& path) {
       radius->SetValue(k, b.radius[i]);
       vel->SetTuple3(k, b.vel[i].v.x(), b.vel[i].v.y(), b.vel[i].v.z());
       omega->SetTuple3(k, b.vel[i].w.x(), b.vel[i].w.y(), b.vel[i].w.z());
+      centre->SetTuple3(k, b.pos[i].x(), b.pos[i].y(), b.pos[i].z());
       ++k;
     }
   }
   vtkNew<vtkPolyData> pd;
   pd->SetPoints(pts);
   pd->SetPolys(polys);
-  add_arrays(pd->GetCellData(), id, shape, radius, vel, omega);
+  add_arrays(pd->GetCellData(), id, shape, radius, vel, omega, centre);
   write_vtp(pd, path);
 }
 
