@@ -70,7 +70,7 @@ help:
 	@echo "  make campaign-inertial          mu(I): one run per I of INERTIAL_I, from a compacted sample"
 	@echo "  make campaign-inertial-ladder   the same values of I from the highest down, each from the point above"
 	@echo "  make campaign-cohesive          each eta of COHESIVE_ETA at each I of COHESIVE_I"
-	@echo "  make campaign-angularity        each shape of ANGULAR_NS (2D) at ANGULAR_I"
+	@echo "  make campaign-angularity        each shape of ANGULAR_NS (2D) or ANGULAR_SHAPES (3D) at ANGULAR_I"
 	@echo "  make campaign-walls             the same shapes between rough walls (the walls protocol, 2D)"
 	@echo "  make campaign-pressure          steady shear at PRESSURE_I under each p of PRESSURE_P"
 	@echo "  make campaign-pressure-ladder   the same from the lowest p up, each from the point below"
@@ -122,6 +122,7 @@ help:
 	$(call help_var,COHESIVE_I,its inertial numbers)
 	$(call help_var,COHESIVE_TOL,its solver.tol (empty: configs/shear-cohesive.toml's))
 	$(call help_var,ANGULAR_NS,polygon sides of campaign-angularity (0: disks))
+	$(call help_var,ANGULAR_SHAPES,its 3D shapes (particles.shape; sphere: spheres))
 	$(call help_var,ANGULAR_I,its inertial number)
 	$(call help_var,VALIDATE,make validate-angularity's folder)
 	$(call help_var,VALIDATE_CHECK,make validate-check's refits)
@@ -373,6 +374,8 @@ COHESIVE_TOL ?=
 cohesive_tol = $(or $(COHESIVE_TOL),$(shell $(BUILD)/cd/cdsim configs/shear-cohesive.toml --print-scene \
   | awk '$$1 == "tol" { print $$3; exit }'))
 ANGULAR_NS ?= 0 3 4 5 6 8 10 20 60
+# DIM=3: the grains' shapes (particles.shape; sphere: spheres), one run each
+ANGULAR_SHAPES ?= sphere tetrahedron cube octahedron dodecahedron icosahedron irregular
 ANGULAR_I ?= 0.01
 # Threads of each cdsim run: `make -jJ` runs J at once, so each gets nproc/J
 # threads (at least 1; plain -j: 1); THREADS=n overrides. More threads than
@@ -416,7 +419,8 @@ CAMPAIGN_SET = --progress $(PROGRESS) --set output.quiet=true --set output.check
 
 inertial_runs   := $(foreach i,$(INERTIAL_I),$(CAMPAIGNS)/inertial/I_$(i))
 cohesive_runs   := $(foreach e,$(COHESIVE_ETA),$(foreach i,$(COHESIVE_I),$(CAMPAIGNS)/cohesive/eta_$(e)_I_$(i)))
-angularity_runs := $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/angularity/ns_$(n))
+angularity_runs := $(if $(dim3),$(foreach s,$(ANGULAR_SHAPES),$(CAMPAIGNS)/angularity/shape_$(s)),\
+  $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/angularity/ns_$(n)))
 walls_runs      := $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/walls/ns_$(n))
 
 .PHONY: campaign-inertial campaign-cohesive campaign-angularity campaign-walls campaign-list campaign-status programs
@@ -436,11 +440,11 @@ pressure-ladder_runs = $(pressure_ladder_runs)
 status_campaigns = $(or $(CAMPAIGN),$(foreach c,inertial inertial-ladder cohesive angularity walls pressure pressure-ladder volume,\
   $(if $(wildcard $(CAMPAIGNS)/$(c)),$(c))))
 prep_runs = $(CAMPAIGNS)/prep/ns_0 $(if $(filter angularity,$(status_campaigns)),$(filter-out %/ns_0,\
-  $(foreach n,$(ANGULAR_NS),$(CAMPAIGNS)/prep/ns_$(n))))
+  $(foreach r,$(angularity_runs),$(CAMPAIGNS)/prep/$(notdir $(r)))))
 campaign-status:
 	@cd/campaign/status.sh $(CAMPAIGNS) $(foreach c,prep $(status_campaigns),$(call help_q,$(c)=$($(c)_runs)))
 campaign-prep-of:
-	@case "$(RUN)" in */angularity/ns_*) echo $(CAMPAIGNS)/prep/$(notdir $(RUN))/.done ;; \
+	@case "$(RUN)" in */angularity/ns_*|*/angularity/shape_*) echo $(CAMPAIGNS)/prep/$(notdir $(RUN))/.done ;; \
 	  */walls/ns_*) echo programs ;; \
 	  *) echo $(CAMPAIGNS)/prep/ns_0/.done ;; esac
 
@@ -468,7 +472,7 @@ manifest_keys_inertial-ladder := LADDER_STRAIN SHEAR_TOL SHEAR_SET INERTIAL_I
 manifest_keys_cohesive := STRAIN SHEAR_TOL SHEAR_SET COHESIVE_TOL
 manifest_record_cohesive := COHESIVE_ETA COHESIVE_I
 manifest_keys_angularity := STRAIN SHEAR_TOL SHEAR_SET ANGULAR_I
-manifest_record_angularity := ANGULAR_NS
+manifest_record_angularity := $(if $(dim3),ANGULAR_SHAPES,ANGULAR_NS)
 manifest_keys_walls := STRAIN SHEAR_TOL SHEAR_SET ANGULAR_I
 manifest_record_walls := ANGULAR_NS
 manifest_keys_pressure := STRAIN SHEAR_TOL SHEAR_SET PRESSURE_I
@@ -598,8 +602,27 @@ $(CAMPAIGNS)/cohesive/eta_%/.done: $(CAMPAIGNS)/prep/ns_0/.done | $(CAMPAIGNS)/c
 	touch $@
 
 $(CAMPAIGNS)/angularity/ns_%/.done: $(CAMPAIGNS)/prep/ns_%/.done | $(CAMPAIGNS)/angularity/.manifest-check
-	$(if $(dim3),@echo "campaign-angularity is 2D only (3D grains are spheres)"; exit 2)
+	$(if $(dim3),@echo "ns_$*: polygons are 2D; DIM=3 runs the shapes of ANGULAR_SHAPES"; exit 2)
 	$(call shear_run,$(ANGULAR_I),$*)
+	touch $@
+
+# DIM=3: shape_<s> is a sample of grains of particles.shape = s (the
+# sphere's: spheres), compacted as the spheres' samples are, then sheared
+# at ANGULAR_I as every 3D run (the shear policy at I; the sample gives the
+# shapes, so the shear names none).
+shape_set = $(if $(filter-out sphere,$(1)),--set particles.shape='"$(1)"')
+$(CAMPAIGNS)/prep/shape_%/.done: | programs $(CAMPAIGNS)/prep/.manifest-check $(goal_manifests)
+	$(if $(dim3),,@echo "shape_$*: polyhedra are 3D (DIM=3)"; exit 2)
+	$(CDSIM) $(PREP_SCENE) --out $(@D) $(CAMPAIGN_SET) --set output.checkpoint_strain=0 \
+	  --set output.snapshot_interval=0 $(call shape_set,$*) \
+	  --set particles.n=$(N) --set shear.pressure=$(P) \
+	  --set particles.size_ratio=$(SIZE_RATIO) --set particles.size_dist=$(SIZE_DIST) \
+	  --set shear.width=0 --set shear.height=0 $(PREP_SET)
+	touch $@
+.PRECIOUS: $(CAMPAIGNS)/prep/shape_%/.done
+$(CAMPAIGNS)/angularity/shape_%/.done: $(CAMPAIGNS)/prep/shape_%/.done | $(CAMPAIGNS)/angularity/.manifest-check
+	$(if $(dim3),,@echo "shape_$*: polyhedra are 3D (DIM=3)"; exit 2)
+	$(call shear_cmd,$(ANGULAR_I),$(CAMPAIGNS)/prep/shape_$*,$(P),$(STRAIN))
 	touch $@
 
 # The walls protocol (docs/shear.md): N grains of each shape placed loose
