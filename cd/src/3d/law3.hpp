@@ -236,7 +236,8 @@ inline Branch3 solve_plane(double wnn, double wnt, double wtt, double bn, double
 // sought first from its slip direction (slide_unit_from), the scan only
 // if that fails. The answer is a solution of the law either way; where the
 // law has several slides (a strongly coupled block and a large mu), the
-// guess picks the one nearest the sweep's path. W_inv (optional): W's
+// guess picks the one nearest the sweep's path; with a guess, the stick
+// trial's direction is tried next. W_inv (optional): W's
 // inverse, for the stick trial (a row's, computed once per solve).
 inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double a, Vec3& r,
                             const Vec3* guess = nullptr, const Mat3* W_inv = nullptr) {
@@ -262,8 +263,15 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
       const Mat3 Wt = T.asDiagonal() * W * T.asDiagonal();
       const Vec3 bt = T.cwiseProduct(b);
       Vec3 p;
-      const bool warm = guess && ((*guess)[1] != 0.0 || (*guess)[2] != 0.0) &&
-                        slide_unit_from(Wt, bt, std::atan2((*guess)[2] / c.mu_b, (*guess)[1] / c.mu_a), p);
+      bool warm = false;
+      if (guess) {
+        if ((*guess)[1] != 0.0 || (*guess)[2] != 0.0)
+          warm = slide_unit_from(Wt, bt, std::atan2((*guess)[2] / c.mu_b, (*guess)[1] / c.mu_a), p);
+        // A slide that starts (the guess sticks) or turned far: from the
+        // stick trial's direction, the slide's own for an isotropic block
+        // and near it otherwise; the scan only if that fails too.
+        if (!warm) warm = slide_unit_from(Wt, bt, std::atan2(g[2] / c.mu_b, g[1] / c.mu_a), p);
+      }
       if (warm || slide_unit(Wt, bt, p)) {
         s = T.cwiseProduct(p);
         br = Branch3::Slide;
