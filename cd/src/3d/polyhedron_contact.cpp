@@ -299,7 +299,144 @@ void check_size(const ConvexPolyhedron& P, const char* name) {
                                 " has too many features for the point keys (2^20)");
 }
 
+// A sphere against a polyhedron, in the polyhedron's centroid frame. One
+// point is wanted, so the sphere's centre is taken into that frame (one
+// rotation) rather than the polyhedron placed in the world's (O(V + F)).
+
+enum class Feature : std::uint8_t { Face, Edge, Vertex };
+
+// The polyhedron's surface point nearest a point p: its feature (a face,
+// an edge or a vertex by index), the outward unit normal there and p's
+// signed distance along it (negative inside).
+struct Nearest {
+  Feature feature = Feature::Face;
+  int index = 0;
+  Vec3 n = Vec3::UnitZ();
+  double distance = 0.0;
+};
+
+// Whether x, in face f's plane, lies in the face: no farther than slack
+// outside any of its side planes.
+bool in_face(const ConvexPolyhedron& P, int f, const Vec3& x, double slack) {
+  const PolyFace& F = P.faces()[static_cast<std::size_t>(f)];
+  const std::vector<Vec3>& V = P.vertices();
+  const std::size_t m = F.loop.size();
+  for (std::size_t k = 0; k < m; ++k) {
+    const Vec3& a = V[static_cast<std::size_t>(F.loop[k])];
+    const Vec3 side = (V[static_cast<std::size_t>(F.loop[(k + 1) % m])] - a).cross(F.normal).normalized();
+    if (side.dot(x - a) > slack) return false;
+  }
+  return true;
+}
+
+// The nearest point of P's edges to p (outside P): the first edge at the
+// least distance. An end point is the vertex itself (not v0 + 1 (v1 - v0),
+// a round-off away), so that edges meeting at the nearest vertex tie
+// exactly and the first of them is taken whatever the others give. Within
+// slack of an end, the feature is that vertex, so that a sphere resting
+// on a vertex keeps its key; the point stays the edge's.
+Nearest nearest_on_edges(const ConvexPolyhedron& P, const Vec3& p, double slack) {
+  const std::vector<Vec3>& V = P.vertices();
+  double best = std::numeric_limits<double>::infinity();
+  int e_best = 0;
+  double along = 0.0, length = 0.0;
+  Vec3 x_best = Vec3::Zero();
+  for (int e = 0; e < static_cast<int>(P.edges().size()); ++e) {
+    const PolyEdge& E = P.edges()[static_cast<std::size_t>(e)];
+    const Vec3 &a = V[static_cast<std::size_t>(E.v0)], &b = V[static_cast<std::size_t>(E.v1)];
+    const Vec3 u = b - a;
+    const double t = (p - a).dot(u) / u.squaredNorm();
+    const Vec3 x = t <= 0.0 ? a : t >= 1.0 ? b : Vec3(a + t * u);
+    const double d2 = (p - x).squaredNorm();
+    if (d2 < best) {
+      best = d2;
+      e_best = e;
+      x_best = x;
+      along = std::clamp(t, 0.0, 1.0);
+      length = u.norm();
+    }
+  }
+  const PolyEdge& E = P.edges()[static_cast<std::size_t>(e_best)];
+  Nearest h;
+  h.distance = std::sqrt(best);
+  h.n = (p - x_best) / h.distance;
+  if (along * length <= slack) {
+    h.feature = Feature::Vertex;
+    h.index = E.v0;
+  } else if ((1.0 - along) * length <= slack) {
+    h.feature = Feature::Vertex;
+    h.index = E.v1;
+  } else {
+    h.feature = Feature::Edge;
+    h.index = e_best;
+  }
+  return h;
+}
+
+// The contact of the sphere (c, r) with P at pose; the polyhedron is B if
+// poly_b (the normal then from the sphere to it), else A.
+std::optional<PolyContact> sphere_polyhedron(const ConvexPolyhedron& P, const Pose3& pose, const Vec3& c,
+                                             double r, double alert, bool poly_b) {
+  check_size(P, poly_b ? "B" : "A");
+  const Eigen::Matrix3d R = pose.orientation.normalized().toRotationMatrix();
+  const Vec3 p = R.transpose() * (c - pose.position);
+  const double slack = kSideSlack * std::min(r, P.circumradius());
+  // The face whose plane is farthest from p (the first on a tie): P lies
+  // behind every face's plane, so no point of P is nearer than that.
+  int f = 0;
+  double s = -std::numeric_limits<double>::infinity();
+  for (int g = 0; g < static_cast<int>(P.faces().size()); ++g) {
+    const PolyFace& F = P.faces()[static_cast<std::size_t>(g)];
+    const double sg = F.normal.dot(p) - F.offset;
+    if (sg > s) {
+      s = sg;
+      f = g;
+    }
+  }
+  if (s - r > alert) return std::nullopt;
+  // Inside P the face of least penetration; outside, the face if p's
+  // projection on it lies in it (then that is the nearest point: a face
+  // holding the nearest point in its interior has the farthest plane),
+  // else an edge or a vertex.
+  const PolyFace& F = P.faces()[static_cast<std::size_t>(f)];
+  Nearest h;
+  if (s <= 0.0 || in_face(P, f, p - s * F.normal, slack)) {
+    h.feature = Feature::Face;
+    h.index = f;
+    h.n = F.normal;
+    h.distance = s;
+  } else {
+    h = nearest_on_edges(P, p, slack);
+  }
+  const double gap = h.distance - r;
+  if (gap > alert) return std::nullopt;
+  const Vec3 n = R * h.n;  // world, from the polyhedron to the sphere
+  static constexpr PolyKeyTag kTag[3] = {PolyKeyTag::Vertex, PolyKeyTag::EdgePair, PolyKeyTag::Corner};
+  static constexpr PolyContactKind kKind[3] = {PolyContactKind::VertexFace, PolyContactKind::SphereEdge,
+                                               PolyContactKind::SphereVertex};
+  const auto which = static_cast<std::size_t>(h.feature);
+  PolyContact out;
+  out.kind = kKind[which];
+  out.axis = {poly_b ? PolyAxisKind::FaceB : PolyAxisKind::FaceA, f, 0};
+  out.normal = poly_b ? Vec3(-n) : n;
+  out.separation = gap;
+  out.count = 1;
+  out.point[0] = {c - (r + 0.5 * gap) * n, gap,
+                  poly_point_key(kTag[which], poly_b, static_cast<std::uint32_t>(h.index), 0, 0)};
+  return out;
+}
+
 }  // namespace
+
+std::optional<PolyContact> collide_sphere(const ConvexPolyhedron& A, const Pose3& pose_a, const Vec3& c,
+                                          double r, double alert) {
+  return sphere_polyhedron(A, pose_a, c, r, alert, false);
+}
+
+std::optional<PolyContact> collide_sphere(const Vec3& c, double r, const ConvexPolyhedron& B,
+                                          const Pose3& pose_b, double alert) {
+  return sphere_polyhedron(B, pose_b, c, r, alert, true);
+}
 
 std::vector<int> reduce_points(std::span<const PolyContactPoint> pts, const Vec3& n, double band) {
   const int m = static_cast<int>(pts.size());

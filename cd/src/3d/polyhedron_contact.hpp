@@ -1,8 +1,8 @@
 // The narrow phase of convex polyhedra (polyhedron.hpp): polyhedron against
-// polyhedron by the separating axis test, and polyhedron against a plane.
+// polyhedron by the separating axis test, polyhedron against a plane, and
+// polyhedron against a sphere by the closest point of its surface.
 // A contact has one normal, a kind, and up to 4 points, each with its gap
 // and a feature key that names it from step to step (for the warm start).
-// Geometry only: no body of the engine is a polyhedron yet.
 //
 // Axes. The candidate axes are the face normals of A, those of B, and the
 // cross products of an edge of A and an edge of B that build a face of the
@@ -78,7 +78,11 @@ struct PolyAxis {
   bool operator==(const PolyAxis&) const = default;
 };
 
-enum class PolyContactKind : std::uint8_t { VertexFace, EdgeFace, FaceFace, EdgeEdge };
+// A sphere's contact (collide_sphere) is VertexFace on a face (its one
+// point as a vertex: the face's normal) and SphereEdge or SphereVertex on
+// an edge or a vertex (the normal along the line from that feature's
+// nearest point to the centre, which no pair of polyhedra has).
+enum class PolyContactKind : std::uint8_t { VertexFace, EdgeFace, FaceFace, EdgeEdge, SphereEdge, SphereVertex };
 
 // A point's feature key: 64 bits, tag (2) | reference is B (1) | reference
 // (21) | a (20) | b (20). The reference is the reference face (face axis),
@@ -88,6 +92,11 @@ enum class PolyContactKind : std::uint8_t { VertexFace, EdgeFace, FaceFace, Edge
 //             face (b counts the face's loop edges from 0);
 //   Corner:   sides a < b of the reference face meeting on the incident face;
 //   EdgePair: edge a of B (b = 0), the reference being A's edge.
+// A sphere's point (collide_sphere) has the polyhedron's feature nearest
+// the centre as its reference, a = b = 0 (the sphere's one point), and the
+// reference bit set when the polyhedron is B: tag Vertex on a face (the
+// sphere's point as the incident vertex), EdgePair on an edge, Corner on a
+// vertex (the reference then a vertex index).
 // Indices must fit (collide throws std::invalid_argument otherwise).
 enum class PolyKeyTag : std::uint8_t { Vertex, EdgeSide, Corner, EdgePair };
 constexpr std::uint64_t poly_point_key(PolyKeyTag tag, bool reference_b, std::uint32_t reference,
@@ -135,6 +144,28 @@ std::optional<PolyContact> collide(const ConvexPolyhedron& A, const Pose3& pose_
 // for a face axis; axis FaceA 0 (the plane's one face).
 std::optional<PolyContact> collide_plane(const Vec3& p0, const Vec3& n, const ConvexPolyhedron& B,
                                          const Pose3& pose_b, double alert);
+
+// The sphere of centre c and radius r (world) against a polyhedron: one
+// point, or nothing if its gap exceeds alert. The polyhedron's nearest
+// feature to c: with c outside, the face whose plane is farthest from c if
+// c's projection on that plane lies in the face (a point less than
+// kSideSlack L outside a side is in it, so that a sphere resting near an
+// edge keeps the face's normal under round-off), else the nearest point of
+// the edges (a vertex if within kSideSlack L of one); with c inside (an
+// overlap beyond the radius), the face of least penetration. The gap is
+// the signed distance of c to the surface less r, the point midway between
+// the two surfaces along the normal, the axis the face farthest from c
+// (FaceA or FaceB by the polyhedron's side), the separation the gap; kind
+// and key as above, L the smaller of r and the circumradius. The first
+// call's polyhedron is A (normal from it to the sphere), the second's is B
+// (normal from the sphere to it): the same point, gap and axis face, the
+// normal negated. Cost O(F + E) plus the face's sides; the centre is taken
+// into the polyhedron's frame (one rotation) rather than the polyhedron
+// placed in the world's.
+std::optional<PolyContact> collide_sphere(const ConvexPolyhedron& A, const Pose3& pose_a, const Vec3& c,
+                                          double r, double alert);
+std::optional<PolyContact> collide_sphere(const Vec3& c, double r, const ConvexPolyhedron& B,
+                                          const Pose3& pose_b, double alert);
 
 // The reduction of more than 4 contact points (a clipped polygon, or a
 // plane's vertices; positions, gaps, the normal) to at most 4 that keep
