@@ -101,7 +101,8 @@ struct ContactInfo3 {
   // which names it within its pair (key) from step to step; 0 otherwise.
   std::uint64_t feature = 0;
   // A polyhedron's contact: 1 + its PolyContactKind (1 vertex-face, 2
-  // edge-face, 3 face-face, 4 edge-edge); 0: a sphere's or a plane's.
+  // edge-face, 3 face-face, 4 edge-edge; with a sphere: 1 on a face, 5 on
+  // an edge, 6 on a vertex); 0: two spheres', or a sphere's and a plane's.
   std::uint8_t kind = 0;
 };
 

@@ -5,13 +5,33 @@
 #include <optional>
 #include <stdexcept>
 
-#include <fmt/format.h>
-
 namespace cd {
 
 namespace {
 
-enum class Candidate : std::uint8_t { Kept, Polyhedra, Refused };
+// What a candidate becomes: kept as detect3 made it (no polyhedron), or
+// the rows of a contact with a polyhedron, from the polyhedron narrow
+// phase (with a polyhedron or a plane) or the sphere's.
+enum class Candidate : std::uint8_t { Kept, Polyhedra, Sphere };
+
+// The narrow phase of candidate (b1, b2) with body 2 at pos2 (its image
+// when the pair meets across the cell): a sphere's with a polyhedron
+// (either one body 1), a plane's, or two polyhedra's with the pair's
+// remembered axis as the hint (face: an edge pair's face contact too).
+std::optional<PolyContact> narrow_phase(const Bodies3& bodies, const std::vector<Vec3>& x,
+                                        const std::vector<Quat>& q, double alert, const PolyMemory3& memory,
+                                        std::uint64_t key, std::size_t b1, std::size_t b2, const Vec3& pos2,
+                                        PolyContact& face) {
+  const Shape3 s1 = bodies.shape[b1], s2 = bodies.shape[b2];
+  const Pose3 pose2{pos2, q[b2]};
+  if (s1 == Shape3::Sphere) return collide_sphere(x[b1], bodies.radius[b1], bodies.polyhedron(b2), pose2, alert);
+  if (s2 == Shape3::Sphere)
+    return collide_sphere(bodies.polyhedron(b1), Pose3{x[b1], q[b1]}, pos2, bodies.radius[b2], alert);
+  if (s1 == Shape3::Plane) return collide_plane(x[b1], bodies.normal[b1], bodies.polyhedron(b2), pose2, alert);
+  const PolyPairMemory3* m = memory.find(key);
+  return collide(bodies.polyhedron(b1), Pose3{x[b1], q[b1]}, bodies.polyhedron(b2), pose2, alert,
+                 m ? std::optional<PolyAxis>(m->axis) : std::nullopt, &face);
+}
 
 }  // namespace
 
@@ -27,37 +47,17 @@ void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const st
 #pragma omp parallel for schedule(static) if (nc >= min_parallel)
   for (int k = 0; k < nc; ++k) {
     const auto u = static_cast<std::size_t>(k);
-    const int b1 = rows[u].b1, b2 = rows[u].b2;
-    const Shape3 s1 = bodies.shape[static_cast<std::size_t>(b1)], s2 = bodies.shape[static_cast<std::size_t>(b2)];
+    const auto b1 = static_cast<std::size_t>(rows[u].b1), b2 = static_cast<std::size_t>(rows[u].b2);
+    const Shape3 s1 = bodies.shape[b1], s2 = bodies.shape[b2];
     if (s1 != Shape3::Polyhedron && s2 != Shape3::Polyhedron) continue;
-    if (s1 == Shape3::Sphere || s2 == Shape3::Sphere) {
-      what[u] = Candidate::Refused;
-      continue;
-    }
-    what[u] = Candidate::Polyhedra;
+    what[u] = s1 == Shape3::Sphere || s2 == Shape3::Sphere ? Candidate::Sphere : Candidate::Polyhedra;
     const ContactInfo3& f = info[u];
     // Body 2's image: its centre seen from body 1 (detect3's branch) when
     // the pair meets across the cell.
     const bool image = f.ix != 0 || f.iy != 0 || f.iz != 0;
-    pos2[u] = image ? Vec3(x[static_cast<std::size_t>(b1)] + f.branch) : x[static_cast<std::size_t>(b2)];
-    const Pose3 pose2{pos2[u], q[static_cast<std::size_t>(b2)]};
-    if (s1 == Shape3::Plane) {
-      hit[u] = collide_plane(x[static_cast<std::size_t>(b1)], bodies.normal[static_cast<std::size_t>(b1)],
-                             bodies.polyhedron(static_cast<std::size_t>(b2)), pose2, alert);
-    } else {
-      const PolyPairMemory3* m = memory.find(f.key);
-      hit[u] = collide(bodies.polyhedron(static_cast<std::size_t>(b1)),
-                       Pose3{x[static_cast<std::size_t>(b1)], q[static_cast<std::size_t>(b1)]},
-                       bodies.polyhedron(static_cast<std::size_t>(b2)), pose2, alert,
-                       m ? std::optional<PolyAxis>(m->axis) : std::nullopt, &face[u]);
-    }
+    pos2[u] = image ? Vec3(x[b1] + f.branch) : x[b2];
+    hit[u] = narrow_phase(bodies, x, q, alert, memory, f.key, b1, b2, pos2[u], face[u]);
   }
-  for (int k = 0; k < nc; ++k)
-    if (what[static_cast<std::size_t>(k)] == Candidate::Refused)
-      throw std::invalid_argument(fmt::format(
-          "bodies {} and {} are a sphere and a polyhedron: contacts between the two are not implemented (a scene "
-          "holds spheres or polyhedra, with planes)",
-          rows[static_cast<std::size_t>(k)].b1, rows[static_cast<std::size_t>(k)].b2));
   // The rows, in the candidates' order.
   std::vector<SphereRow> out;
   std::vector<ContactInfo3> out_info;
@@ -75,7 +75,8 @@ void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const st
     const PolyContact& c = *hit[u];
     const auto b1 = static_cast<std::size_t>(rows[u].b1);
     const bool plane = bodies.shape[b1] == Shape3::Plane;
-    if (!plane) axes.push_back({info[u].key, c.axis});
+    // Only a pair of polyhedra takes its axis as the next step's hint.
+    if (what[u] == Candidate::Polyhedra && !plane) axes.push_back({info[u].key, c.axis});
     // The contact's points, then (an edge pair's) its face's, each set with
     // its own normal.
     for (const PolyContact* cc : {&c, static_cast<const PolyContact*>(&face[u])}) {

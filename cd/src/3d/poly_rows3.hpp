@@ -11,15 +11,19 @@
 // (collide's face_too: 5 rows at most); a point's lever arms
 // run from each body's centroid (a plane's: from its point) to the point,
 // its gap is the point's, its ContactInfo3 key the pair's and its feature
-// the point's key. Candidates without a polyhedron stay as detect3 made
-// them. A sphere meeting a polyhedron is refused (std::invalid_argument):
-// that narrow phase does not exist yet.
+// the point's key. A candidate pair of a sphere and a polyhedron (either
+// body 1) becomes 0 or 1 row, the sphere's narrow phase's point
+// (collide_sphere), set as a polyhedron's: its lever arms run from the
+// centroid and from the sphere's centre to the point, the latter along n,
+// so that the sphere's rotation enters through friction alone. Candidates
+// without a polyhedron stay as detect3 made them.
 //
 // Memory: one entry per pair that had rows (keyed by contact_key3(b1, b2)),
-// holding the axis of its contact (the next narrow phase's hint: the same
-// face or edge pair unless another beats it by the margin) and each row's
-// impulse in the world frame on body 2 by its feature key (a sphere's or a
-// plane's row: feature 0, one per pair). A row of the new step takes the
+// holding the axis of a polyhedra pair's contact (the next narrow phase's
+// hint: the same face or edge pair unless another beats it by the margin;
+// a plane's or a sphere's pair needs none) and each row's
+// impulse in the world frame on body 2 by its feature key (a row of two
+// spheres or of a sphere and a plane: feature 0, one per pair). A row of the new step takes the
 // impulse remembered under its pair and feature (remembered_impulse),
 // projected on its frame by World3's build as spheres' warm start is; a
 // new point starts from zero.
@@ -59,8 +63,8 @@ struct PolyPairAxis3 {
 
 // Replaces the candidate rows (x, q: the bodies' midpoint positions and
 // orientations) as above, with no impulse; axes receives the axis of every
-// pair of polyhedra with rows (the plane's axis is not kept); memory gives
-// the hints.
+// pair of polyhedra with rows (a plane's or a sphere's is not kept); memory
+// gives the hints.
 void polyhedra_rows3(const Bodies3& bodies, const std::vector<Vec3>& x, const std::vector<Quat>& q,
                      double alert, const PolyMemory3& memory, std::vector<SphereRow>& rows,
                      std::vector<ContactInfo3>& info, std::vector<PolyPairAxis3>& axes, int min_parallel);

@@ -128,8 +128,8 @@ struct CellState3 {
   double strain = 0.0;
 };
 
-// Polyhedra (bodies of Shape3::Polyhedron; a scene has them or spheres,
-// with planes either way): detect adds the narrow phase of poly_rows3.hpp
+// Polyhedra (bodies of Shape3::Polyhedron, alone or with spheres, and
+// planes): detect adds the narrow phase of poly_rows3.hpp
 // (the candidates' points), build takes every body's world inverse inertia
 // at the midpoint orientation (ContactProblem3::inv_inertia; the solver
 // then sweeps block rows, block_coupling3.hpp), and solve gives each
