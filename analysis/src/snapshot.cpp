@@ -76,7 +76,8 @@ ContactSet merge_side_side(const ContactSet& cs) {
 }
 
 const char* kind3_name(int kind) {
-  static constexpr const char* names[kKinds3] = {"sphere", "vertex-face", "edge-face", "face-face", "edge-edge"};
+  static constexpr const char* names[kKinds3] = {"sphere",    "vertex-face", "edge-face",    "face-face",
+                                                 "edge-edge", "sphere-edge", "sphere-vertex"};
   return kind >= 0 && kind < kKinds3 ? names[kind] : "unknown";
 }
 

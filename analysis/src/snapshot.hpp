@@ -68,9 +68,10 @@ struct Contact3 {
 using ContactSet3 = std::vector<Contact3>;
 
 // The kinds of the `kind` array: a sphere's row, then a polyhedron's
-// contact by the features that touch (1 + cd's PolyContactKind).
-enum class Kind3 { Sphere = 0, VertexFace = 1, EdgeFace = 2, FaceFace = 3, EdgeEdge = 4 };
-inline constexpr int kKinds3 = 5;
+// contact by the features that touch (1 + cd's PolyContactKind); a sphere
+// on a polyhedron's face is a VertexFace, on its edge or vertex the last two.
+enum class Kind3 { Sphere = 0, VertexFace = 1, EdgeFace = 2, FaceFace = 3, EdgeEdge = 4, SphereEdge = 5, SphereVertex = 6 };
+inline constexpr int kKinds3 = 7;
 const char* kind3_name(int kind);  // "sphere", "vertex-face", ...; "unknown" out of range
 
 // The points of a polyhedra pair (same bodies, kind > 0) merged into one

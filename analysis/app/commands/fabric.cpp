@@ -53,7 +53,8 @@ void print_kinds3(const RunFabric3& f) {
   fmt::print("kinds      face-face {:.4f}  edge-face {:.4f}  vertex-face {:.4f}  edge-edge {:.4f}",
              f.kind_share(Kind3::FaceFace), f.kind_share(Kind3::EdgeFace), f.kind_share(Kind3::VertexFace),
              f.kind_share(Kind3::EdgeEdge));
-  if (f.by_kind[0] > 0) fmt::print("  sphere {:.4f}", f.kind_share(Kind3::Sphere));
+  for (const Kind3 k : {Kind3::Sphere, Kind3::SphereEdge, Kind3::SphereVertex})  // mixtures only
+    if (f.by_kind[static_cast<std::size_t>(k)] > 0) fmt::print("  {} {:.4f}", kind3_name(static_cast<int>(k)), f.kind_share(k));
   fmt::print(" of the force-bearing contacts\n");
   fmt::print("face-face  carry q/p {:.4f} of the {:.4f}\n", f.q_over_p_face_face(), f.stress.q_over_p());
   for (const auto& [name, a] : {std::pair{"face-face", &f.aniso_face_face}, std::pair{"others", &f.aniso_other}}) {
