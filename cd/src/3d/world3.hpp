@@ -136,7 +136,8 @@ struct CellState3 {
 // polyhedron its free angular velocity with the gyroscopic torque by the
 // implicit midpoint rule before the contacts (rigid_rotation.hpp). The
 // warm start is then the pair memory of poly_rows3.hpp in place of the
-// shell's. Checkpoints, problem dumps and the compliant law refuse them.
+// shell's. Checkpoints and problem dumps hold them (checkpoint3.hpp,
+// dump3.hpp); the compliant law refuses them.
 //
 // The shell (bodies, clock, timers, the last step's problem and records,
 // solver slot, warm-start memory, colour stage) is core/world_shell.hpp's,
