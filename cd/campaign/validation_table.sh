@@ -18,15 +18,23 @@
 #   WINDOW`.
 # Both then give protocol, ns, N, I, strain (the run's end), window and, at
 # the end, cpu_s, sweeps_mean and build (cdlab_version) of each run.
+# periodic3 (CAMPAIGN/angularity/shape_*, make campaign-angularity DIM=3):
+#   `cdanalysis report` over the finished runs, each over its own steady
+#   window (WINDOW is not used: give -): protocol, shape, N, I, strain,
+#   window_begin, window_end, then mu (-sigma_xy/sigma_yy), nu, z, p and
+#   the fabric (a_c, a_n, a_t, the contact kinds' shares, the q/p of the
+#   face-face contacts, the sliding share, check_rel), each with its _err,
+#   then cpu_s, sweeps_mean, build.
 set -euo pipefail
 CDA=$1 PROTOCOL=$2 CAMPAIGN=$3 WINDOW=$4
 case "$PROTOCOL" in
-  periodic) DIR=$CAMPAIGN/angularity ;;
-  walls) DIR=$CAMPAIGN/walls ;;
-  *) echo "validation_table.sh: protocol '$PROTOCOL': periodic or walls" >&2; exit 2 ;;
+  periodic) DIR=$CAMPAIGN/angularity PATTERN=ns_* ;;
+  walls) DIR=$CAMPAIGN/walls PATTERN=ns_* ;;
+  periodic3) DIR=$CAMPAIGN/angularity PATTERN=shape_* ;;
+  *) echo "validation_table.sh: protocol '$PROTOCOL': periodic, walls or periodic3" >&2; exit 2 ;;
 esac
 runs=()
-for r in $(ls -d "$DIR"/ns_* 2> /dev/null | sort -t_ -k2 -n); do
+for r in $(ls -d "$DIR"/$PATTERN 2> /dev/null | sort -t_ -k2 -n); do
   grep -qs '^status = "done"' "$r/summary.toml" && runs+=("$r")
 done
 [ ${#runs[@]} -gt 0 ] || { echo "validation_table.sh: no finished run in $DIR" >&2; exit 1; }
@@ -46,7 +54,32 @@ cost() {
   echo "$(toml "$s" "" cpu_time),$(toml "$s" "" sweeps_mean),$(toml "$s" "" cdlab_version)"
 }
 
-if [ "$PROTOCOL" = periodic ]; then
+if [ "$PROTOCOL" = periodic3 ]; then
+  out=$(mktemp -d)
+  trap 'rm -rf "$out"' EXIT
+  mkdir "$out/runs"
+  for r in "${runs[@]}"; do ln -s "$r" "$out/runs/$(basename "$r")"; done
+  "$CDA" report "$out/runs" --out "$out/report" > "$out/log" 2>&1 || { cat "$out/log" >&2; exit 1; }
+  steady="mu:shear_stress_ratio nu:packing_fraction z:z p:p"
+  fabric="a_c a_n a_t face_face_share edge_face_share vertex_face_share edge_edge_share q_over_p_face_face sliding check_rel"
+  head="protocol,shape,N,I,strain,window_begin,window_end"
+  for c in $steady; do head="$head,${c%%:*},${c%%:*}_err"; done
+  for c in $fabric; do head="$head,$c,${c}_err"; done
+  echo "$head,cpu_s,sweeps_mean,build"
+  # column NAME of row RUN (by its index) of a report table
+  col() {
+    awk -F, -v want="$2" -v run="$3" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == want) c = i; next }
+      $1 == run { print (c ? $c : "nan"); exit }' "$out/report/$1"
+  }
+  tail -n +2 "$out/report/runs.csv" | while IFS=, read -r i folder _; do
+    r=$(readlink -f "$out/runs/$(basename "${folder//\"/}")")
+    line="periodic3,${r##*/shape_},$(grains "$r"),$(toml "$r/scene.toml" shear inertial_number),$(toml "$r/scene.toml" shear strain)"
+    line="$line,$(col steady.csv window_begin "$i"),$(col steady.csv window_end "$i")"
+    for c in $steady; do line="$line,$(col steady.csv "${c#*:}" "$i"),$(col steady.csv "${c#*:}_err" "$i")"; done
+    for c in $fabric; do line="$line,$(col fabric.csv "$c" "$i"),$(col fabric.csv "${c}_err" "$i")"; done
+    echo "$line,$(cost "$r")"
+  done
+elif [ "$PROTOCOL" = periodic ]; then
   out=$(mktemp -d)
   trap 'rm -rf "$out"' EXIT
   # The table is written before the fit of mu*(alpha), which needs 3 shapes.
