@@ -2,7 +2,8 @@
 // read back pixel by pixel. Synthetic snapshots with known geometry: the
 // force chains must be drawn where the contacts are, in the colour of their
 // force class, polygons with their true sides (not their circumcircle), and
-// in 3D only the slice's spheres and contacts.
+// in 3D only the slice's spheres and contacts, and polyhedra as their
+// sections by the slice.
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
@@ -16,6 +17,9 @@
 #include "analysis/src/picture.hpp"
 #include "analysis/src/snapshot.hpp"
 #include "cli_util.hpp"
+#include "output3.hpp"
+#include "polyhedron.hpp"
+#include "world3.hpp"
 
 namespace fs = std::filesystem;
 using namespace cda;
@@ -160,4 +164,62 @@ TEST(Picture, ThreeDimensionalSlice) {
   const double rc = std::sqrt(1 - 0.01);
   EXPECT_TRUE(near_colour(im, p, -rc, 0, {64, 64, 64}, 60));
   EXPECT_TRUE(blank(im, p, 1, 1.5 + 0.9));
+}
+
+// Two cubes of side a stacked on a floor under gravity along -y, their
+// faces parallel to the axes: the slice z = 0 through their centres cuts
+// each along its true square (not its circumscribed sphere's circle), and
+// each face-to-face contact's four points are drawn as one bar, centre to
+// centre (the floor's from the floor to the lower centre).
+TEST(Picture, PolyhedraAreDrawnAsTheirSections) {
+  ASSERT_TRUE(have_gnuplot()) << "gnuplot is not installed (make deps installs gnuplot-nox)";
+  cd::WorldParams3 prm;
+  prm.dt = 1e-3;
+  prm.gravity = cd::Vec3(0, -9.81, 0);
+  prm.mu = prm.mu_wall = 0.5;
+  prm.alert = 1e-4;
+  prm.solver.tol = 1e-10;
+  prm.solver.max_iter = 10000;
+  cd::World3 w(prm);
+  w.bodies.add_plane(cd::Vec3::Zero(), cd::Vec3(0, 1, 0));
+  const double a = 0.02;
+  const int shape = w.bodies.add_shape(cd::cuboid(a, a, a));
+  w.bodies.add_polyhedron(cd::Vec3(0, a / 2, 0), shape, 2600);
+  w.bodies.add_polyhedron(cd::Vec3(0, 1.5 * a, 0), shape, 2600);
+  for (int k = 0; k < 20; ++k) w.step();
+  int rows = 0;
+  for (const auto& r : w.rows()) rows += r.r[0] > 0;
+  ASSERT_EQ(rows, 8) << "four points under each cube";
+  const auto d = scratch("polyhedra");
+  std::ofstream(d / "scene.toml") << "dimension = 3\n";
+  cd::write_spheres_vtp(w, (d / "spheres_00000.vtp").string());
+  cd::write_polyhedra_vtp(w, (d / "polyhedra_00000.vtp").string());
+  cd::write_contacts3_vtp(w, (d / "contacts_00000.vtp").string());
+  const Picture p = draw_snapshot(d.string(), (d / "slice.png").string(), {-1, 600});
+  ASSERT_TRUE(p.gnuplot_ok);
+  EXPECT_NEAR(p.z_mid, 0, 1e-12);
+  EXPECT_EQ(p.grains, 2u);
+  EXPECT_EQ(p.bars, 2u);
+  const Image im = read_png(p.png);
+  // The squares' sides, at half a side from the centres; nothing on the
+  // circle of the circumscribed sphere's section (radius a sqrt(3)/2)
+  // beside the lower cube, nor at its centre but the bars.
+  EXPECT_TRUE(near_colour(im, p, a / 2, a / 2, {64, 64, 64}, 60));
+  EXPECT_TRUE(near_colour(im, p, -a / 2, 1.5 * a, {64, 64, 64}, 60));
+  EXPECT_TRUE(near_colour(im, p, 0, 2 * a, {64, 64, 64}, 60));  // the upper cube's top side
+  EXPECT_TRUE(blank(im, p, 0.8 * a, 0.5 * a));
+  EXPECT_TRUE(blank(im, p, 0.3 * a, 1.5 * a));
+  // The bars: the cubes' contact (m g, below <fn> = 1.5 m g: the weak
+  // class, its thin line) centre to centre, x = 0 from y = a/2 to 3a/2;
+  // the floor's (2 m g: class [1, 1.5)) from the floor to the lower centre.
+  // (the 1-pixel line is antialiased: some pixel there reddish, not grey)
+  bool reddish = false;
+  const auto [bx, by] = pixel(p, 0, 1.25 * a);
+  for (int dx = -2; dx <= 2; ++dx) {
+    const auto v = im.at(bx + dx, by);
+    reddish = reddish || (v[0] - v[2] > 25 && v[0] > 200);
+  }
+  EXPECT_TRUE(reddish);
+  EXPECT_TRUE(near_colour(im, p, 0, 0.25 * a, hex(kForceClassColour[1])));
+  EXPECT_TRUE(blank(im, p, 0.25 * a, 1.25 * a));
 }

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <map>
 #include <numbers>
+#include <optional>
+#include <set>
 
 #include "plot.hpp"
 #include "scene_info.hpp"
@@ -48,7 +50,24 @@ Picture draw_snapshot(const std::string& run, const std::string& png, const Pict
   const auto [pfile, cfile] = snapshot_pair(run, particles_prefix(dim), opt.snapshot);
   pic.particles = pfile;
   pic.contacts = cfile;
-  const ParticleSet ps = read_particles(pfile);
+  ParticleSet ps = read_particles(pfile);
+  // 3D polyhedra: their bodies (centres, circumradii) from the polyhedra
+  // snapshot of the same number, drawn as their sections by the slice.
+  std::optional<std::string> polyfile;
+  std::set<int> polyhedra;
+  if (dim == 3) {
+    const std::string f = (fs::path(pfile).parent_path() /
+                           ("polyhedra" + fs::path(pfile).filename().string().substr(std::string("spheres").size())))
+                              .string();
+    std::error_code ec;
+    if (fs::is_regular_file(f, ec)) {
+      polyfile = f;
+      for (const auto& p : read_polyhedra(f)) {
+        ps.push_back(p);
+        polyhedra.insert(p.id);
+      }
+    }
+  }
   if (ps.empty()) throw AnalysisError(fmt::format("'{}' holds no particle", pfile));
   std::map<int, const Particle*> by_id;
   for (const auto& p : ps) by_id[p.id] = &p;
@@ -70,7 +89,20 @@ Picture draw_snapshot(const std::string& run, const std::string& png, const Pict
   const auto extend = [&](double x, double y) {
     x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
   };
+  if (polyfile) {
+    pic.particles += " + " + *polyfile;
+    for (const auto& [body, corners] : polyhedra_sections(*polyfile, zmid)) {
+      for (std::size_t k = 0; k <= corners.size(); ++k) {
+        const auto& q = corners[k % corners.size()];
+        grains += fmt::format("{} {}\n", toml_num(q[0]), toml_num(q[1]));
+        extend(q[0], q[1]);
+      }
+      grains += "\n";
+      ++pic.grains;
+    }
+  }
   for (const auto& p : ps) {
+    if (polyhedra.count(p.id)) continue;  // a polyhedron: its section above
     double r = p.radius;
     if (dim == 3) {
       const double dz = p.z - zmid;
@@ -103,7 +135,8 @@ Picture draw_snapshot(const std::string& run, const std::string& png, const Pict
     bars.push_back({xa, ya, xa + lx, ya + ly, fn});
   };
   if (dim == 3) {
-    for (const auto& c : read_contacts3(cfile)) {
+    // A polyhedra pair's points as one contact (their forces summed).
+    for (const auto& c : merge_points3(read_contacts3(cfile))) {
       const auto i2 = by_id.find(c.c.b2);
       if (i2 == by_id.end()) continue;
       const double zb = i2->second->z, za = zb - c.c.l[2];

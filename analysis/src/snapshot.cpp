@@ -338,6 +338,40 @@ ParticleSet read_polyhedra(const std::string& path) {
   return ps;
 }
 
+std::map<int, std::vector<std::array<double, 2>>> polyhedra_sections(const std::string& path, double z0) {
+  auto pd = read_polydata(path);
+  std::map<int, std::vector<std::array<double, 2>>> out;
+  const vtkIdType n = pd->GetNumberOfCells();
+  if (n == 0) return out;
+  auto* id = need(pd->GetCellData(), "id", 1, path);
+  vtkNew<vtkIdList> loop;
+  for (vtkIdType c = 0; c < n; ++c) {
+    pd->GetCellPoints(c, loop);
+    const vtkIdType m = loop->GetNumberOfIds();
+    for (vtkIdType k = 0; k < m; ++k) {
+      // Each edge is on two faces: taken once, from a to b with a < b.
+      const vtkIdType ia = loop->GetId(k), ib = loop->GetId((k + 1) % m);
+      if (ia > ib) continue;
+      double a[3], b[3];
+      pd->GetPoint(ia, a);
+      pd->GetPoint(ib, b);
+      if ((a[2] < z0) == (b[2] < z0)) continue;
+      const double u = (z0 - a[2]) / (b[2] - a[2]);
+      out[static_cast<int>(id->GetTuple1(c))].push_back({a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])});
+    }
+  }
+  for (auto& [body, pts] : out) {
+    double cx = 0, cy = 0;
+    for (const auto& q : pts) cx += q[0], cy += q[1];
+    cx /= static_cast<double>(pts.size());
+    cy /= static_cast<double>(pts.size());
+    std::sort(pts.begin(), pts.end(), [&](const auto& p, const auto& q) {
+      return std::atan2(p[1] - cy, p[0] - cx) < std::atan2(q[1] - cy, q[0] - cx);
+    });
+  }
+  return out;
+}
+
 ParticleSet read_particles(const std::string& path) {
   auto pd = read_polydata(path);
   ParticleSet ps;

@@ -6,6 +6,8 @@
 // on body 2 (fn > 0 repulsive); the branch vector l points from the centre of
 // body 1 to the centre of body 2 (periodic image included).
 #pragma once
+#include <array>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -94,6 +96,10 @@ ParticleSet read_particles(const std::string& vtp_path);
 // face), one per body in the order of their first face: id, centre (the
 // `centre` array), circumradius, velocity.
 ParticleSet read_polyhedra(const std::string& vtp_path);
+// The sections of those bodies by the plane z = z0: per body id that the
+// plane cuts, the corners of its section (a convex polygon: the crossings
+// of its faces' edges), in counter-clockwise order about their mean.
+std::map<int, std::vector<std::array<double, 2>>> polyhedra_sections(const std::string& vtp_path, double z0);
 
 // Writers of the same format, for synthetic fixtures (tests, examples).
 // Contact lines start at the centre of body b1 (from `centres`, the origin
