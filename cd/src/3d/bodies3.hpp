@@ -57,6 +57,12 @@ struct Bodies3 {
 
   std::size_t size() const { return pos.size(); }
   bool is_dynamic(std::size_t i) const { return driven[i] == 0; }
+  // A grain's volume: its polyhedron's, or the sphere's (obs::sphere_volume's
+  // expression); 0 for a plane.
+  double volume(std::size_t i) const {
+    if (shape[i] == Shape3::Polyhedron) return polyhedron(i).volume();
+    return shape[i] == Shape3::Sphere ? 4.0 / 3.0 * std::numbers::pi * radius[i] * radius[i] * radius[i] : 0.0;
+  }
 
   // A sphere of radius r and density rho (kg/m^3); returns its index.
   int add_sphere(const Vec3& x, double r, double rho, const Vec3& v = Vec3::Zero(),

@@ -56,8 +56,7 @@ obs::Coordination coordination3(const World3& w) {
 double packing_fraction3(const Bodies3& b, double V) {
   std::vector<double> vol;
   for (std::size_t i = 0; i < b.size(); ++i)
-    if (b.shape[i] == Shape3::Sphere) vol.push_back(obs::sphere_volume(b.radius[i]));
-    else if (b.shape[i] == Shape3::Polyhedron) vol.push_back(b.polyhedron(i).volume());
+    if (b.shape[i] != Shape3::Plane) vol.push_back(b.volume(i));
   return obs::packing_fraction(vol, {}, V);
 }
 

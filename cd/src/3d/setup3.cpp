@@ -98,17 +98,13 @@ void load_start3(const CompleteScene& cs, World3& w) {
     if (B.shape[i] == Shape3::Plane || !B.is_dynamic(i))
       throw SceneError(fmt::format("shear.start: '{}' holds a plane or a driven grain (body {}); a periodic "
                                    "run starts from a periodic run's grains", s.start, i));
-  // A grain's volume: a sphere's, or its polyhedron's.
-  const auto volume = [&](std::size_t i) {
-    return B.shape[i] == Shape3::Polyhedron ? B.polyhedron(i).volume() : obs::sphere_volume(B.radius[i]);
-  };
   // The grains (all dynamic: checked above) to core/continuation.hpp; a
   // polyhedron's diameter is its circumscribed one, as the scene's sizes.
   continuation::Grains grains{B.size(),
                               [&](std::size_t i) { return B.pos[i].y(); },
                               [&](std::size_t i) -> double& { return B.vel[i].v.x(); },
                               [&](std::size_t i) { return 2 * B.radius[i]; },
-                              [&](std::size_t i) { return B.mass[i] / volume(i); },
+                              [&](std::size_t i) { return B.mass[i] / B.volume(i); },
                               B.has_polyhedra() ? "grains" : "spheres",
                               "kg/m^3"};
   continuation::check_density(grains, s.density);
@@ -122,7 +118,7 @@ void load_start3(const CompleteScene& cs, World3& w) {
   if (cs.pressure <= 0) c.rate = Vec3::Zero();  // volume control: the lengths stay
   if (s.volume_fraction > 0) {
     double solids = 0;
-    for (std::size_t i = 0; i < B.size(); ++i) solids += volume(i);
+    for (std::size_t i = 0; i < B.size(); ++i) solids += B.volume(i);
     const double f = continuation::volume_scale(solids, c.size.prod(), s.volume_fraction, 3);
     const Vec3 o = w.params().cell_origin;
     for (Vec3& x : B.pos) x = o + f * (x - o);
