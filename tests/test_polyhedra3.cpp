@@ -23,6 +23,7 @@
 #include "checkpoint3.hpp"
 #include "cli_util.hpp"
 #include "config.hpp"
+#include "polyhedra_box_util.hpp"
 #include "setup3.hpp"
 #include "shear3_util.hpp"
 #include "polyhedron.hpp"
@@ -416,41 +417,13 @@ namespace {
 // orientations and velocities: the state after `steps` steps.
 std::vector<double> polyhedra_box(int threads, int steps, int& rows) {
   omp_set_num_threads(threads);
-  WorldParams3 p = params(0.4);
-  p.solver.tol = 1e-4;
-  p.solver.max_iter = 30;  // the same sweeps on both runs: identity, not convergence, is tested
-  p.solver.min_parallel = 8;
-  p.alert = 2e-3;
-  World3 w(p);
-  const double L = 0.1;
-  w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
-  w.bodies.add_plane(Vec3(-L / 2, 0, 0), Vec3(1, 0, 0));
-  w.bodies.add_plane(Vec3(L / 2, 0, 0), Vec3(-1, 0, 0));
-  w.bodies.add_plane(Vec3(0, -L / 2, 0), Vec3(0, 1, 0));
-  w.bodies.add_plane(Vec3(0, L / 2, 0), Vec3(0, -1, 0));
-  const double r = 0.01;
-  const int shapes[3] = {w.bodies.add_shape(cuboid(r, r, r)), w.bodies.add_shape(platonic(Platonic::Tetrahedron, r)),
-                         w.bodies.add_shape(platonic(Platonic::Icosahedron, r * 0.7))};
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> U(-1, 1);
-  int k = 0;
-  for (int iz = 0; iz < 3; ++iz)
-    for (int iy = 0; iy < 4; ++iy)
-      for (int ix = 0; ix < 4; ++ix, ++k) {
-        const Vec3 x(-0.03 + 0.02 * ix, -0.03 + 0.02 * iy, 0.01 + 0.018 * iz);
-        const Quat q(Eigen::AngleAxisd(3 * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized()));
-        w.bodies.add_polyhedron(x, shapes[k % 3], kRho, q, 0.2 * Vec3(U(rng), U(rng), U(rng)),
-                                5.0 * Vec3(U(rng), U(rng), U(rng)));
-      }
+  World3 w = cdtest::polyhedra_box(params(0.4), [](World3& w, int k, const Vec3& x, const Quat& q, const Vec3& v,
+                                                   const Vec3& om, const int* shapes) {
+    w.bodies.add_polyhedron(x, shapes[k % 3], kRho, q, v, om);
+  });
   for (int s = 0; s < steps; ++s) w.step();
   rows = static_cast<int>(w.rows().size());
-  std::vector<double> st;
-  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
-    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.pos[i][c]);
-    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.vel[i].w[c]);
-    st.push_back(w.bodies.orient[i].w());
-  }
-  return st;
+  return cdtest::body_state(w);
 }
 
 }  // namespace
