@@ -22,9 +22,9 @@
 #   `cdanalysis report` over the finished runs, each over its own steady
 #   window (WINDOW is not used: give -): protocol, shape, N, I, strain,
 #   window_begin, window_end, then mu (-sigma_xy/sigma_yy), nu, z, p and
-#   the fabric (a_c, a_n, a_t, the contact kinds' shares, the q/p of the
-#   face-face contacts, the sliding share, check_rel), each with its _err,
-#   then cpu_s, sweeps_mean, build.
+#   the fabric (q/p of the snapshots, a_c, a_n, a_t, the contact kinds'
+#   shares, the q/p of the face-face contacts, the sliding share,
+#   check_rel), each with its _err, then cpu_s, sweeps_mean, build.
 set -euo pipefail
 CDA=$1 PROTOCOL=$2 CAMPAIGN=$3 WINDOW=$4
 case "$PROTOCOL" in
@@ -61,7 +61,7 @@ if [ "$PROTOCOL" = periodic3 ]; then
   for r in "${runs[@]}"; do ln -s "$r" "$out/runs/$(basename "$r")"; done
   "$CDA" report "$out/runs" --out "$out/report" > "$out/log" 2>&1 || { cat "$out/log" >&2; exit 1; }
   steady="mu:shear_stress_ratio nu:packing_fraction z:z p:p"
-  fabric="a_c a_n a_t face_face_share edge_face_share vertex_face_share edge_edge_share q_over_p_face_face sliding check_rel"
+  fabric="q_over_p a_c a_n a_t face_face_share edge_face_share vertex_face_share edge_edge_share q_over_p_face_face sliding check_rel"
   head="protocol,shape,N,I,strain,window_begin,window_end"
   for c in $steady; do head="$head,${c%%:*},${c%%:*}_err"; done
   for c in $fabric; do head="$head,$c,${c}_err"; done
