@@ -216,7 +216,7 @@ TEST(AnalysisPolyhedra, AKindOutOfRangeIsRefusedByName) {
 // contacts against the series row of its step.
 TEST(AnalysisPolyhedra, SnapshotMatchesTheSeriesOfARealRunOfCubes) {
   cd::Scene sc = cdtest::shear3_prep_scene(80);
-  sc.shape = cd::Shape3d::Cube;
+  sc.shape = {cd::Shape3d::Cube};
   cd::World3 w = cd::build_world3(sc);
   const double dt = w.params().dt;
   sc.duration = 200 * dt;

@@ -36,7 +36,7 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 
 void compare(const Scene& x, const Scene& y, bool same) {
   const auto& [name, source, dimension, dt, duration, gravity, mu, mu_wall, mu_b, mu_wall_b, axis_a, e_n, e_t, alert, rotation, overlap_correction, overlap_projection, adhesion, stiffness, debond, tol,
-               max_iter, residual_tol, anderson, subspace, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, shape, aspect, vertices, region,
+               max_iter, residual_tol, anderson, subspace, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, shape, shape_fractions, aspect, vertices, region,
                box_width, box_height, box_depth, disks, walls, series_interval, snapshot_interval, series_strain, snapshot_strain,
                checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, cell_depth, shear_control, pressure,
                imposed_rate, rate_tp, volume_fraction, inertial_number, cell_mass, isotropic, compaction_rate, settle_stress, settle_phi, settle_time, strain, dt_tp, start, cohesion_number, stiffness_number, stiffness_ratio] = x;
@@ -46,7 +46,7 @@ void compare(const Scene& x, const Scene& y, bool same) {
   CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(overlap_projection); CHECK_FIELD(adhesion); CHECK_FIELD(stiffness); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(anderson); CHECK_FIELD(subspace); CHECK_FIELD(threads);
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
   CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
-  CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(shape); CHECK_FIELD(aspect); CHECK_FIELD(vertices); CHECK_FIELD(region); CHECK_FIELD(box_width);
+  CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(shape); CHECK_FIELD(shape_fractions); CHECK_FIELD(aspect); CHECK_FIELD(vertices); CHECK_FIELD(region); CHECK_FIELD(box_width);
   CHECK_FIELD(box_height); CHECK_FIELD(box_depth); CHECK_FIELD(series_interval); CHECK_FIELD(snapshot_interval);
   CHECK_FIELD(series_strain); CHECK_FIELD(snapshot_strain);
   CHECK_FIELD(checkpoint_interval); CHECK_FIELD(checkpoint_strain); CHECK_FIELD(checkpoint_wall);
@@ -103,7 +103,8 @@ Scene nondefault() {
   s.density = 7.8;
   s.seed = 4294967295u;
   s.nsides = {0.0, 6.0};
-  s.shape = cd::Shape3d::Irregular;
+  s.shape = {cd::Shape3d::Irregular, cd::Shape3d::Cube};
+  s.shape_fractions = {0.25, 0.75};
   s.aspect = {1.0, 2.0, 3.0};
   s.vertices = 20;
   s.region = {0.0, 0.01, 0.1, 0.2};
@@ -418,9 +419,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 71 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 72 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 71u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 72u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

@@ -446,7 +446,7 @@ namespace {
 // The world of configs/pile-polyhedra.toml, made smaller: 64 cubes.
 Scene small_polyhedra_pile(Shape3d shape) {
   Scene s = load_scene(std::string(CDLAB_SOURCE_DIR) + "/configs/pile-polyhedra.toml");
-  s.shape = shape;
+  s.shape = {shape};
   s.n = 64;
   s.max_iter = 100;  // identity, not convergence, is what these tests see
   return s;
@@ -517,7 +517,7 @@ TEST(Polyhedra3, SceneMakesCuboidsAndIrregularGrains) {
   }
   EXPECT_EQ(grains, 64);
 
-  s.shape = Shape3d::Irregular;
+  s.shape = {Shape3d::Irregular};
   s.aspect = {1.0, 1.0, 2.0};
   s.vertices = 10;
   World3 irr = build_world3(s);
@@ -630,7 +630,7 @@ TEST(Polyhedra3, WarmSlideFindsTheScansSlide) {
 // scene that names a shape is refused (the sample gives them).
 TEST(Polyhedra3, ShearStartsFromASampleOfPolyhedra) {
   Scene prep = cdtest::shear3_prep_scene(100);
-  prep.shape = Shape3d::Cuboid;
+  prep.shape = {Shape3d::Cuboid};
   prep.aspect = {1.0, 1.5, 2.0};
   World3 p = build_world3(prep);
   for (int k = 0; k < 150; ++k) p.step();
@@ -684,7 +684,7 @@ TEST(Polyhedra3, ShearStartsFromASampleOfPolyhedra) {
   EXPECT_LT(mu, 1.5);
 
   Scene named = s;
-  named.shape = Shape3d::Cube;
+  named.shape = {Shape3d::Cube};
   try {
     build_world3(named);
     ADD_FAILURE() << "a started scene naming particles.shape was taken";
@@ -692,3 +692,4 @@ TEST(Polyhedra3, ShearStartsFromASampleOfPolyhedra) {
     EXPECT_NE(std::string(e.what()).find("particles.shape"), std::string::npos) << e.what();
   }
 }
+

@@ -37,7 +37,7 @@ const ContactProblem3& captured() {
   static const ContactProblem3 p = [] {
     Scene s = load_scene(std::string(CDLAB_SOURCE_DIR) + "/configs/pile-polyhedra.toml");
     s.n = 216;
-    s.shape = Shape3d::Cuboid;
+    s.shape = {Shape3d::Cuboid};
     s.aspect = {1.0, 1.5, 2.0};
     s.subspace = 0;
     World3 w = build_world3(s);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <cstdint>
 #include <random>
 #include <utility>
 
@@ -171,23 +172,46 @@ namespace {
 // A Platonic solid or a cuboid (sides in the ratios particles.aspect): one
 // shape per distinct size; an irregular grain: a shape of its own, the hull
 // of particles.vertices points on the ellipsoid of semi-axes in those
-// ratios, seeded by particles.seed and the grain's index. Bodies keep their
-// order and velocities.
-ConvexPolyhedron grain_shape(const Scene& s, double r, std::size_t grain) {
+// ratios, seeded by particles.seed and the grain's index. A mixture (a
+// list particles.shape): grain i's shape is drawn from the list with the
+// number fractions particles.shape_fractions by one uniform of its own,
+// a hash of particles.seed and i; a sphere stays a sphere. Bodies keep
+// their order and velocities.
+ConvexPolyhedron grain_shape(const Scene& s, Shape3d k, double r, std::size_t grain) {
   const Vec3 a(s.aspect[0], s.aspect[1], s.aspect[2]);
-  switch (s.shape) {
+  switch (k) {
     case Shape3d::Cuboid:
       return cuboid(a.x(), a.y(), a.z()).scaled_to_circumradius(r);
     case Shape3d::Irregular:
       return random_polyhedron(s.vertices, a, s.seed * 0x9e3779b97f4a7c15ull + grain).scaled_to_circumradius(r);
     default:
-      return platonic(static_cast<Platonic>(static_cast<int>(s.shape) - 1), r);
+      return platonic(static_cast<Platonic>(static_cast<int>(k) - 1), r);
   }
+}
+
+// Grain i's shape in a mixture: splitmix64 of (seed, i) as a uniform in
+// [0, 1), against the cumulative fractions (equal when none are given).
+Shape3d mixture_shape(const Scene& s, std::size_t i) {
+  std::uint64_t z = (static_cast<std::uint64_t>(s.seed) << 32 ^ i) + 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  z ^= z >> 31;
+  const double u = static_cast<double>(z >> 11) * 0x1.0p-53;
+  const std::size_t n = s.shape.size();
+  double c = 0;
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    c += s.shape_fractions.empty() ? 1.0 / static_cast<double>(n) : s.shape_fractions[k];
+    if (u < c) return s.shape[k];
+  }
+  // the last shape with a nonzero fraction takes the rest
+  for (std::size_t k = n; k-- > 0;)
+    if (s.shape_fractions.empty() || s.shape_fractions[k] > 0) return s.shape[k];
+  return s.shape.back();
 }
 
 Bodies3 polyhedra_of(const Scene& s, const Bodies3& B) {
   Bodies3 out;
-  std::map<double, int> shapes;
+  std::map<std::pair<int, double>, int> shapes;
   std::mt19937_64 g(s.seed ^ 0x9e3779b97f4a7c15ull);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   for (std::size_t i = 0; i < B.size(); ++i) {
@@ -196,15 +220,21 @@ Bodies3 polyhedra_of(const Scene& s, const Bodies3& B) {
       continue;
     }
     const double r = B.radius[i];
+    const Shape3d k = s.shape.size() == 1 ? s.shape[0] : mixture_shape(s, i);
+    const double u1 = U(g), u2 = U(g), u3 = U(g);
+    if (k == Shape3d::Sphere) {
+      out.add_sphere(B.pos[i], r, s.density, B.vel[i].v, B.vel[i].w);
+      continue;
+    }
     int id;
-    if (s.shape == Shape3d::Irregular) {
-      id = out.add_shape(grain_shape(s, r, i));
+    if (k == Shape3d::Irregular) {
+      id = out.add_shape(grain_shape(s, k, r, i));
     } else {
-      auto it = shapes.find(r);
-      if (it == shapes.end()) it = shapes.emplace(r, out.add_shape(grain_shape(s, r, i))).first;
+      auto it = shapes.find({static_cast<int>(k), r});
+      if (it == shapes.end())
+        it = shapes.emplace(std::pair{static_cast<int>(k), r}, out.add_shape(grain_shape(s, k, r, i))).first;
       id = it->second;
     }
-    const double u1 = U(g), u2 = U(g), u3 = U(g);
     const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1), t2 = 2 * std::numbers::pi * u2,
                  t3 = 2 * std::numbers::pi * u3;
     const Quat q(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));
@@ -214,7 +244,7 @@ Bodies3 polyhedra_of(const Scene& s, const Bodies3& B) {
 }
 
 void make_polyhedra3(const Scene& s, World3& w) {
-  if (s.shape != Shape3d::Sphere) w.bodies = polyhedra_of(s, w.bodies);
+  if (!all_spheres(s)) w.bodies = polyhedra_of(s, w.bodies);
 }
 
 }  // namespace

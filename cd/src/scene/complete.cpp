@@ -140,9 +140,9 @@ void check_cell3(const Scene& s) {
     // The spheres and the cell come from the sample (build_cell3).
     if (s.n > 0 || !s.diameters.empty())
       fail3("shear.start gives the grains: set particles.n = 0 and no particles.diameters");
-    if (s.shape != Shape3d::Sphere)
-      fail3(fmt::format("particles.shape = \"{}\": shear.start gives the grains, their shapes too (a sample "
-                        "of polyhedra stores them); leave particles.shape out", name_of(s.shape)));
+    if (!all_spheres(s))
+      fail3(fmt::format("particles.shape = {}: shear.start gives the grains, their shapes too (a sample "
+                        "of polyhedra stores them); leave particles.shape out", shape_text(s.shape)));
     if (s.cell_width != 0 || s.cell_height != 0 || s.cell_depth != 0)
       fail3(fmt::format("shear.width, shear.height, shear.depth = {}, {}, {}: shear.start gives the cell; "
                         "leave them at 0", s.cell_width, s.cell_height, s.cell_depth));
@@ -186,8 +186,11 @@ Scene with_auto_cell3(const Scene& s) {
 
 // What a polyhedra scene (particles.shape) cannot have yet, refused by key.
 void check_polyhedra3(const Scene& s) {
-  if (s.shape == Shape3d::Sphere) return;
-  const std::string what = fmt::format("particles.shape = \"{}\"", name_of(s.shape));
+  if (!s.shape_fractions.empty() && s.shape_fractions.size() != s.shape.size())
+    fail3(fmt::format("particles.shape_fractions: {} fractions for the {} shapes of particles.shape = {}: one per "
+                      "shape, in its order", s.shape_fractions.size(), s.shape.size(), shape_text(s.shape)));
+  if (all_spheres(s)) return;
+  const std::string what = fmt::format("particles.shape = {}", shape_text(s.shape));
   if (contact_stiffness(s) > 0)
     fail3(fmt::format("contact.stiffness: compliant contacts need grains of scalar inertia (spheres); {} grains "
                       "take rigid contacts (no contact.stiffness)", what));

@@ -111,7 +111,7 @@ Rule disk_density() {
 template <class T>
 using Field = std::variant<double T::*, int T::*, unsigned T::*, bool T::*, std::string T::*,
                            std::array<double, 2> T::*, std::vector<double> T::*, ShearMode T::*,
-                           ShearControl T::*, SizeDist T::*, Shape3d T::*>;
+                           ShearControl T::*, SizeDist T::*, std::vector<Shape3d> T::*>;
 
 template <class T>
 struct Param {
@@ -162,7 +162,8 @@ const std::vector<Param<Scene>>& scene_params() {
       {"particles", "density", &Scene::density, "kg/m^2 (2D), kg/m^3 (3D)", gt(0), "2D: mass per unit area (2600 kg/m^3 x 1 mm = 2.6); 3D: mass per unit volume (2600 for glass)"},
       {"particles", "seed", &Scene::seed, "", any(), "random seed of sizes and positions"},
       {"particles", "nsides", &Scene::nsides, "", side_list(), "shapes of the generated particles, drawn uniformly from the list: 0 disk, n >= 3 regular n-gon (sizes are then circumscribed diameters)"},
-      {"particles", "shape", &Scene::shape, "", one_of<Shape3d>(), "3D only: the generated grains' shape: spheres, or a convex polyhedron of the engine (docs/3d.md) whose circumscribed diameter is the grain's size, placed at a random orientation: a Platonic solid, a cuboid (particles.aspect), or an irregular polyhedron, each grain its own (particles.vertices, particles.aspect)"},
+      {"particles", "shape", &Scene::shape, "", {names_text<Shape3d>() + ", or a non-empty list of them", {}}, "3D only: the generated grains' shape: spheres, or a convex polyhedron of the engine (docs/3d.md) whose circumscribed diameter is the grain's size, placed at a random orientation: a Platonic solid, a cuboid (particles.aspect), or an irregular polyhedron, each grain its own (particles.vertices, particles.aspect); a list: a mixture, each grain's shape drawn from the list by particles.seed and its index, with the number fractions particles.shape_fractions"},
+      {"particles", "shape_fractions", &Scene::shape_fractions, "", any(), "3D only: with a list particles.shape, the number fraction of each of its shapes, in its order: each >= 0, summing to 1; [] (the default): equal fractions"},
       {"particles", "aspect", &Scene::aspect, "", vector_of(3, 3), "3D only: with particles.shape = \"cuboid\", the ratios of its sides (along its own x, y, z); with \"irregular\", of the semi-axes of the ellipsoid its points are drawn on; each > 0, largest / smallest <= 100; refused with other shapes"},
       {"particles", "vertices", &Scene::vertices, "", in(4, 1000), "3D only: with particles.shape = \"irregular\", the number of random points (uniform on the ellipsoid) whose convex hull is each grain (those inside it dropped); refused with other shapes"},
       {"particles", "region", &Scene::region, "m", region(), "generation region [xmin, ymin, xmax, ymax]; []: inside the box"},
@@ -362,6 +363,27 @@ std::string get(const toml::value& v, E& x) {
   return "";
 }
 
+// particles.shape: a name, or a non-empty list of names.
+std::string get(const toml::value& v, std::vector<Shape3d>& x) {
+  std::vector<Shape3d> out;
+  const auto one = [&](const toml::value& e) {
+    Shape3d k{};
+    std::string err = get(e, k);
+    if (err.empty()) out.push_back(k);
+    return err;
+  };
+  if (v.is_array()) {
+    if (v.as_array().empty())
+      return fmt::format(": expected a name or a non-empty list of names: {}", names_text<Shape3d>());
+    for (const toml::value& e : v.as_array())
+      if (std::string err = one(e); !err.empty()) return err;
+  } else if (std::string err = one(v); !err.empty()) {
+    return err;
+  }
+  x = std::move(out);
+  return "";
+}
+
 std::string get(const toml::value& v, std::vector<double>& x) {
   if (!v.is_array()) return ": expected an array of numbers, got " + type_name(v);
   std::vector<double> out(v.as_array().size());
@@ -414,6 +436,7 @@ template <class E>
 std::string text(E x, bool toml) {
   return text(std::string(name_of(x)), toml);
 }
+std::string text(const std::vector<Shape3d>& x, bool) { return shape_text(x); }
 template <std::size_t N>
 std::string text(const std::array<double, N>& x, bool toml) {
   return text(std::vector<double>(x.begin(), x.end()), toml);
@@ -423,6 +446,7 @@ template <class X>
 Val to_val(const X& x) {
   if constexpr (std::is_same_v<X, bool> || std::is_same_v<X, std::string>) return x;
   else if constexpr (std::is_enum_v<X>) return std::string(name_of(x));
+  else if constexpr (std::is_same_v<X, std::vector<Shape3d>>) return shape_text(x);
   else if constexpr (std::is_arithmetic_v<X>) return static_cast<double>(x);
   else return std::vector<double>(x.begin(), x.end());
 }
@@ -623,10 +647,28 @@ Scene read_scene(const toml::value& root, const std::string& path) {
     out.add(child(child(root, "box"), "depth"), "depth",
             fmt::format("box.depth = {}: only a dimension = 3 scene has a depth",
                         text(s.box_depth, false)));
-  if (s.dimension == 2 && s.shape != Shape3d::Sphere)
+  if (s.dimension == 2 && !all_spheres(s))
     out.add(child(child(root, "particles"), "shape"), "shape",
-            fmt::format("particles.shape = \"{}\": a dimension = 3 key; 2D shapes are particles.nsides",
-                        name_of(s.shape)));
+            fmt::format("particles.shape = {}: a dimension = 3 key; 2D shapes are particles.nsides",
+                        shape_text(s.shape)));
+  if (!s.shape_fractions.empty()) {
+    const toml::value& at = child(child(root, "particles"), "shape_fractions");
+    const std::string f = "particles.shape_fractions = " + text(s.shape_fractions, false);
+    double sum = 0;
+    for (const double x : s.shape_fractions) sum += x;
+    const auto neg = std::find_if(s.shape_fractions.begin(), s.shape_fractions.end(), [](double x) { return x < 0; });
+    if (s.dimension == 2)
+      out.add(at, "shape_fractions", f + ": a dimension = 3 key; 2D shapes are particles.nsides");
+    else if (s.shape_fractions.size() != s.shape.size())
+      out.add(at, "shape_fractions",
+              fmt::format("{}: {} fractions for the {} shapes of particles.shape = {}: one per shape, in its order",
+                          f, s.shape_fractions.size(), s.shape.size(), shape_text(s.shape)));
+    else if (neg != s.shape_fractions.end())
+      out.add(at, "shape_fractions",
+              fmt::format("{}: element {} is {}: must be >= 0", f, neg - s.shape_fractions.begin(), text(*neg, false)));
+    else if (!(std::abs(sum - 1) <= 1e-9))
+      out.add(at, "shape_fractions", fmt::format("{}: the fractions sum to {}: must sum to 1 (within 1e-9)", f, sum));
+  }
   if (s.dimension == 2 && s.subspace > 0)
     out.add(child(child(root, "solver"), "subspace"), "subspace",
             fmt::format("solver.subspace = {}: the subspace correction serves 3D spheres only (dimension = 3); "
@@ -714,7 +756,7 @@ void apply_override(toml::value& root, const std::string& set) {
                       std::holds_alternative<ShearMode Scene::*>(p->field) ||
                       std::holds_alternative<ShearControl Scene::*>(p->field) ||
                       std::holds_alternative<SizeDist Scene::*>(p->field) ||
-                      std::holds_alternative<Shape3d Scene::*>(p->field) ||
+                      std::holds_alternative<std::vector<Shape3d> Scene::*>(p->field) ||
                       (value == "auto" && auto_key(key));
     if (!word)
       throw ConfigError(fmt::format("{}: '{}' is not a TOML value (a number, true, false, "

@@ -183,15 +183,15 @@ static void check_settings_act(const Scene& s) {
     fail(fmt::format("contact.debond = {}: the debonding distance acts only on adhesive contacts "
                      "(contact.adhesion or contact.cohesion_number > 0)",
                      s.debond));
-  const bool stretched = s.shape == Shape3d::Cuboid || s.shape == Shape3d::Irregular;
+  const bool stretched = has_shape(s, Shape3d::Cuboid) || has_shape(s, Shape3d::Irregular);
   if (!stretched && s.aspect != d.aspect)
     fail(fmt::format("particles.aspect = [{}]: the ratios act only on particles.shape = \"cuboid\" or "
-                     "\"irregular\" (here \"{}\"); leave it out",
-                     fmt::join(s.aspect, ", "), name_of(s.shape)));
-  if (s.shape != Shape3d::Irregular && s.vertices != d.vertices)
+                     "\"irregular\" (here {}); leave it out",
+                     fmt::join(s.aspect, ", "), shape_text(s.shape)));
+  if (!has_shape(s, Shape3d::Irregular) && s.vertices != d.vertices)
     fail(fmt::format("particles.vertices = {}: the number of points acts only on particles.shape = \"irregular\" "
-                     "(here \"{}\"); leave it out",
-                     s.vertices, name_of(s.shape)));
+                     "(here {}); leave it out",
+                     s.vertices, shape_text(s.shape)));
   if (s.shear_mode != ShearMode::None && s.shear_control == ShearControl::Volume && s.cell_mass != d.cell_mass)
     fail(fmt::format("shear.cell_mass = {}: under shear.control = \"volume\" the cell's lengths are held "
                      "fixed, so they have no mass; leave it out",

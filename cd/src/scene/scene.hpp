@@ -122,8 +122,11 @@ struct Scene {
   // shapes drawn uniformly from this list: 0 disk, 3..60 regular polygon
   // (sizes then refer to the circumscribed diameter 2R)
   std::vector<double> nsides{0.0};
-  // 3D: the generated grains' shape (sizes then circumscribed diameters)
-  Shape3d shape = Shape3d::Sphere;
+  // 3D: the generated grains' shape (sizes then circumscribed diameters);
+  // several: a mixture, each grain's shape drawn from the list with the
+  // number fractions shape_fractions (empty: equal fractions)
+  std::vector<Shape3d> shape{Shape3d::Sphere};
+  std::vector<double> shape_fractions;
   // cuboid: side ratios; irregular: the ellipsoid's semi-axis ratios
   std::vector<double> aspect{1.0, 1.0, 1.0};
   // irregular: the number of random points whose hull is a grain
@@ -184,5 +187,23 @@ struct Scene {
   // The orthotropic (elliptic) cone: 3D, with mu_b or mu_wall_b given (>= 0).
   bool orthotropic() const { return dimension == 3 && (mu_b >= 0 || mu_wall_b >= 0); }
 };
+
+// particles.shape: whether any generated grain may be `k`, whether all are
+// spheres, and the value as written ("cube", or ["sphere", "cube"]).
+inline bool has_shape(const Scene& s, Shape3d k) {
+  for (const Shape3d x : s.shape)
+    if (x == k) return true;
+  return false;
+}
+inline bool all_spheres(const Scene& s) {
+  for (const Shape3d x : s.shape)
+    if (x != Shape3d::Sphere) return false;
+  return true;
+}
+inline std::string shape_text(const std::vector<Shape3d>& v) {
+  std::string out;
+  for (const Shape3d x : v) out += (out.empty() ? "\"" : ", \"") + std::string(name_of(x)) + "\"";
+  return v.size() == 1 ? out : "[" + out + "]";
+}
 
 }  // namespace cd
