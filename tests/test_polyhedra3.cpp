@@ -693,3 +693,112 @@ TEST(Polyhedra3, ShearStartsFromASampleOfPolyhedra) {
   }
 }
 
+namespace {
+
+// configs/pile-polyhedra.toml as a mixture of 200 grains: particles.shape a
+// list, particles.shape_fractions its number fractions.
+Scene mixture_pile(const std::string& fractions) {
+  Scene s = load_scene(std::string(CDLAB_SOURCE_DIR) + "/configs/pile-polyhedra.toml",
+                       {"particles.n=200", "particles.shape=[\"sphere\", \"cube\"]",
+                        "particles.shape_fractions=" + fractions});
+  s.max_iter = 100;  // identity, not convergence, is what this test sees
+  return s;
+}
+
+std::string mixture_error(const std::string& particles) {
+  try {
+    parse_scene("dimension = 3\n[particles]\n" + particles + "\n[gravity]\ng = [0, 0, -9.81]\n", "m.toml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+// A mixture by number: each grain's shape drawn from particles.seed and its
+// index, so the counts are binomial (200 grains, p = 1/2: within 4 standard
+// deviations, 28 grains, of 100), both shapes present, the spheres spheres
+// and the cubes cubes of the grain's circumscribed size at the spheres'
+// places; the pile steps, the same with 1 and 2 threads. A single shape
+// given as a one-element list is the same world as the string.
+TEST(Polyhedra3, SceneMixesShapesByNumber) {
+  const Scene s = mixture_pile("[0.5, 0.5]");
+  const World3 w = build_world3(s);
+  const World3 spheres = build_world3(small_polyhedra_pile(Shape3d::Sphere));
+  Scene all_spheres_scene = s;
+  all_spheres_scene.shape = {Shape3d::Sphere};
+  all_spheres_scene.shape_fractions.clear();
+  const World3 ref = build_world3(all_spheres_scene);
+  ASSERT_EQ(w.bodies.size(), ref.bodies.size());
+  int nsphere = 0, ncube = 0;
+  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
+    if (w.bodies.shape[i] == Shape3::Plane) continue;
+    EXPECT_EQ(w.bodies.pos[i], ref.bodies.pos[i]);
+    const double r = ref.bodies.radius[i];
+    if (w.bodies.shape[i] == Shape3::Sphere) {
+      ++nsphere;
+      EXPECT_EQ(w.bodies.radius[i], r);
+      EXPECT_EQ(w.bodies.mass[i], ref.bodies.mass[i]);
+    } else {
+      ASSERT_EQ(w.bodies.shape[i], Shape3::Polyhedron);
+      ++ncube;
+      EXPECT_NEAR(w.bodies.polyhedron(i).circumradius(), r, 1e-14 * r);
+      EXPECT_EQ(w.bodies.polyhedron(i).vertices().size(), 8u);
+    }
+  }
+  std::printf("%d spheres, %d cubes\n", nsphere, ncube);
+  EXPECT_EQ(nsphere + ncube, 200);
+  EXPECT_LE(std::abs(nsphere - 100), 28);
+  EXPECT_GT(nsphere, 0);
+  EXPECT_GT(ncube, 0);
+
+  const auto run = [&](int threads) {
+    omp_set_num_threads(threads);
+    World3 x = build_world3(s);
+    for (int k = 0; k < 20; ++k) x.step();
+    EXPECT_GT(x.last().contacts, 0);
+    return state_bits(x);
+  };
+  const std::vector<double> s1 = run(1), s2 = run(2);
+  omp_set_num_threads(omp_get_num_procs());
+  ASSERT_EQ(s1.size(), s2.size());
+  std::size_t diff = 0;
+  for (std::size_t k = 0; k < s1.size(); ++k) diff += s1[k] != s2[k];
+  EXPECT_EQ(diff, 0u);
+
+  // All cubes by fractions [0, 1]: the world of particles.shape = "cube".
+  Scene cubes = s;
+  cubes.shape_fractions = {0.0, 1.0};
+  Scene cube = s;
+  cube.shape = {Shape3d::Cube};
+  cube.shape_fractions.clear();
+  const World3 a = build_world3(cubes), b = build_world3(cube);
+  EXPECT_EQ(state_bits(a), state_bits(b));
+  (void)spheres;
+}
+
+// Bad mixtures refused by key.
+TEST(Polyhedra3, SceneMixtureRefusals) {
+  const auto has = [](const std::string& e, const std::string& what) {
+    EXPECT_NE(e.find(what), std::string::npos) << e;
+  };
+  EXPECT_EQ(mixture_error("shape = [\"sphere\", \"cube\"]\nshape_fractions = [0.25, 0.75]"), "");
+  EXPECT_EQ(mixture_error("shape = [\"sphere\", \"cube\"]"), "");
+  has(mixture_error("shape = [\"sphere\", \"cube\"]\nshape_fractions = [0.5, 0.6]"),
+      "m.toml:4:1: particles.shape_fractions = [0.5, 0.6]: the fractions sum to 1.1: must sum to 1 (within 1e-9)");
+  has(mixture_error("shape = [\"sphere\", \"cube\"]\nshape_fractions = [1.5, -0.5]"),
+      "particles.shape_fractions = [1.5, -0.5]: element 1 is -0.5: must be >= 0");
+  has(mixture_error("shape = [\"sphere\", \"cube\"]\nshape_fractions = [0.2, 0.3, 0.5]"),
+      "particles.shape_fractions = [0.2, 0.3, 0.5]: 3 fractions for the 2 shapes of particles.shape = "
+      "[\"sphere\", \"cube\"]: one per shape, in its order");
+  has(mixture_error("shape = \"cube\"\nshape_fractions = [0.5, 0.5]"), "2 fractions for the 1 shapes");
+  has(mixture_error("shape = [\"sphere\", \"blob\"]"), "particles.shape = \"blob\": must be \"sphere\"");
+  has(mixture_error("shape = []"), "particles.shape: expected a name or a non-empty list of names");
+  try {
+    parse_scene("[particles]\nshape_fractions = [1]\n", "m.toml");
+    ADD_FAILURE() << "a 2D scene took particles.shape_fractions";
+  } catch (const ConfigError& e) {
+    has(e.what(), "particles.shape_fractions = [1]: a dimension = 3 key");
+  }
+}
