@@ -1,4 +1,5 @@
-// The pile of the polyhedra tests that compare 1 and 2 threads: 48 grains
+// The polyhedra tests' world settings, and the pile of those that compare
+// 1 and 2 threads: 48 grains
 // on a 4 x 4 x 3 lattice dropped in a box of five planes (the floor z = 0,
 // walls at x, y = +-0.05), each at a random orientation and velocity, the
 // solver stopped after 30 sweeps a step (identity, not convergence, is
@@ -47,16 +48,29 @@ cd::World3 polyhedra_box(cd::WorldParams3 p, Add add) {
   return w;
 }
 
-// Every body's position, velocity, angular velocity and orientation's w.
+// Every body's position, velocity, angular velocity and orientation.
 inline std::vector<double> body_state(const cd::World3& w) {
   std::vector<double> st;
   for (std::size_t i = 0; i < w.bodies.size(); ++i) {
     for (int c = 0; c < 3; ++c) st.push_back(w.bodies.pos[i][c]);
     for (int c = 0; c < 3; ++c) st.push_back(w.bodies.vel[i].v[c]);
     for (int c = 0; c < 3; ++c) st.push_back(w.bodies.vel[i].w[c]);
-    st.push_back(w.bodies.orient[i].w());
+    for (const double q : w.bodies.orient[i].coeffs()) st.push_back(q);
   }
   return st;
+}
+
+// The closed-form tests' world: gravity g along -z, friction mu on grains
+// and walls, an alert distance of 0.1 mm, the solver converged to round-off.
+inline cd::WorldParams3 exact_params3(double mu, double dt = 1e-3) {
+  cd::WorldParams3 p;
+  p.dt = dt;
+  p.gravity = cd::Vec3(0, 0, -9.81);
+  p.mu = p.mu_wall = mu;
+  p.alert = 1e-4;
+  p.solver.tol = 1e-13;
+  p.solver.max_iter = 10000;
+  return p;
 }
 
 }  // namespace cdtest

@@ -37,16 +37,6 @@ namespace {
 constexpr double kG = 9.81;
 constexpr double kRho = 2600.0;
 
-WorldParams3 params(double mu, double dt = 1e-3) {
-  WorldParams3 p;
-  p.dt = dt;
-  p.gravity = Vec3(0, 0, -kG);
-  p.mu = p.mu_wall = mu;
-  p.alert = 1e-4;
-  p.solver.tol = 1e-13;
-  p.solver.max_iter = 10000;
-  return p;
-}
 
 // Sum of the rows' impulses on body b (world frame), and their centre of
 // pressure (normal impulses as weights) with the total normal impulse.
@@ -79,7 +69,7 @@ Load load_on(const World3& w, int b) {
 // move. Four points are hyperstatic: only the sum and the moment are
 // determined, and only they are checked.
 TEST(Polyhedra3, CubeRestsOnPlaneWithFourPoints) {
-  World3 w(params(0.3));
+  World3 w(cdtest::exact_params3(0.3));
   w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
   const double a = 0.02;
   const int shape = w.bodies.add_shape(cuboid(a, a, a));
@@ -120,7 +110,7 @@ struct Block {
 // A block of base b x b and height H released at rest on a plane tilted by
 // theta about y (its base on the plane), mu on the plane, `steps` steps.
 Block block_on_incline(double b, double H, double theta, double mu, int steps) {
-  World3 w(params(mu));
+  World3 w(cdtest::exact_params3(mu));
   const Vec3 n(std::sin(theta), 0, std::cos(theta)), d(std::cos(theta), 0, -std::sin(theta));
   w.bodies.add_plane(Vec3::Zero(), n);
   const int shape = w.bodies.add_shape(cuboid(b, b, H));
@@ -218,7 +208,7 @@ TEST(Polyhedra3, BlockOnInclineSlidesOrTipsAtMuAgainstBOverH) {
 // upper contact m g dt under the upper centroid (its overlap with the lower
 // face is a rectangle: four points).
 TEST(Polyhedra3, TwoCubesStacked) {
-  World3 w(params(0.5));
+  World3 w(cdtest::exact_params3(0.5));
   w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
   const double a = 0.02;
   const int shape = w.bodies.add_shape(cuboid(a, a, a));
@@ -303,7 +293,7 @@ TEST(Polyhedra3, FreeAsymmetricBodyKeepsEnergyAndAngularMomentum) {
 // gravity, friction 0.5: it falls over and comes to rest on a face, three
 // contact points carrying m g dt, the face's outward normal pointing down.
 TEST(Polyhedra3, TetrahedronDroppedOnAVertexRestsOnAFace) {
-  World3 w(params(0.5));
+  World3 w(cdtest::exact_params3(0.5));
   w.params();
   w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
   const double r = 0.01;
@@ -417,7 +407,7 @@ namespace {
 // orientations and velocities: the state after `steps` steps.
 std::vector<double> polyhedra_box(int threads, int steps, int& rows) {
   omp_set_num_threads(threads);
-  World3 w = cdtest::polyhedra_box(params(0.4), [](World3& w, int k, const Vec3& x, const Quat& q, const Vec3& v,
+  World3 w = cdtest::polyhedra_box(cdtest::exact_params3(0.4), [](World3& w, int k, const Vec3& x, const Quat& q, const Vec3& v,
                                                    const Vec3& om, const int* shapes) {
     w.bodies.add_polyhedron(x, shapes[k % 3], kRho, q, v, om);
   });
@@ -452,17 +442,7 @@ Scene small_polyhedra_pile(Shape3d shape) {
   return s;
 }
 
-std::vector<double> state_bits(const World3& w) {
-  std::vector<double> st;
-  for (std::size_t i = 0; i < w.bodies.size(); ++i) {
-    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.pos[i][c]);
-    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.vel[i].v[c]);
-    for (int c = 0; c < 3; ++c) st.push_back(w.bodies.vel[i].w[c]);
-    st.push_back(w.bodies.orient[i].w());
-    st.push_back(w.bodies.orient[i].x());
-  }
-  return st;
-}
+std::vector<double> state_bits(const World3& w) { return cdtest::body_state(w); }
 
 }  // namespace
 

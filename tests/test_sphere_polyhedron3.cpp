@@ -238,16 +238,6 @@ TEST(SpherePolyhedron, RandomCentresProjectOnTheHull) {
 
 namespace {
 
-WorldParams3 params(double mu, double dt = 1e-3) {
-  WorldParams3 p;
-  p.dt = dt;
-  p.gravity = Vec3(0, 0, -kG);
-  p.mu = p.mu_wall = mu;
-  p.alert = 1e-4;
-  p.solver.tol = 1e-13;
-  p.solver.max_iter = 10000;
-  return p;
-}
 
 // The rows between bodies a and b (either body 1): their number, their
 // impulse on b (world frame), the last one's kind and feature.
@@ -292,7 +282,7 @@ std::pair<double, Vec3> floor_load(const World3& w, int b) {
 // centre of mass (a wrong lever arm on the cube would move it); nothing
 // moves over 500 steps.
 TEST(SpherePolyhedron3, SphereRestsOnACubesFace) {
-  World3 w(params(0.4));
+  World3 w(cdtest::exact_params3(0.4));
   w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
   const double a = 0.02, r = 0.006;
   const int cube = w.bodies.add_polyhedron(Vec3(0, 0, a / 2), w.bodies.add_shape(cuboid(a, a, a)), kRho);
@@ -330,7 +320,7 @@ TEST(SpherePolyhedron3, SphereRestsOnACubesFace) {
 // foot, and the floor that plus m g. The spheres come before the cube, so
 // each pair has the sphere as body 1 (collide_sphere's other order).
 TEST(SpherePolyhedron3, CubeOnThreeSpheresSharesItsWeightByBarycentres) {
-  World3 w(params(0.5));
+  World3 w(cdtest::exact_params3(0.5));
   w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
   const double a = 0.03, r = 0.004;
   const std::array<Vec3, 3> foot{Vec3(-0.011, -0.008, 0), Vec3(0.012, -0.005, 0), Vec3(-0.002, 0.013, 0)};
@@ -367,7 +357,7 @@ TEST(SpherePolyhedron3, CubeOnThreeSpheresSharesItsWeightByBarycentres) {
 // mechanical energy never rises above its start by more than the sphere
 // piles' bound, 1e-5 m g d (tests/test_pile.cpp).
 TEST(SpherePolyhedron3, SphereDroppedIntoAGrooveRestsOnTwoEdges) {
-  WorldParams3 p = params(0.0);
+  WorldParams3 p = cdtest::exact_params3(0.0);
   p.mu_wall = 0.5;
   // It lands at 0.2 m/s, 2e-4 a step: an alert distance beyond that closes
   // the gap without an overlap (which pure contact dynamics would keep).
@@ -410,7 +400,7 @@ TEST(SpherePolyhedron3, SphereDroppedIntoAGrooveRestsOnTwoEdges) {
 // pressure sits under the pair's centre of mass with the sphere at its
 // image (the point of the row is the image's).
 TEST(SpherePolyhedron3, SphereRestsOnACubeThroughALeesEdwardsImage) {
-  WorldParams3 p = params(0.4);
+  WorldParams3 p = cdtest::exact_params3(0.4);
   const double L = 0.1, off = 0.03;
   p.periodic = {true, true, false};
   p.cell = Vec3(L, L, L);
@@ -441,7 +431,7 @@ namespace {
 // steps, and the rows between a sphere and a polyhedron summed over them.
 std::vector<double> mixed_box(int threads, int steps, int& rows, int& mixed) {
   omp_set_num_threads(threads);
-  World3 w = cdtest::polyhedra_box(params(0.4), [](World3& w, int k, const Vec3& x, const Quat& q, const Vec3& v,
+  World3 w = cdtest::polyhedra_box(cdtest::exact_params3(0.4), [](World3& w, int k, const Vec3& x, const Quat& q, const Vec3& v,
                                                    const Vec3& om, const int* shapes) {
     if (k % 2 == 0) w.bodies.add_sphere(x, 0.005, kRho, v, om);
     else w.bodies.add_polyhedron(x, shapes[(k / 2) % 3], kRho, q, v, om);
