@@ -53,21 +53,14 @@ Picture draw_snapshot(const std::string& run, const std::string& png, const Pict
   ParticleSet ps = read_particles(pfile);
   // 3D polyhedra: their bodies (centres, circumradii) from the polyhedra
   // snapshot of the same number, drawn as their sections by the slice.
-  std::optional<std::string> polyfile;
+  const std::optional<std::string> polyfile =
+      dim == 3 ? companion_snapshot(pfile, "polyhedra") : std::optional<std::string>{};
   std::set<int> polyhedra;
-  if (dim == 3) {
-    const std::string f = (fs::path(pfile).parent_path() /
-                           ("polyhedra" + fs::path(pfile).filename().string().substr(std::string("spheres").size())))
-                              .string();
-    std::error_code ec;
-    if (fs::is_regular_file(f, ec)) {
-      polyfile = f;
-      for (const auto& p : read_polyhedra(f)) {
-        ps.push_back(p);
-        polyhedra.insert(p.id);
-      }
+  if (polyfile)
+    for (const auto& p : read_polyhedra(*polyfile)) {
+      ps.push_back(p);
+      polyhedra.insert(p.id);
     }
-  }
   if (ps.empty()) throw AnalysisError(fmt::format("'{}' holds no particle", pfile));
   std::map<int, const Particle*> by_id;
   for (const auto& p : ps) by_id[p.id] = &p;

@@ -119,17 +119,6 @@ Estimate measured_inertial_number(const Table& series, const std::string& x_colu
   return {i, 0.5 * i * ss.error() / ss.mean};
 }
 
-// The bodies snapshot with the same number as a contacts snapshot
-// (stem "particles" in 2D, "spheres" in 3D), if it exists.
-static std::optional<std::string> companion_snapshot(const std::string& contacts_file, const std::string& stem) {
-  const fs::path f(contacts_file);
-  const std::string p =
-      (f.parent_path() / (stem + f.filename().string().substr(std::string("contacts").size()))).string();
-  std::error_code ec;
-  if (!fs::exists(p, ec)) return std::nullopt;
-  return p;
-}
-
 RunFabric run_fabric(const std::string& run_dir, int k, int bins, double volume, double mu,
                      double sliding_tol, double force_rel) {
   RunFabric f;

@@ -307,6 +307,17 @@ ContactSet3 read_contacts3(const std::string& path) {
   return cs;
 }
 
+std::optional<std::string> companion_snapshot(const std::string& snapshot, const std::string& stem) {
+  const std::filesystem::path f(snapshot);
+  const std::string name = f.filename().string();
+  const auto us = name.rfind('_');
+  if (us == std::string::npos) return std::nullopt;
+  const std::string p = (f.parent_path() / (stem + name.substr(us))).string();
+  std::error_code ec;
+  if (!std::filesystem::exists(p, ec)) return std::nullopt;
+  return p;
+}
+
 ParticleSet read_polyhedra(const std::string& path) {
   auto pd = read_polydata(path);
   ParticleSet ps;

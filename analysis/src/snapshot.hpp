@@ -8,6 +8,7 @@
 #pragma once
 #include <array>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,9 @@ std::vector<cd::obs::Contact<3>> as_forces(const ContactSet3& cs);
 ContactSet read_contacts(const std::string& vtp_path);
 ContactSet3 read_contacts3(const std::string& vtp_path);
 ParticleSet read_particles(const std::string& vtp_path);
+// The snapshot `stem`_NNNNN.vtp beside a snapshot <any>_NNNNN.vtp (the
+// same number: cdsim writes a step's files together), if it exists.
+std::optional<std::string> companion_snapshot(const std::string& snapshot, const std::string& stem);
 // The bodies of a 3D polyhedra snapshot (polyhedra_NNNNN.vtp: one cell per
 // face), one per body in the order of their first face: id, centre (the
 // `centre` array), circumradius, velocity.
