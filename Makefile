@@ -60,6 +60,8 @@ help:
 	@echo "  make tensile         tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
 	@echo "  make compare-liggghts-shear  a 1000-sphere mu(I) point by LIGGGHTS and cdsim, one thread each: CPU per"
 	@echo "                       unit strain, sweeps, mu, phi, z, the ratio (CMP_DIR; QUICK=1: strain 0.3)"
+	@echo "  make compare-yade-pile  the first YCMP_T s of 1000 cubes falling (pile-polyhedra) by YADE's polyhedra"
+	@echo "                       and cdsim, one thread each: CPU, steps, largest overlap, the ratio (YCMP_DIR)"
 	@echo "  make prep-overlap    ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N: fails if an overlap reaches 0.01 d_small"
 	@echo "  make frozen-shear    steady-shear contact problems (disks, hexagons; I = 1e-2, 1e-3) into FROZEN/N_<FS_N>/"
 	@echo "  make frozen-shear3   a 3D shear step at I = 1e-2 (tests/data/frozen-shear3) into FROZEN/3d/N_<FS3_N>/"
@@ -114,6 +116,8 @@ help:
 	$(call help_var,SHEAR_TOL,solver.tol for every shear run (empty: by I; docs/shear.md))
 	$(call help_var,SHEAR_SET,more --set options for every shear run (e.g. --set solver.anderson=5))
 	$(call help_var,CMP_DIR,make compare-liggghts-shear's folder)
+	$(call help_var,YCMP_DIR,make compare-yade-pile's folder)
+	$(call help_var,YCMP_E,YADE's polyhedra stiffness (the material's young; its law's kn = E/2 in N/m^3))
 	$(call help_var,CMP_I,its inertial number)
 	$(call help_var,CMP_STRAIN,its strain (QUICK=1: 0.3))
 	$(call help_var,PREP_SET,more --set options for the preparations)
@@ -1022,6 +1026,28 @@ fuzz-%:
 	    tail -40 logs/$*.log; exit 1; fi
 
 # ---- Dense shear side by side with LIGGGHTS (docs/accuracy.md) ---------------
+# make compare-yade-pile [YCMP_T=0.12] [YCMP_E=1e8]: the deposition of
+# configs/pile-polyhedra.toml (1000 cubes, d in [5, 10] mm, mu = 0.4) for its
+# first YCMP_T seconds by cdsim (the scene as shipped) and by YADE's
+# polyhedra (Debian's yade, built with CGAL: the volumetric law, F_n = kn V,
+# time step a tenth of the smallest cube's critical one), the same
+# construction in cd/bench/peers/yade-polyhedra/pile.py; one after the
+# other, one thread each, then the table of table.py (CPU, steps, largest
+# overlap, the ratio). Redone into YCMP_DIR on each call.
+YCMP_DIR ?= outputs/compare-yade
+YCMP_T ?= 0.12
+YCMP_E ?= 1e8
+.PHONY: compare-yade-pile
+compare-yade-pile: build
+	$(call install_missing,compare-yade-pile,yade)
+	rm -rf $(YCMP_DIR) && mkdir -p $(YCMP_DIR)
+	@echo "compare-yade-pile: load average at the start $$(cut -d' ' -f1-3 /proc/loadavg)"
+	$(BUILD)/cd/cdsim configs/pile-polyhedra.toml --out $(YCMP_DIR)/cdsim --threads 1 \
+	  --set time.duration=$(YCMP_T) --set output.snapshot_interval=0 > $(YCMP_DIR)/cdsim.log 2>&1
+	cd $(YCMP_DIR) && N=1000 T=$(YCMP_T) E=$(YCMP_E) OMP_NUM_THREADS=1 \
+	  yade -n -j 1 -x $(CURDIR)/cd/bench/peers/yade-polyhedra/pile.py > yade.log 2>&1
+	/usr/bin/python3 cd/bench/peers/yade-polyhedra/table.py $(YCMP_DIR)
+
 # make compare-liggghts-shear [QUICK=1] [CMP_STRAIN=2] [CMP_I=0.01] [SHEAR_TOL=...] [SHEAR_SET=...]
 # One 1000-grain mu(I) point by both codes side by side, one thread each:
 # LIGGGHTS 3.8 (Debian's, installed here if missing) shearing 1000 spheres
