@@ -324,6 +324,62 @@ TEST(Polyhedra3, TetrahedronDroppedOnAVertexRestsOnAFace) {
   EXPECT_NEAR(w.bodies.pos[b].z(), r / 3, 1e-9 * r);
 }
 
+// Each Platonic solid released just above a plane at a generic
+// orientation, with an alert distance of 0.7 circumradii, so that the
+// vertices next to the face it lands on are within alert of the plane too
+// (an icosahedron's and a dodecahedron's next ring is 0.6 r above that
+// face): it comes to rest on a face, its centroid at the inradius (r/3 for
+// the tetrahedron, r/sqrt 3 for the cube and the octahedron,
+// r sqrt((5 + 2 sqrt 5)/15) for the dodecahedron and the icosahedron),
+// borne by the face's vertices (at most 4 kept) carrying m g. When the
+// plane's contact kept the widest 4 of all the vertices within alert, the
+// icosahedron and the dodecahedron lost two bearing vertices and sank into
+// the plane by 0.3 d in 1.5 s, never at rest.
+TEST(Polyhedra3, EverySolidDroppedOnAPlaneRestsOnAFace) {
+  const double r = 0.01;
+  const double s5 = std::sqrt(5.0);
+  const struct {
+    Platonic kind;
+    double inradius;  // over r
+    int face_vertices;
+  } solids[] = {{Platonic::Tetrahedron, 1.0 / 3.0, 3},
+                {Platonic::Cube, 1.0 / std::sqrt(3.0), 4},
+                {Platonic::Octahedron, 1.0 / std::sqrt(3.0), 3},
+                {Platonic::Dodecahedron, std::sqrt((5.0 + 2.0 * s5) / 15.0), 5},
+                {Platonic::Icosahedron, std::sqrt((5.0 + 2.0 * s5) / 15.0), 3}};
+  for (const auto& solid : solids) {
+    WorldParams3 p = cdtest::exact_params3(0.4);
+    p.alert = 0.7 * r;
+    World3 w(p);
+    w.bodies.add_plane(Vec3::Zero(), Vec3(0, 0, 1));
+    const int shape = w.bodies.add_shape(platonic(solid.kind, r));
+    const Quat q(Eigen::AngleAxisd(0.7, Vec3(0.3, 1.0, 0.2).normalized()));
+    double low = 0;
+    for (const Vec3& v : w.bodies.polyhedra[0].vertices()) low = std::min(low, (q * v).z());
+    const int b = w.bodies.add_polyhedron(Vec3(0, 0, -low + 0.01 * r), shape, kRho, q);
+    const double m = w.bodies.mass[b], dt = w.params().dt;
+    double deepest = 0;
+    for (int k = 0; k < 1500; ++k) {
+      w.step();
+      for (const Vec3& v : w.bodies.polyhedra[0].vertices())
+        deepest = std::min(deepest, (w.bodies.pos[b] + w.bodies.orient[b] * v).z());
+    }
+    SCOPED_TRACE(static_cast<int>(solid.kind));
+    const Load l = load_on(w, b);
+    EXPECT_EQ(l.rows, std::min(solid.face_vertices, 4));
+    EXPECT_NEAR(l.normal, m * kG * dt, 1e-8 * m * kG * dt);
+    EXPECT_NEAR(w.bodies.pos[b].z(), solid.inradius * r, 1e-6 * r);
+    EXPECT_LT(w.kinetic_energy(), 1e-12 * m * kG * r);
+    // Pure contact dynamics lets a point enter the plane by what it moves
+    // in a step as it lands: below 1e-8 r for the solids whose landing
+    // face keeps all its vertices, 5e-3 r for the dodecahedron, whose
+    // pentagon keeps 4 (the fifth enters as the face closes, and leaves);
+    // 0.6 r before the fix.
+    std::printf("deepest %.3g r\n", -deepest / r);
+    EXPECT_GT(deepest, -1e-2 * r);
+  }
+}
+
 namespace {
 
 // A row between two bodies with random lever arms, normal, masses, full

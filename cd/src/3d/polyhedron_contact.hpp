@@ -139,7 +139,8 @@ std::optional<PolyContact> collide(const ConvexPolyhedron& A, const Pose3& pose_
                                    PolyContact* face_too = nullptr);
 
 // The plane through p0 with unit normal n (into the free side; body 1)
-// against B: B's vertices within alert of the plane (gap n . (v - p0)),
+// against B: the vertices of B's incident face (the most anti-parallel to
+// n) within alert of the plane (gap n . (v - p0)) and B's deepest vertex,
 // reduced to 4; keys Vertex with the vertex index; kind by their number as
 // for a face axis; axis FaceA 0 (the plane's one face).
 std::optional<PolyContact> collide_plane(const Vec3& p0, const Vec3& n, const ConvexPolyhedron& B,
