@@ -118,6 +118,7 @@ help:
 	$(call help_var,CMP_DIR,make compare-liggghts-shear's folder)
 	$(call help_var,YCMP_DIR,make compare-yade-pile's folder)
 	$(call help_var,YCMP_E,YADE's polyhedra stiffness (the material's young; its law's kn = E/2 in N/m^3))
+	$(call help_var,YCMP_T,the simulated seconds of make compare-yade-pile)
 	$(call help_var,CMP_I,its inertial number)
 	$(call help_var,CMP_STRAIN,its strain (QUICK=1: 0.3))
 	$(call help_var,PREP_SET,more --set options for the preparations)
