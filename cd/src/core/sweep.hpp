@@ -233,8 +233,9 @@ class Stall {
 // and r + d (a sliding row's tangential impulse scaled with its normal
 // one, so that it stays on the cone's edge) goes through the law's own
 // projection into the rows and their bodies. W is symmetric positive
-// semidefinite and the system consistent, so CG converges on it and leaves
-// the indeterminate part of the forces where the sweeps put it. The
+// semidefinite; where the system is consistent CG converges on it and
+// leaves the indeterminate part of the forces where the sweeps put it, and
+// a direction W barely sees (kNullRel) ends it where it is not. The
 // boundary dofs are held (their own update follows in the next sweep). One
 // CG iteration is one product W p through the bodies of the closed rows (a
 // scatter and a gather). When the pairs stall (Stall, the rule of Anderson's
@@ -255,6 +256,7 @@ class Subspace {
  public:
   static constexpr int kSubspaceEvery = 2;      // pairs of sweeps between corrections
   static constexpr double kSubspaceRel = 1e-2;  // CG's relative residual
+  static constexpr double kNullRel = 1e-10;     // p^T W p against p^T diag(W) p: W's null space
 
   Subspace(int iters, int rows) : iters_(iters), n_(rows * D), free_(n_), diag_(n_), u_(n_), pf_(n_), yf_(n_) {}
 
@@ -277,9 +279,11 @@ class Subspace {
     const int m = static_cast<int>(comp_.size());
     res_.resize(m);
     idg_.resize(m);
+    dgf_.resize(m);
     for (int j = 0; j < m; ++j) {
       res_[j] = -u_[comp_[j]];
-      idg_[j] = 1.0 / diag_[comp_[j]];
+      dgf_[j] = diag_[comp_[j]];
+      idg_[j] = 1.0 / dgf_[j];
     }
     z_ = res_.cwiseProduct(idg_);
     p_ = z_;
@@ -294,7 +298,12 @@ class Subspace {
       c.subspace_apply(R, live_, pf_.data(), yf_.data(), s);
       for (int j = 0; j < m; ++j) wp_[j] = yf_[comp_[j]];
       const double pwp = p_.dot(wp_);
-      if (!(pwp > 0)) break;
+      // A direction W barely sees (its Rayleigh quotient against W's
+      // diagonal below kNullRel): the status the iterate gave is not a
+      // consistent linear problem there (say a closing row held at u = 0
+      // beside resting ones that forbid it), and CG would step along W's
+      // null space without bound. Stop before it.
+      if (!(pwp > kNullRel * p_.cwiseAbs2().dot(diag_of_free()))) break;
       const double a = rz / pwp;
       d_ += a * p_;
       res_ -= a * wp_;
@@ -314,7 +323,8 @@ class Subspace {
  private:
   int iters_, n_;
   Eigen::VectorXd free_, diag_, u_, pf_, yf_;        // full: D per row
-  Eigen::VectorXd res_, z_, p_, d_, wp_, idg_;       // the free components
+  Eigen::VectorXd res_, z_, p_, d_, wp_, idg_, dgf_;  // the free components
+  const Eigen::VectorXd& diag_of_free() const { return dgf_; }
   std::vector<int> live_, comp_;
 };
 
