@@ -197,6 +197,21 @@ void set_points(PolyContact& c, const std::vector<PolyContactPoint>& cand, const
   }
 }
 
+// The incident face of I against a reference normal n: its face most
+// anti-parallel to n (the first on a tie).
+int incident_face(const Placed& I, const Vec3& n) {
+  int fi = 0;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int g = 0; g < static_cast<int>(I.n.size()); ++g) {
+    const double e = I.n[g].dot(n);
+    if (e < lowest) {
+      lowest = e;
+      fi = g;
+    }
+  }
+  return fi;
+}
+
 // The contact on face f of the reference body R (A unless ref_b) with the
 // incident body I.
 PolyContact face_contact(const Placed& R, int f, const Placed& I, bool ref_b, double separation,
@@ -207,16 +222,7 @@ PolyContact face_contact(const Placed& R, int f, const Placed& I, bool ref_b, do
   c.separation = separation;
   c.axis = {ref_b ? PolyAxisKind::FaceB : PolyAxisKind::FaceA, f, 0};
   c.normal = ref_b ? Vec3(-n) : n;
-  // Incident face: the most anti-parallel (the first on a tie).
-  int fi = 0;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int g = 0; g < static_cast<int>(I.n.size()); ++g) {
-    const double e = I.n[g].dot(n);
-    if (e < lowest) {
-      lowest = e;
-      fi = g;
-    }
-  }
+  const int fi = incident_face(I, n);
   const std::vector<int>& loop = I.shape->faces()[fi].loop;
   const int m = static_cast<int>(loop.size());
   std::vector<ClipPoint> poly, next;
@@ -579,15 +585,7 @@ std::optional<PolyContact> collide_plane(const Vec3& p0, const Vec3& n, const Co
     if (gap[k] < gap[deepest]) deepest = k;
   }
   if (gap[deepest] > alert) return std::nullopt;
-  int fi = 0;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int f = 0; f < static_cast<int>(pb.n.size()); ++f) {
-    const double e = pb.n[f].dot(n);
-    if (e < lowest) {
-      lowest = e;
-      fi = f;
-    }
-  }
+  const int fi = incident_face(pb, n);
   std::vector<char> take(static_cast<std::size_t>(nv), 0);
   for (const int k : B.faces()[fi].loop) take[k] = gap[k] <= alert;
   take[deepest] = 1;

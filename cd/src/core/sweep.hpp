@@ -303,7 +303,7 @@ class Subspace {
       // consistent linear problem there (say a closing row held at u = 0
       // beside resting ones that forbid it), and CG would step along W's
       // null space without bound. Stop before it.
-      if (!(pwp > kNullRel * p_.cwiseAbs2().dot(diag_of_free()))) break;
+      if (!(pwp > kNullRel * p_.cwiseAbs2().dot(dgf_))) break;
       const double a = rz / pwp;
       d_ += a * p_;
       res_ -= a * wp_;
@@ -323,8 +323,7 @@ class Subspace {
  private:
   int iters_, n_;
   Eigen::VectorXd free_, diag_, u_, pf_, yf_;        // full: D per row
-  Eigen::VectorXd res_, z_, p_, d_, wp_, idg_, dgf_;  // the free components
-  const Eigen::VectorXd& diag_of_free() const { return dgf_; }
+  Eigen::VectorXd res_, z_, p_, d_, wp_, idg_, dgf_;  // the free components (dgf_: W's diagonal there)
   std::vector<int> live_, comp_;
 };
 
