@@ -227,6 +227,34 @@ TEST(Watchdog, NonFiniteStateStopsTheRunWithExitThree) {
   EXPECT_FALSE(fs::exists(dir / "out" / "checkpoint.bin"));
 }
 
+// A finite state gone bad: a disk thrown at another one so fast (v dt =
+// 1.2 d from a gap of 0.05 d) that it is found inside it by 0.55 d at the
+// first step's midpoint (0.05 - 1.2 / 2), past the watchdog's limit of half
+// the smaller diameter: exit 3 naming the step and the overlap, no row and
+// no checkpoint from that state. Half that speed sinks it 0.25 d (0.05 -
+// 0.6 / 2): a run that warns and ends, exit 0.
+TEST(Watchdog, GrainsSunkIntoEachOtherByHalfADiameterStopTheRun) {
+  const fs::path dir = cdtest::scratch_dir("bad_input", "watchdog_overlap");
+  for (const auto& [v, code] : {std::pair{"1200.0", 3}, std::pair{"600.0", 0}}) {
+    SCOPED_TRACE(v);
+    std::string scene = kScene;
+    scene.replace(scene.find("pos = [1.0, 0.5]"), 16, std::string("pos = [0.0, 1.55]\nvel = [0.0, -") + v + "]");
+    scene += "checkpoint_interval = 1e-3\n";
+    const fs::path sc = write(dir, "s.toml", scene), out = dir / (std::string("out") + v);
+    const cdtest::CmdResult r = cdsim(sc.string() + " -q --out " + out.string());
+    EXPECT_EQ(r.code, code) << r.out;
+    if (code == 3) {
+      EXPECT_NE(r.out.find("run diverged: step 1 (t = 0.001 s): two grains overlap by 0.55 of the smaller one's "
+                           "diameter, past the limit of 0.5"), std::string::npos) << r.out;
+      EXPECT_LE(csv(out / "series.csv").size(), 1u);
+      EXPECT_FALSE(fs::exists(out / "checkpoint.bin"));
+    } else {
+      EXPECT_NE(r.out.find("the largest overlap reached 0.25 of the smaller grain's diameter"), std::string::npos)
+          << r.out;
+    }
+  }
+}
+
 // SIGTERM mid-run: exit 128 + 15 at a step boundary, a checkpoint written;
 // the same command resumes and ends in the state of an uninterrupted run
 // (kinetic energy of the last row bit-identical). The signal is sent as GNU

@@ -41,9 +41,11 @@ struct RunOptions {
 };
 
 // A run that produced a non-finite position, velocity, impulse, cell
-// quantity or series value: the message names the step, the body or contact
-// and the quantity. The series holds the rows before it; the last
-// checkpoint written is intact (none is written after the bad step).
+// quantity or series value, or two grains sunk into each other by
+// half the smaller one's diameter (run_session.cpp): the message names the
+// step, the body or contact and the quantity. The series holds the rows
+// before it; the last checkpoint written is intact (none is written after
+// the bad step).
 struct RunDiverged : std::runtime_error {
   using std::runtime_error::runtime_error;
 };

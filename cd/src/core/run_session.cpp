@@ -14,6 +14,15 @@ namespace cd {
 
 namespace {
 
+// The watchdog's finite limit: a contact whose overlap reaches half the
+// smaller grain's diameter (StepStats::max_overlap_small) is no rigid (or
+// stiff) contact any more but a state gone bad that stays finite (a
+// solve that took an impulse from a singular system, a step far too long
+// for the grains' speeds); the run stops as diverged rather than going on
+// to numbers that look like results. A run warns of overlaps from 0.01 of
+// that diameter on (cdsim's closing warning), fifty times below this limit.
+constexpr double kDivergedOverlap = 0.5;
+
 // A resumed run reads its rows back, so that it stops where the run never
 // stopped does, and one that had settled at its checkpoint takes no more
 // steps.
@@ -88,7 +97,7 @@ void RunSession::open_outputs() {
 bool RunSession::advance(std::int64_t k) {
   step_engine(k);
   const StepStats& st = e_.last();
-  check_finite(k, st);
+  check_state(k, st);
   const bool row_due = cadence_.row_due(k);
   if (const int sig = stop_signal(); sig != 0)
     std::fputs(stop_notice_.seen(sig, row_due, cadence_.next_row(k), progress_.on_terminal()).c_str(), stderr);
@@ -134,7 +143,7 @@ void RunSession::step_engine(std::int64_t k) {
   }
 }
 
-void RunSession::check_finite(std::int64_t k, const StepStats& st) {
+void RunSession::check_state(std::int64_t k, const StepStats& st) {
   if (const std::string bad = e_.non_finite(); !bad.empty())
     throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): non-finite state: {}; series.csv "
                                       "holds the rows before it{}", k, e_.time(), bad,
@@ -149,6 +158,11 @@ void RunSession::check_finite(std::int64_t k, const StepStats& st) {
     if (!std::isfinite(x))
       throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): the step's {} is {}; series.csv holds the "
                                         "rows before it", k, e_.time(), name, x));
+  if (st.max_overlap_small >= kDivergedOverlap)
+    throw diverged(k - 1, fmt::format("step {} (t = {:.6g} s): two grains overlap by {:.3g} of the smaller one's "
+                                      "diameter, past the limit of {} (a time step too long for the grains' "
+                                      "speeds, or a solve gone wrong); series.csv holds the rows before it{}", k, e_.time(), st.max_overlap_small, kDivergedOverlap,
+                                      plan_.checkpoints() ? ", checkpoint.bin (if written) the last good state" : ""));
 }
 
 void RunSession::after_step(std::int64_t k) {

@@ -31,7 +31,8 @@ class RunSession {
   // Step k and its outputs; false when the session ends at it.
   bool advance(std::int64_t k);
   void step_engine(std::int64_t k);
-  void check_finite(std::int64_t k, const StepStats& st);
+  // The watchdog (run_loop.hpp, RunDiverged): throws if step k left a bad state.
+  void check_state(std::int64_t k, const StepStats& st);
   void after_step(std::int64_t k);
   void write_row(std::int64_t k, const StepStats& st);
   void write_snapshot();
