@@ -100,13 +100,6 @@ ContactSet3 split(const ContactSet3& cs, std::uint64_t seed) {
   return rows;
 }
 
-M3 tensor(const Mat3& t) {
-  M3 m;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m(i, j) = t[i][j];
-  return m;
-}
-
 void write_run(const fs::path& dir, const ContactSet3& rows) {
   fs::create_directories(dir);
   std::ofstream(dir / "scene.toml") << "dimension = 3\n";

@@ -129,4 +129,17 @@ Anisotropy3 anisotropy3(const ContactSet3& cs) {
   return a;
 }
 
+BranchAnisotropy3 branch_anisotropy3(const ContactSet3& cs) {
+  ContactSet3 branch = cs;
+  for (auto& k : branch) {
+    const Eigen::Vector3d n(k.c.n[0], k.c.n[1], k.c.n[2]), l(k.c.l[0], k.c.l[1], k.c.l[2]);
+    const double ln = l.dot(n);
+    const Eigen::Vector3d lt = l - ln * n;
+    k.c.fn = ln;
+    for (int i = 0; i < 3; ++i) k.c.ft[i] = lt[i];
+  }
+  const Anisotropy3 a = anisotropy3(branch);
+  return {a.An, a.At, a.mean_f};
+}
+
 }  // namespace cda

@@ -82,10 +82,30 @@ struct Anisotropy3 {
   double sum_2_5_on(const Stress3& s) const;
 };
 
+// The branch anisotropies (Azema, Radjai & Dubois 2013): the same harmonic
+// forms for the branch vector l (centre of body 1 to centre of body 2) as
+// for the force, its normal part l_n = l.n and tangential part
+// l_t = l - l_n n in place of f_n and f_t,
+//   <l_n>(n) = <l> (1 + A_ln : n n),
+//   <l_t>(n) = <l> (2/3) (A_lt n - (n . A_lt n) n),
+// estimated as the force's (anisotropy3 with f := l). With them the
+// stress-fabric relation for grains whose branch is not along the normal is
+//   q/p = (2/5)(a_c + a_n + a_t + a_ln + a_lt)
+// to first order. Spheres: l = |l| n, so A_lt = 0 and A_ln says only how the
+// pairs' sizes correlate with their direction.
+struct BranchAnisotropy3 {
+  Mat3 Aln{}, Alt{};
+  double mean_l = 0;  // <l> of the forms
+  double a_ln() const { return spread3(Aln); }
+  double a_lt() const { return spread3(Alt); }
+};
+
 // The anisotropies of the given contacts (each one force-bearing physical
 // contact; the caller selects them). Throws AnalysisError when there are
 // none, or when the fixed point does not converge (anisotropies of order 1,
 // far outside the harmonic forms).
 Anisotropy3 anisotropy3(const ContactSet3& cs);
+// The branch anisotropies of the same contacts (thrown as anisotropy3).
+BranchAnisotropy3 branch_anisotropy3(const ContactSet3& cs);
 
 }  // namespace cda

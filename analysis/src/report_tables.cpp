@@ -45,6 +45,8 @@ std::map<std::string, double> fabric3_row(const ReportRun& r) {
   }
   row["check_rel"] = fw.check_rel;
   row["check_rel_err"] = fw.check_rel_err;
+  row["check_rel_branch"] = fw.check_rel_branch;
+  row["check_rel_branch_err"] = fw.check_rel_branch_err;
   row["fabric_snapshots"] = static_cast<double>(fw.files.size());
   return row;
 }
@@ -112,11 +114,12 @@ Table fabric_table(const ReportScan& scan) {
     // (s1 - s3)/3 beside (2/5) sum a, and mu = -sxy/syy of the snapshots:
     // each the mean over the contact snapshots in the steady window with
     // its _err (sem over them), the relative deviation check_rel of (2/5)
-    // sum a from q/p, and the count fabric_snapshots (1: the last snapshot
+    // sum a from q/p (check_rel_branch: with the branch terms a_ln, a_lt), and the count fabric_snapshots (1: the last snapshot
     // alone).
     names = {"run"};
     for (const auto& c : kFabric3Columns) names.insert(names.end(), {c, c + "_err"});
-    names.insert(names.end(), {"check_rel", "check_rel_err", "fabric_snapshots"});
+    names.insert(names.end(), {"check_rel", "check_rel_err", "check_rel_branch", "check_rel_branch_err",
+                               "fabric_snapshots"});
   } else {
     names = {"run", "a_c", "theta_c", "a_ln", "a_lt", "a_fn", "a_ft", "sum_half",
              "q_over_p", "a_c_tensor", "a_ln_tensor", "a_lt_tensor", "a_fn_tensor",

@@ -225,6 +225,7 @@ RunFabric3 run_fabric3(const std::string& run_dir, int k, double volume, double 
   if (bearing.empty()) throw AnalysisError(fmt::format("'{}' has no force-bearing contact", f.file));
   try {
     f.aniso = anisotropy3(bearing);
+    f.branch = branch_anisotropy3(bearing);
   } catch (const AnalysisError& e) {
     f.aniso_problem = fmt::format("'{}': {}", f.file, e.what());
   }
@@ -407,6 +408,8 @@ Val window_rate_min(const std::string& run_dir, const Table& series, const std::
 
 const std::vector<std::string> kFabric3Columns = {
     "a_c", "a_n", "a_t", "sum_2_5", "sum_2_5_tensor", "q_over_p", "q_vm_over_p", "mu", "sliding", "z", "non_floating",
+    // the branch anisotropies and (2/5)(a_c + a_n + a_t + a_ln + a_lt)
+    "a_ln", "a_lt", "sum_2_5_branch",
     // polyhedra only (nan for spheres): RunFabric3's shares and face-face parts
     "face_face_share", "edge_face_share", "vertex_face_share", "edge_edge_share", "q_over_p_face_face",
     "a_c_face_face", "a_n_face_face", "a_t_face_face", "a_c_other", "a_n_other", "a_t_other"};
@@ -435,7 +438,7 @@ WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, co
   r.averaged = !picks.empty();
   if (!r.averaged) picks = {-1};  // the last snapshot
   std::vector<std::vector<double>> per(kFabric3Columns.size());
-  std::vector<double> diff;  // (2/5) sum a - q/p, per snapshot
+  std::vector<double> diff, diff_branch;  // (2/5) sum a - q/p, per snapshot, without and with the branch terms
   std::string first_error;
   for (const int snap : picks) {
     RunFabric3 f;
@@ -457,6 +460,8 @@ WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, co
                                    f.stress.mu(), f.sliding,
                                    f.connectivity ? f.connectivity->z : nan,
                                    f.connectivity ? f.connectivity->non_floating : nan,
+                                   ok ? f.branch->a_ln() : nan, ok ? f.branch->a_lt() : nan,
+                                   ok ? a.sum_2_5() + 0.4 * (f.branch->a_ln() + f.branch->a_lt()) : nan,
                                    f.kind_share(Kind3::FaceFace), f.kind_share(Kind3::EdgeFace),
                                    f.kind_share(Kind3::VertexFace), f.kind_share(Kind3::EdgeEdge),
                                    f.q_over_p_face_face(),
@@ -467,7 +472,8 @@ WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, co
                                    f.aniso_other ? f.aniso_other->a_n() : nan,
                                    f.aniso_other ? f.aniso_other->a_t() : nan};
     for (std::size_t i = 0; i < v.size(); ++i) per[i].push_back(v[i]);
-    diff.push_back(v[3] - v[5]);  // sum_2_5 - q_over_p
+    diff.push_back(v[3] - v[5]);          // sum_2_5 - q_over_p
+    diff_branch.push_back(v[13] - v[5]);  // sum_2_5_branch - q_over_p
     r.files.push_back(fs::path(f.file).filename().string());
     r.bearing += static_cast<double>(f.physical_contacts);
   }
@@ -479,6 +485,8 @@ WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, co
   const double qp = r.of("q_over_p").v;
   r.check_rel = (r.of("sum_2_5").v - qp) / qp;
   r.check_rel_err = mean_sem(diff).err / std::abs(qp);
+  r.check_rel_branch = (r.of("sum_2_5_branch").v - qp) / qp;
+  r.check_rel_branch_err = mean_sem(diff_branch).err / std::abs(qp);
   return r;
 }
 

@@ -95,6 +95,7 @@ struct RunFabric3 {
   // The anisotropies; empty when the harmonic forms do not fit the contacts
   // (too few, or anisotropies of order 1), with the reason in aniso_problem.
   std::optional<Anisotropy3> aniso;
+  std::optional<BranchAnisotropy3> branch;  // of the same contacts, with aniso
   std::string aniso_problem;
   Stress3 stress;  // with the given volume (1 if none: stress times V)
   bool has_volume = false;
@@ -212,7 +213,11 @@ extern const std::vector<std::string> kFabric3Columns;
 // skipped by the means). Throws AnalysisError when no snapshot can be read.
 struct WindowFabric3 {
   std::vector<Val> mean;  // per kFabric3Columns
+  // ((2/5) sum a - q/p)/(q/p) per snapshot, averaged, with its sem: the
+  // force and fabric terms (a_c + a_n + a_t), and with the branch terms too
+  // (+ a_ln + a_lt).
   double check_rel = std::nan(""), check_rel_err = std::nan("");
+  double check_rel_branch = std::nan(""), check_rel_branch_err = std::nan("");
   std::vector<std::string> files;  // the snapshots used, in order
   double bearing = 0;              // force-bearing contacts per snapshot, mean
   bool averaged = false;           // false: the last snapshot alone
