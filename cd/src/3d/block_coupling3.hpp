@@ -201,8 +201,31 @@ struct BlockCoupling3 {
 
   // One row update: the free velocity q = u - W r, the exact local solve,
   // the change into the bodies (body 1 only when Write1).
+  // velocity(r)[0], the same operations in the same order (the same bits).
+  double normal_velocity(const BlockRow3& r) const {
+    const BodyVel3& A = vel[r.b1];
+    const BodyVel3& B = vel[r.b2];
+    const Vec3 dv = B.v - A.v;
+    double un = r.n.dot(dv) + r.bn;
+    un += r.a2[0].dot(B.w) - r.a1[0].dot(A.w);
+    return un;
+  }
+
   template <class L, bool Write1>
   void update(BlockRow3& r, double& dp2, double& pabs) const {
+    // A row at zero impulse whose normal velocity stays >= 0 stays open
+    // (most of a polyhedra step's rows: the points within the alert
+    // distance). solve_local3 would find that from the whole velocity and
+    // W r, with r = 0 (q = u, and b = q without adhesion): its open branch
+    // returns s = +0, r = s - 0 e_n = +0. The normal component alone
+    // decides it, at a third of the velocity's products and none of W r's.
+    if (r.r[0] == 0.0 && r.r[1] == 0.0 && r.r[2] == 0.0 && (!L::cohesive || r.adh == 0.0) &&
+        normal_velocity(r) >= 0.0) {
+      r.r = Vec3::Zero();
+      dp2 = 0.0;
+      pabs = 0.0;
+      return;
+    }
     const RowExtra3* e = extra_of(r);
     const Vec3 q = velocity(r) - r.W * r.r;
     Vec3 rn;
