@@ -627,6 +627,47 @@ TEST(PolyhedronContact, RandomShapesSeparationIsTheSupportGapAlongTheNormal) {
   EXPECT_GT(kinds[static_cast<int>(PolyContactKind::EdgeEdge)], 30);
 }
 
+// On a face axis, the incident body's vertex that gives the separation (its
+// lowest along the reference face's normal) may lie outside the reference
+// face's prism, clipped away with the incident face's polygon, and still
+// be inside the reference body (through a neighbouring face's region).
+// Then it must be a point of the contact, the deepest, at the separation:
+// held by no row, it sank on (irregular hulls in a compaction: 0.002 d a
+// step, 0.056 d in 25 steps). Random pairs (measured: of 981 face
+// contacts, 813 have that vertex inside the reference body; without the
+// vertex's point, 114 of those miss it by more than the band).
+TEST(PolyhedronContact, APenetratingVertexClippedAwayIsStillAPoint) {
+  int face_contacts = 0, inside = 0;
+  for (const RandomPair& r : random_pairs(3000)) {
+    const auto c = collide(r.a, r.pa, r.b, r.pb, 0.02);
+    if (!c || c->axis.kind == PolyAxisKind::EdgePair) continue;
+    ++face_contacts;
+    const bool ref_a = c->axis.kind == PolyAxisKind::FaceA;
+    const ConvexPolyhedron& R = ref_a ? r.a : r.b;
+    const ConvexPolyhedron& I = ref_a ? r.b : r.a;
+    const Pose3& pr = ref_a ? r.pa : r.pb;
+    const Pose3& pi = ref_a ? r.pb : r.pa;
+    const Vec3 n = ref_a ? c->normal : Vec3(-c->normal);  // the reference face's outward normal
+    Vec3 low = pi.position + pi.orientation * I.vertices()[0];
+    for (const Vec3& v : I.vertices()) {
+      const Vec3 x = pi.position + pi.orientation * v;
+      if (n.dot(x) < n.dot(low)) low = x;
+    }
+    bool in = true;
+    for (const auto& f : R.faces()) in = in && (pr.orientation * f.normal).dot(low - pr.position) < f.offset - 1e-9;
+    if (!in) continue;
+    ++inside;
+    double deepest = 1e300;
+    for (const auto& p : c->points()) deepest = std::min(deepest, p.gap);
+    // Within the narrow phase's band (1e-3 L): a clipped point as deep as
+    // that, near the vertex, holds it as well.
+    const double band = 1e-3 * std::min(R.circumradius(), I.circumradius());
+    EXPECT_LE(deepest, c->separation + band) << "the vertex at the separation is no point of the contact";
+  }
+  std::printf("face contacts %d, their separation's vertex inside the reference body %d\n", face_contacts, inside);
+  EXPECT_GT(inside, 100);
+}
+
 TEST(PolyhedronContact, RepeatedCallsAreBitIdentical) {
   auto bits = [](const PolyContact& c) {
     std::vector<unsigned char> out;
