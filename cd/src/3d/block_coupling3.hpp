@@ -119,12 +119,21 @@ struct BlockCoupling3 {
 
   const RowExtra3* extra_of(const BlockRow3& r) const { return extra ? extra + (&r - base) : nullptr; }
 
+  // The normal component of velocity(r), which the open-row test reads alone.
+  double normal_velocity(const BlockRow3& r) const {
+    const BodyVel3& A = vel[r.b1];
+    const BodyVel3& B = vel[r.b2];
+    const Vec3 dv = B.v - A.v;
+    double un = r.n.dot(dv) + r.bn;
+    un += r.a2[0].dot(B.w) - r.a1[0].dot(A.w);
+    return un;
+  }
   Vec3 velocity(const BlockRow3& r) const {
     const BodyVel3& A = vel[r.b1];
     const BodyVel3& B = vel[r.b2];
     const Vec3 dv = B.v - A.v;
-    Vec3 u(r.n.dot(dv) + r.bn, r.t1.dot(dv), r.t2.dot(dv));
-    for (int j = 0; j < 3; ++j) u[j] += r.a2[j].dot(B.w) - r.a1[j].dot(A.w);
+    Vec3 u(normal_velocity(r), r.t1.dot(dv), r.t2.dot(dv));
+    for (int j = 1; j < 3; ++j) u[j] += r.a2[j].dot(B.w) - r.a1[j].dot(A.w);
     if (const RowExtra3* e = extra_of(r)) {
       u[1] += e->bt1;
       u[2] += e->bt2;
@@ -201,16 +210,6 @@ struct BlockCoupling3 {
 
   // One row update: the free velocity q = u - W r, the exact local solve,
   // the change into the bodies (body 1 only when Write1).
-  // velocity(r)[0], the same operations in the same order (the same bits).
-  double normal_velocity(const BlockRow3& r) const {
-    const BodyVel3& A = vel[r.b1];
-    const BodyVel3& B = vel[r.b2];
-    const Vec3 dv = B.v - A.v;
-    double un = r.n.dot(dv) + r.bn;
-    un += r.a2[0].dot(B.w) - r.a1[0].dot(A.w);
-    return un;
-  }
-
   template <class L, bool Write1>
   void update(BlockRow3& r, double& dp2, double& pabs) const {
     // A row at zero impulse whose normal velocity stays >= 0 stays open

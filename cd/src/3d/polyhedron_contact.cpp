@@ -46,12 +46,20 @@ Placed place(const ConvexPolyhedron& P, const Pose3& pose, const Vec3& origin) {
   return out;
 }
 
-// min over the vertices of n . v
-double support_low(const Placed& P, const Vec3& n) {
-  double m = std::numeric_limits<double>::infinity();
-  for (const Vec3& x : P.v) m = std::min(m, n.dot(x));
-  return m;
+// The vertex of P lowest along n (the first on a tie).
+int support_low_vertex(const Placed& P, const Vec3& n) {
+  int v = 0;
+  double low = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < static_cast<int>(P.v.size()); ++k)
+    if (const double s = n.dot(P.v[k]); s < low) {
+      low = s;
+      v = k;
+    }
+  return v;
 }
+
+// min over the vertices of n . v
+double support_low(const Placed& P, const Vec3& n) { return n.dot(P.v[support_low_vertex(P, n)]); }
 
 // The separation of I from R along R's face f.
 double face_separation(const Placed& R, int f, const Placed& I) {
@@ -246,14 +254,8 @@ PolyContact face_contact(const Placed& R, int f, const Placed& I, bool ref_b, do
   }
   // The incident body's deepest vertex against the face: the one that gives
   // this axis its separation.
-  int v = 0;
-  double low = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < static_cast<int>(I.v.size()); ++k)
-    if (n.dot(I.v[k]) < low) {
-      low = n.dot(I.v[k]);
-      v = k;
-    }
-  const double g = low - d;
+  const int v = support_low_vertex(I, n);
+  const double g = n.dot(I.v[v]) - d;
   const auto vertex_point = [&] {
     return PolyContactPoint{I.v[v] - 0.5 * g * n, g,
                             poly_point_key(PolyKeyTag::Vertex, ref_b, fr, static_cast<std::uint32_t>(v), 0)};
