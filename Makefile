@@ -60,6 +60,8 @@ help:
 	@echo "  make tensile         tensile strength of a cohesive aggregate against dt (outputs/tensile/; QUICK=1: ~20 s)"
 	@echo "  make compare-liggghts-shear  a 1000-sphere mu(I) point by LIGGGHTS and cdsim, one thread each: CPU per"
 	@echo "                       unit strain, sweeps, mu, phi, z, the ratio (CMP_DIR; QUICK=1: strain 0.3)"
+	@echo "  make compare-liggghts-ladder  LIGGGHTS at each stiffness E/p of LADDER_EP beside cdsim's settings"
+	@echo "                       LADDER_CD, each against the rigid reference: cost for the same mu, phi, z"
 	@echo "  make compare-yade-pile  the first YCMP_T s of 1000 cubes falling (pile-polyhedra) by YADE's polyhedra"
 	@echo "                       and cdsim, one thread each: CPU, steps, largest overlap, the ratio (YCMP_DIR)"
 	@echo "  make prep-overlap    ratio-4 preparations (disks, hexagons, a 3/6/0 mixture at ratio 5), N = PO_N: fails if an overlap reaches 0.01 d_small"
@@ -97,6 +99,7 @@ help:
 	@echo "  make regress-campaign, regress3-campaign  the reference campaigns of make regress"
 	@echo "  make frozen-shear-runs, accuracy-shear-runs, accuracy-shear3-runs  the runs of make frozen-shear, make accuracy-shear, make accuracy-shear3"
 	@echo "  make frozen-shear3-run  the run of make frozen-shear3 (its sample, then the shear)"
+	@echo "  make compare-liggghts-ladder-runs, ladder-cdsim  the runs of make compare-liggghts-ladder (all; cdsim's)"
 	@echo "Variables (make TARGET VAR=value ...), with their values now"
 	$(call help_var,SCENE,the scene of make run)
 	$(call help_var,OUT,its output folder)
@@ -116,6 +119,11 @@ help:
 	$(call help_var,SHEAR_TOL,solver.tol for every shear run (empty: by I; docs/shear.md))
 	$(call help_var,SHEAR_SET,more --set options for every shear run (e.g. --set solver.anderson=5))
 	$(call help_var,CMP_DIR,make compare-liggghts-shear's folder)
+	$(call help_var,LADDER_DIR,make compare-liggghts-ladder's folder)
+	$(call help_var,LADDER_EP,its LIGGGHTS stiffnesses E/p at I = 0.01)
+	$(call help_var,LADDER_EP3,those at I = 1e-3)
+	$(call help_var,LADDER_SEEDS,LIGGGHTS' samples (deck.py seed))
+	$(call help_var,LADDER_CD,cdsim's settings (a3_set_<name>))
 	$(call help_var,YCMP_DIR,make compare-yade-pile's folder)
 	$(call help_var,YCMP_E,YADE's polyhedra stiffness (the material's young; its law's kn = E/2 in N/m^3))
 	$(call help_var,YCMP_T,the simulated seconds of make compare-yade-pile)
@@ -1072,9 +1080,54 @@ compare-liggghts-shear: build
 	    DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y --no-install-recommends libvtk9-dev python3-paraview-; }
 	rm -rf $(CMP_DIR) && mkdir -p $(CMP_DIR)
 	@echo "compare-liggghts-shear: load average at the start $$(cut -d' ' -f1-3 /proc/loadavg)"
-	/usr/bin/python3 cd/bench/peers/liggghts-shear/run.py $(CMP_DIR)/liggghts I=$(CMP_I) Ep=1e5 \
+	CDANALYSIS=$(BUILD)/analysis/cdanalysis /usr/bin/python3 cd/bench/peers/liggghts-shear/run.py $(CMP_DIR)/liggghts I=$(CMP_I) Ep=1e5 \
 	  strain=$(CMP_STRAIN) > $(CMP_DIR)/liggghts.log 2>&1 & lig=$$!; \
 	$(MAKE) --no-print-directory campaign-inertial DIM=3 N=1000 INERTIAL_I=$(CMP_I) THREADS=1 \
 	  STRAIN=$(CMP_STRAIN) CAMPAIGNS=$(CMP_DIR)/cdsim; cd=$$?; \
 	wait $$lig || { tail -5 $(CMP_DIR)/liggghts.log; exit 1; }; [ $$cd = 0 ]
 	/usr/bin/python3 cd/bench/peers/shear_table.py $(CMP_DIR)
+
+# make compare-liggghts-ladder [LADDER_EP="1e4 1e5 1e6 1e7"] [LADDER_SEEDS=...] [LADDER_CD=...]
+# What each code costs for the same answer. LIGGGHTS (the deck of
+# compare-liggghts-shear, its top wall a body under -p A at any stiffness)
+# at each Hertz stiffness E/p of LADDER_EP at I = 0.01 (strain 2, window
+# 1-2) and of LADDER_EP3 at I = 1e-3 (strain 1, window 0.5-1), each seed of
+# LADDER_SEEDS; cdsim's 1000-sphere point of make accuracy-shear3 (sample
+# 11, the reference's first, continued for strain 1 at I = 0.01) under
+# each setting of LADDER_CD (a3_set_<name>: policy, fast, k1e4 the
+# compliant contacts at the stiffness number DEM's E/p = 1e6 has), side by
+# side (-j2: two runs at a time, one thread each). Then
+# cd/bench/peers/ladder_table.py: mu, phi, z (one estimator for both:
+# cdanalysis' force-bearing network without rattlers), sigma_yy/p, CPU per
+# unit strain, each against the rigid reference of make accuracy-shear3
+# (cd/bench/peers/rigid_reference.csv, five samples) in combined standard
+# errors; LADDER_DIR/table.md and ladder.svg (cost against the stiffness).
+LADDER_DIR ?= outputs/compare-liggghts-ladder
+LADDER_EP ?= 1e4 1e5 1e6 1e7
+LADDER_EP3 ?= 1e5 1e6
+LADDER_SEEDS ?= 12345
+LADDER_CD ?= policy fast k1e4
+a3_set_k1e4 := --set contact.stiffness_number=1e4
+a3_set_k1e5 := --set contact.stiffness_number=1e5
+ladder_lig = $(foreach s,$(LADDER_SEEDS),$(foreach e,$(LADDER_EP),$(LADDER_DIR)/liggghts/I_0.01/Ep_$(e)/s_$(s)) \
+  $(foreach e,$(LADDER_EP3),$(LADDER_DIR)/liggghts/I_0.001/Ep_$(e)/s_$(s)))
+.PHONY: compare-liggghts-ladder compare-liggghts-ladder-runs
+compare-liggghts-ladder: programs
+	$(call install_missing,compare-liggghts-ladder,liggghts python3-numpy)
+	@echo "compare-liggghts-ladder: load average at the start $$(cut -d' ' -f1-3 /proc/loadavg)"
+	$(MAKE) --no-print-directory compare-liggghts-ladder-runs
+	/usr/bin/python3 cd/bench/peers/ladder_table.py $(LADDER_DIR) cd/bench/peers/rigid_reference.csv \
+	  $(foreach k,$(LADDER_CD),$(LADDER_DIR)/cdsim/I_0.01/s11/$(k))
+compare-liggghts-ladder-runs: $(addsuffix /.done,$(ladder_lig)) ladder-cdsim
+# The cdsim side: make accuracy-shear3's runs, in LADDER_DIR (sharing -j).
+.PHONY: ladder-cdsim
+ladder-cdsim:
+	+$(MAKE) --no-print-directory accuracy-shear3-runs A3_DIR=$(LADDER_DIR)/cdsim A3_SEEDS=11 A3_I=0.01 \
+	  A3_SETTINGS="$(LADDER_CD)" A3_STRAIN=1
+$(LADDER_DIR)/liggghts/%/.done:
+	rm -rf $(@D) && mkdir -p $(@D)
+	CDANALYSIS=$(BUILD)/analysis/cdanalysis /usr/bin/python3 cd/bench/peers/liggghts-shear/run.py $(@D) \
+	  I=$(word 2,$(subst _, ,$(word 1,$(subst /, ,$*)))) Ep=$(word 2,$(subst _, ,$(word 2,$(subst /, ,$*)))) \
+	  seed=$(word 2,$(subst _, ,$(word 3,$(subst /, ,$*)))) \
+	  strain=$(if $(filter I_0.001/%,$*),1,2) > $(@D).log 2>&1 || { tail -5 $(@D).log; exit 1; }
+	touch $@

@@ -10,7 +10,9 @@ Both codes are averaged over the second half of their strain, mu as the
 ratio of the mean stresses, its error the standard error of 5 equal strain
 blocks. cdsim: mu = -(s_xy + s_yx)/2 / s_yy of the contact stress, phi of
 the whole cell, z without rattlers (series.csv); LIGGGHTS: the wall
-forces, phi and z (rattlers included) in the bulk (post.py). CPU: user +
+forces, phi in the bulk, z by cdanalysis on the bulk's force-bearing
+network without rattlers (the estimator of cdsim's z), and its raw contact
+count per grain, rattlers in (post.py). CPU: user +
 system seconds of each process (cdsim: summary.toml's cpu_time).
 """
 import csv
@@ -88,9 +90,9 @@ def main():
            "largest overlap |\n|---|---|---|---|---|---|---|---|---|---|---|\n")
     rows = [
         "| LIGGGHTS shear, E/p = %.3g, to gamma = %.2f | %.1f | %.2f | 1 | %s | - | %.3f +- %.3f | %.4f | %.2f "
-        "(rattlers in) | %.3f | - |" % (float(lig["Ep"]), S_l, cpu_l, per_l, lig["steps"], float(lig["mu"]),
-                                       float(lig["mu_se"]), float(lig["phi"]), float(lig["z"]),
-                                       float(lig["p_over_set"])),
+        "(raw %.2f) | %.3f | - |" % (float(lig["Ep"]), S_l, cpu_l, per_l, lig["steps"], float(lig["mu"]),
+                                     float(lig["mu_se"]), float(lig["phi"]), float(lig["z"]), float(lig["z_raw"]),
+                                     float(lig["p_over_set"])),
         "| cdsim 3D shear, to gamma = %.2f | %.1f | %.2f | **%.1f** | %d | %.0f (%.1f %% at the cap) | "
         "%.3f +- %.3f | %.4f | %.2f | %.3f | %.2g d |" % (S_c, cpu_c, per_c, per_c / per_l, shear["steps"],
                                                          shear["sweeps_mean"], 100 * shear["cap_share"], st["mu"],

@@ -12,27 +12,37 @@ shear rate is 1.06-1.25 times the nominal one).
 usage: deck.py OUTDIR [key=value ...]    keys and defaults: DEFAULTS below
 
 The scene
-  grains   N spheres, diameters uniform in [(1 - poly) d, (1 + poly) d]
-           (number mean d), density rho; Hertz-Mindlin with history
+  grains   N spheres, diameters in [a, ratio a] of number mean d, drawn
+           as cdsim draws a scene's (particles.size_dist, cd/src/scene/
+           derived.cpp): uniform_area, pdf ~ 1/d^2 (cdsim's default and its
+           3D shear samples', ratio 2), or uniform; density rho; Hertz-Mindlin with history
            ("hertz tangential history"), E = Ep p, Poisson nu, restitution
            en, friction mu, the same for grain-wall contacts.
   walls    Lxz x Lxz glued spheres of diameter d on a square grid of pitch
            d, jittered +-0.1 d in x and z, +-0.25 d in y; the bottom fixed,
-           the top moved rigidly (`fix move variable`): v_x = V, v_y from a
-           servo on the normal force it carries.
+           the top a rigid body of mass M (its spheres' density wallrho
+           rho) free along y under the grains' force and the imposed -p A
+           (`fix aveforce`: each of its spheres gets the mean force; `fix
+           setforce` holds v_x and v_z), so that <F_y> = p A exactly
+           whenever its momentum is steady, at any contact stiffness.
   prepare  random sequential addition of the grains at packing fraction
            phi0 between the walls; (A) the top wall comes down at rate
-           rmax H/t_p until the grains' layer holds phi = 0.55; (B) the
-           servo v_y = H clip(g (F_y/(p A) - 1), +-rmax)/t_p for tB t_p,
-           g = gain/(K/p), K the Hertz stiffness of a packing at p.
+           rmax H/t_p (`fix move`) until the grains' layer holds phi =
+           0.55; (B) the wall under -p A for tB t_p (records of F_y/(p A)
+           in prep_ave.txt).
   shear    V = gdot H0 (gdot = I sqrt(p/rho)/d, H0 the wall gap at the
-           start of shear), the grains given the linear profile, servo on.
-           gamma = V t / H0.
+           start of shear), the grains given the linear profile, the wall
+           under -p A moving along x at V. gamma = V t / H0.
+  Why not a servo on the wall's velocity from its force error (the deck's
+  first form, v_y = H g (F_y/(pA) - 1)/t_p with g ~ p/K): at a stiffness
+  E/p = 1e6 its gain is so small that the dilatancy of shear kept p at
+  0.84 of the target after gamma = 2.
   step     dtfac times the Hertz duration of a collision of two of the
            smallest grains at sqrt(p/rho).
   records  every dgamma of strain (averaged over every 10th step): the wall
            forces, the gap H, the mean contact number; a dump of every
-           atom every 5 dgamma (phi, z, profiles).
+           atom and one of every contact (the pair, its normal force:
+           shear.contacts) every 5 dgamma (phi, z, profiles).
 Writes OUTDIR/in.shear, OUTDIR/shear.data and OUTDIR/params.txt (what
 post.py reads).
 """
@@ -41,8 +51,8 @@ import os
 import random
 import sys
 
-DEFAULTS = dict(N=1000, I=0.01, strain=2.0, Ep=1e5, en=0.1, mu=0.4, nu=0.3, poly=0.25,
-                seed=12345, dtfac=0.1, p=100.0, d=1e-3, rho=2600.0, phi0=0.35, gain=1.0,
+DEFAULTS = dict(N=1000, I=0.01, strain=2.0, Ep=1e5, en=0.1, mu=0.4, nu=0.3, ratio=2.0, dist="uniform_area",
+                seed=12345, dtfac=0.1, p=100.0, d=1e-3, rho=2600.0, phi0=0.35, wallrho=1.0,
                 tB=40.0, skin=0.15, dgamma=0.02, Lxz=8, rmax=0.02)
 INTS = {"N", "seed", "Lxz"}
 
@@ -53,13 +63,27 @@ def options(argv):
         k, sep, v = a.partition("=")
         if not sep or k not in o:
             sys.exit("deck.py: unknown option '%s' (keys: %s)" % (a, " ".join(DEFAULTS)))
-        o[k] = int(v) if k in INTS else float(v)
+        if k == "dist":
+            if v not in ("uniform", "uniform_area"):
+                sys.exit("deck.py: dist '%s': uniform or uniform_area" % v)
+            o[k] = v
+        else:
+            o[k] = int(v) if k in INTS else float(v)
     return o
+
+
+def diameter_range(o):
+    """[a, b], b = ratio a, whose number mean is d under the law dist (cdsim's diameter_range)."""
+    r, d = o["ratio"], o["d"]
+    if r == 1.0:
+        return d, d
+    a = 2.0 * d / (1.0 + r) if o["dist"] == "uniform" else d * (r - 1.0) / (r * math.log(r))
+    return a, a * r
 
 
 def hertz_duration(o, E_eff):
     """Duration of a head-on Hertz collision of two of the smallest grains at sqrt(p/rho)."""
-    dmin = (1 - o["poly"]) * o["d"]
+    dmin = diameter_range(o)[0]
     m_eff = 0.5 * o["rho"] * math.pi * dmin ** 3 / 6
     r_eff = dmin / 4
     v = math.sqrt(o["p"] / o["rho"])
@@ -107,17 +131,13 @@ def main():
     gd = o["I"] / tp
     tH = hertz_duration(o, E_eff)
     dt = o["dtfac"] * tH
-    # Servo gain: K/p of a packing under p, from the Hertz overlap of a
-    # contact carrying the mean force of a packing (phi ~ 0.6, z ~ 4.5).
-    f_mean = math.pi * d * d * p / (4.5 * 0.6)
-    overlap = (3 * f_mean / (4 * E_eff * math.sqrt(d / 4))) ** (2.0 / 3.0)
-    K_over_p = 1.5 / (overlap / d)
-    g = o["gain"] / K_over_p
 
     rng = random.Random(o["seed"])
     L = o["Lxz"] * d
     area = L * L
-    diam = [d * (1 - o["poly"] + 2 * o["poly"] * rng.random()) for _ in range(N)]
+    a, b = diameter_range(o)
+    diam = [a + (b - a) * rng.random() if o["dist"] == "uniform" else 1.0 / (1.0 / a - rng.random() * (1.0 / a - 1.0 / b))
+            for _ in range(N)]
     vol = sum(math.pi * x ** 3 / 6 for x in diam)
     gas = vol / o["phi0"] / area  # the layer the grains fill at phi0
     centres = place_grains(o, rng, diam, L, d, gas)
@@ -132,7 +152,8 @@ def main():
         f.write("cdlab side-by-side: LIGGGHTS wall shear, N=%d\n\n%d atoms\n1 atom types\n\n" % (N, len(atoms)))
         f.write("0 %.9g xlo xhi\n%.9g %.9g ylo yhi\n0 %.9g zlo zhi\n\nAtoms\n\n" % (L, -2 * d, y_top + 3 * d, L))
         for k, (dd, c) in enumerate(atoms):
-            f.write("%d 1 %.9g %.6g %.9g %.9g %.9g\n" % (k + 1, dd, rho, c[0], c[1], c[2]))
+            f.write("%d 1 %.9g %.6g %.9g %.9g %.9g\n" % (k + 1, dd, rho * (o["wallrho"] if k >= N else 1.0),
+                                                         c[0], c[1], c[2]))
 
     rmax = o["rmax"]
     H_A = vol / (0.55 * area) + d  # wall gap (centre to centre) when the layer holds phi = 0.55
@@ -142,7 +163,11 @@ def main():
     steps_S = int(math.ceil(o["strain"] / (gd * dt) / every)) * every
     bot = (N + 1, N + nwall)
     top = (N + nwall + 1, N + 2 * nwall)
-    vars_ = dict(o, E=E, tp=tp, gd=gd, dt=dt, tH=tH, g=g, K_over_p=K_over_p, area=area, steps_A=steps_A,
+    # The record interval of (B): every 0.1 t_p, each the mean of every 10th step.
+    everyB = max(10, int(round(0.1 * tp / dt / 10.0)) * 10)
+    fwall = -p * area / nwall  # added to each top sphere's share of the mean force
+    vars_ = dict(o, E=E, tp=tp, gd=gd, dt=dt, tH=tH, fwall=fwall, everyB=everyB, everyB10=everyB // 10,
+                 area=area, steps_A=steps_A,
                  steps_B=steps_B, steps_S=steps_S, every=every, every10=every // 10, dump=5 * every,
                  thermo_A=max(10, steps_A // 100 * 10), thermo_B=max(10, steps_B // 200 * 10),
                  thermo_S=5 * every, b0=bot[0], b1=bot[1], t0=top[0], t1=top[1], neigh=o["skin"] * d)
@@ -158,8 +183,8 @@ def main():
 
 
 DECK = """# cdlab side-by-side: 3D plane shear between rough walls at imposed normal stress (deck.py)
-# N={N} I={I} strain={strain} E/p={Ep:g} en={en} mu={mu} nu={nu} poly={poly} seed={seed} walls {Lxz}x{Lxz}
-# p={p} Pa d={d} m rho={rho} t_p={tp:.6e} s gdot={gd:.6e} /s dt={dt:.6e} s, servo g={g:.4e} (K/p ~ {K_over_p:.0f})
+# N={N} I={I} strain={strain} E/p={Ep:g} en={en} mu={mu} nu={nu} ratio={ratio} {dist} seed={seed} walls {Lxz}x{Lxz}
+# p={p} Pa d={d} m rho={rho} t_p={tp:.6e} s gdot={gd:.6e} /s dt={dt:.6e} s, top wall density {wallrho} rho
 atom_style granular
 atom_modify map array
 boundary p f p
@@ -185,10 +210,10 @@ fix ts flow check/timestep/gran 10 0.3 0.1
 compute rke flow erotate/sphere
 compute cpa all contact/atom
 compute ncon flow reduce sum c_cpa
+compute pgl all pair/gran/local id force_normal force_tangential
 variable P equal {p}
 variable A equal {area:.9e}
 variable tp equal {tp:.9e}
-variable g equal {g:.9e}
 variable rmax equal {rmax}
 variable H equal xcm(top,y)-xcm(bot,y)
 variable Fyt equal fcm(top,y)
@@ -196,8 +221,6 @@ variable Fxt equal fcm(top,x)
 variable Fyb equal fcm(bot,y)
 variable Fxb equal fcm(bot,x)
 variable zf equal c_ncon/{N}
-variable e equal v_g*(v_Fyt/(v_P*v_A)-1.0)
-variable c equal (v_e>v_rmax)*v_rmax+(v_e<-v_rmax)*(-v_rmax)+(abs(v_e)<=v_rmax)*v_e
 variable V equal 0.0
 variable vyt equal -v_rmax*v_H/v_tp
 fix mv top move variable NULL NULL NULL v_V v_vyt NULL
@@ -206,10 +229,23 @@ thermo_modify lost error norm no flush yes
 thermo {thermo_A}
 # (A) the top wall comes down to a layer at phi = 0.55
 run {steps_A}
-# (B) the servo at p
-variable vyt equal v_H*v_c/v_tp
+# (B) the top wall a rigid body under -p A: aveforce gives each of its
+# spheres the mean force plus its share of -p A (its global vector: the
+# grains' force on the wall before that change), setforce then holds v_x
+# and v_z; nve moves it.
+unfix mv
+velocity top set 0.0 0.0 0.0 units box
+fix fw top aveforce 0.0 {fwall:.9e} 0.0
+fix sw top setforce 0.0 NULL 0.0
+fix integt top nve
+variable Fyt equal f_fw[2]
+variable Fxt equal f_fw[1]
+variable pyt equal v_Fyt/(v_P*v_A)
+variable pyb equal -v_Fyb/(v_P*v_A)
+fix aveB all ave/time 10 {everyB10} {everyB} v_pyt v_pyb v_H file prep_ave.txt
 thermo {thermo_B}
 run {steps_B}
+unfix aveB
 print "PREP_DONE H=$(v_H) Fyt/pA=$(v_Fyt/(v_P*v_A)) Fyb/pA=$(v_Fyb/(v_P*v_A)) z=$(v_zf) ke=$(ke)"
 # shear
 variable tmp equal v_H
@@ -221,7 +257,7 @@ variable yt equal ${{tmp}}
 variable tmp equal {gd:.9e}*v_H0
 variable Vs equal ${{tmp}}
 velocity flow ramp vx 0.0 ${{Vs}} y ${{yb}} ${{yt}} sum yes units box
-variable V equal v_Vs
+velocity top set ${{Vs}} NULL 0.0 units box
 variable tmp equal step
 variable s0 equal ${{tmp}}
 variable strain equal (step-v_s0)*dt*v_Vs/v_H0
@@ -230,6 +266,7 @@ thermo_style custom step time v_strain ke c_rke v_H v_Fxt v_Fyt v_Fxb v_Fyb v_zf
 thermo {thermo_S}
 dump dsh all custom {dump} shear.dump id radius x y z vx vy vz c_cpa
 dump_modify dsh sort id
+dump dlc all local {dump} shear.contacts c_pgl[1] c_pgl[2] c_pgl[3] c_pgl[4] c_pgl[5] c_pgl[6] c_pgl[7] c_pgl[8] c_pgl[9]
 run {steps_S}
 print "SHEAR_DONE strain=$(v_strain) H=$(v_H)"
 """

@@ -7,7 +7,9 @@ difference. Then post.py's averages.
 usage: run.py RUNDIR [deck.py key=value ...]
 Writes RUNDIR/{in.shear, shear.data, params.txt, out.txt, log.lammps,
 shear_ave.txt, shear.dump, cpu.txt, result.txt}; result.txt is one line of
-key=value pairs (post.py's, then cpu_prep, cpu_shear, cpu_total).
+key=value pairs (post.py's, then cpu_prep, cpu_shear, cpu_total). With
+CDANALYSIS set (a cdanalysis binary) post.py also measures z by it, from
+the frames as cdsim snapshots in RUNDIR/snapshots/.
 """
 import os
 import subprocess
@@ -33,6 +35,7 @@ def main():
     # Line-buffered stdout, so that PREP_DONE arrives when it is printed.
     cmd = ["stdbuf", "-oL", "liggghts", "-in", "in.shear", "-log", "log.lammps"]
     cpu_prep = None
+    done = False
     with open(os.path.join(rundir, "out.txt"), "w") as out:
         proc = subprocess.Popen(cmd, cwd=rundir, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                 text=True)
@@ -40,12 +43,15 @@ def main():
             out.write(line)
             if cpu_prep is None and line.startswith("PREP_DONE"):
                 cpu_prep = cpu_of(proc.pid)
+            done = done or line.startswith("SHEAR_DONE")
         _, status, usage = os.wait4(proc.pid, 0)
         proc.returncode = os.waitstatus_to_exitcode(status)
-    if proc.returncode != 0 or cpu_prep is None:
-        sys.exit("run.py: liggghts failed (exit %d); see %s/out.txt" % (proc.returncode, rundir))
+    if proc.returncode != 0 or cpu_prep is None or not done:
+        sys.exit("run.py: liggghts failed (exit %d%s); see %s/out.txt" %
+                 (proc.returncode, "" if done else ", no SHEAR_DONE line", rundir))
     cpu_total = usage.ru_utime + usage.ru_stime
-    post = subprocess.run([PY, os.path.join(HERE, "post.py"), rundir], check=True, text=True,
+    cda = ["cda=" + os.environ["CDANALYSIS"]] if os.environ.get("CDANALYSIS") else []
+    post = subprocess.run([PY, os.path.join(HERE, "post.py"), rundir] + cda, check=True, text=True,
                           stdout=subprocess.PIPE).stdout.strip()
     line = "%s cpu_prep=%.2f cpu_shear=%.2f cpu_total=%.2f" % (post, cpu_prep, cpu_total - cpu_prep, cpu_total)
     with open(os.path.join(rundir, "result.txt"), "w") as f:
