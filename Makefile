@@ -124,6 +124,7 @@ help:
 	$(call help_var,LADDER_EP3,those at I = 1e-3)
 	$(call help_var,LADDER_SEEDS,LIGGGHTS' samples (deck.py seed))
 	$(call help_var,LADDER_CD,cdsim's settings (a3_set_<name>))
+	$(call help_var,LADDER_CD3,those at I = 1e-3)
 	$(call help_var,YCMP_DIR,make compare-yade-pile's folder)
 	$(call help_var,YCMP_E,YADE's polyhedra stiffness (the material's young; its law's kn = E/2 in N/m^3))
 	$(call help_var,YCMP_T,the simulated seconds of make compare-yade-pile)
@@ -1095,8 +1096,8 @@ compare-liggghts-shear: build
 # LADDER_SEEDS; cdsim's 1000-sphere point of make accuracy-shear3 (sample
 # 11, the reference's first, continued for strain 1 at I = 0.01) under
 # each setting of LADDER_CD (a3_set_<name>: policy, fast, k1e4 the
-# compliant contacts at the stiffness number DEM's E/p = 1e6 has), side by
-# side (-j2: two runs at a time, one thread each). Then
+# compliant contacts at the stiffness number DEM's E/p = 1e6 has) and at
+# I = 1e-3 of LADDER_CD3 (continued for strain 0.25), side by side (-j2: two runs at a time, one thread each). Then
 # cd/bench/peers/ladder_table.py: mu, phi, z (one estimator for both:
 # cdanalysis' force-bearing network without rattlers), sigma_yy/p, CPU per
 # unit strain, each against the rigid reference of make accuracy-shear3
@@ -1107,6 +1108,7 @@ LADDER_EP ?= 1e4 1e5 1e6 1e7
 LADDER_EP3 ?= 1e5 1e6
 LADDER_SEEDS ?= 12345
 LADDER_CD ?= policy fast k1e4
+LADDER_CD3 ?= policy
 a3_set_k1e4 := --set contact.stiffness_number=1e4
 a3_set_k1e5 := --set contact.stiffness_number=1e5
 ladder_lig = $(foreach s,$(LADDER_SEEDS),$(foreach e,$(LADDER_EP),$(LADDER_DIR)/liggghts/I_0.01/Ep_$(e)/s_$(s)) \
@@ -1117,13 +1119,16 @@ compare-liggghts-ladder: programs
 	@echo "compare-liggghts-ladder: load average at the start $$(cut -d' ' -f1-3 /proc/loadavg)"
 	$(MAKE) --no-print-directory compare-liggghts-ladder-runs
 	/usr/bin/python3 cd/bench/peers/ladder_table.py $(LADDER_DIR) cd/bench/peers/rigid_reference.csv \
-	  $(foreach k,$(LADDER_CD),$(LADDER_DIR)/cdsim/I_0.01/s11/$(k))
+	  $(foreach k,$(LADDER_CD),$(LADDER_DIR)/cdsim/I_0.01/s11/$(k)) \
+	  $(foreach k,$(LADDER_CD3),$(LADDER_DIR)/cdsim/I_0.001/s11/$(k))
 compare-liggghts-ladder-runs: $(addsuffix /.done,$(ladder_lig)) ladder-cdsim
 # The cdsim side: make accuracy-shear3's runs, in LADDER_DIR (sharing -j).
 .PHONY: ladder-cdsim
 ladder-cdsim:
 	+$(MAKE) --no-print-directory accuracy-shear3-runs A3_DIR=$(LADDER_DIR)/cdsim A3_SEEDS=11 A3_I=0.01 \
 	  A3_SETTINGS="$(LADDER_CD)" A3_STRAIN=1
+	+$(MAKE) --no-print-directory accuracy-shear3-runs A3_DIR=$(LADDER_DIR)/cdsim A3_SEEDS=11 A3_I=0.001 \
+	  A3_SETTINGS="$(LADDER_CD3)" A3_STRAIN=0.25
 $(LADDER_DIR)/liggghts/%/.done:
 	rm -rf $(@D) && mkdir -p $(@D)
 	CDANALYSIS=$(BUILD)/analysis/cdanalysis /usr/bin/python3 cd/bench/peers/liggghts-shear/run.py $(@D) \

@@ -24,18 +24,8 @@ import os
 import statistics
 import sys
 
-
-def summary(path):
-    out = {}
-    for line in open(path):
-        line = line.split("#", 1)[0].strip()
-        if "=" in line:
-            k, v = (x.strip() for x in line.split("=", 1))
-            try:
-                out[k] = float(v)
-            except ValueError:
-                out[k] = v
-    return out
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+from run_files import summary
 
 
 def run(folder, w0):

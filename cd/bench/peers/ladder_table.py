@@ -15,10 +15,11 @@ the walls' forces; cdsim: the contact stress), phi the packing fraction
 (LIGGGHTS: the bulk slab 2.5 d from the walls; cdsim: the cell), z the
 force-bearing network's coordination with rattlers out, by the code of
 cdsim's z column (LIGGGHTS: cdanalysis on the bulk, post.py). A LIGGGHTS
-row with several seeds: their mean +- the standard error over seeds;
-with one: its window's own error (strain blocks for mu, frames for phi
-and z). A cdsim run: its window (continuation strain >= W0 = 0.1 at
-I = 0.01, 0.05 at 1e-3) in 5 blocks. (d sigma): the difference to the
+row of several seeds: their mean +- the larger of the standard error over
+seeds and the runs' own window errors combined as a mean's (strain blocks
+for mu, frames for phi and z); of one: its window's own error. A cdsim
+run: its window (continuation strain >= W0 = 0.1 at I = 0.01, 0.05 at
+1e-3) in 5 blocks. (d sigma): the difference to the
 reference in combined errors, sqrt(se_ref^2 + se^2); the reference's se is
 over its five samples. kappa: the stiffness number k / (p d) of a linear
 contact, (E/p)^(2/3) for LIGGGHTS' Hertz contacts (the order of the
@@ -32,33 +33,13 @@ import os
 import statistics
 import sys
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from run_files import scene_value, summary  # noqa: E402
+
 
 def kv_file(path):
     return dict(x.split("=", 1) for x in open(path).read().split())
-
-
-def summary(path):
-    out = {}
-    for line in open(path):
-        line = line.split("#", 1)[0].strip()
-        if "=" in line:
-            k, v = (x.strip() for x in line.split("=", 1))
-            try:
-                out[k] = float(v)
-            except ValueError:
-                out[k] = v.strip('"')
-    return out
-
-
-def scene_value(path, section, key):
-    sec = ""
-    for line in open(path):
-        line = line.split("#", 1)[0].strip()
-        if line.startswith("["):
-            sec = line.strip("[]")
-        elif sec == section and "=" in line and line.split("=", 1)[0].strip() == key:
-            return line.split("=", 1)[1].strip().strip('"')
-    return None
 
 
 def blocks_se(values, nb=5):
@@ -81,8 +62,11 @@ def liggghts_rows(top):
         for k in ("mu", "phi", "z"):
             vals = [float(r[k]) for r in rs]
             row[k] = statistics.fmean(vals)
-            row[k + "_se"] = (statistics.stdev(vals) / math.sqrt(len(vals)) if len(vals) > 1
-                              else float(rs[0][k + "_se"]))
+            # The runs' own window errors, combined as those of a mean of
+            # independent runs; with several seeds, the larger of that and
+            # the scatter over seeds (two or three seeds estimate it poorly).
+            own = math.sqrt(sum(float(r[k + "_se"]) ** 2 for r in rs)) / len(rs)
+            row[k + "_se"] = max(own, statistics.stdev(vals) / math.sqrt(len(vals))) if len(vals) > 1 else own
         for k in ("z_raw", "p_over_set", "p_prep", "I_bulk"):
             row[k] = statistics.fmean(float(r[k]) for r in rs)
         row["cpu"] = statistics.fmean(float(r["cpu_shear"]) / float(r["strain"]) for r in rs)

@@ -21,32 +21,17 @@ import math
 import os
 import sys
 
-
-def toml_values(path):
-    """The key = value lines of a flat summary.toml, as floats where they parse."""
-    out = {}
-    for line in open(path):
-        line = line.split("#", 1)[0].strip()
-        if "=" not in line:
-            continue
-        k, v = (x.strip() for x in line.split("=", 1))
-        try:
-            out[k] = float(v)
-        except ValueError:
-            out[k] = v.strip('"')
-    return out
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from run_files import scene_value, summary  # noqa: E402
 
 
 def toml_scene_pressure(path):
     """shear.pressure of a resolved scene.toml."""
-    section = ""
-    for line in open(path):
-        line = line.split("#", 1)[0].strip()
-        if line.startswith("["):
-            section = line.strip("[]")
-        elif section == "shear" and line.startswith("pressure"):
-            return float(line.split("=", 1)[1])
-    sys.exit("shear_table.py: no shear.pressure in " + path)
+    p = scene_value(path, "shear", "pressure")
+    if p is None:
+        sys.exit("shear_table.py: no shear.pressure in " + path)
+    return float(p)
 
 
 def window_stats(series, P, blocks=5):
@@ -78,8 +63,8 @@ def main():
     runs = sorted(glob.glob(os.path.join(top, "cdsim", "inertial", "I_*")))
     if len(runs) != 1:
         sys.exit("shear_table.py: expected one cdsim run in %s/cdsim/inertial, found %d" % (top, len(runs)))
-    shear = toml_values(os.path.join(runs[0], "summary.toml"))
-    prep = toml_values(os.path.join(top, "cdsim", "prep", "ns_0", "summary.toml"))
+    shear = summary(os.path.join(runs[0], "summary.toml"))
+    prep = summary(os.path.join(top, "cdsim", "prep", "ns_0", "summary.toml"))
     P = toml_scene_pressure(os.path.join(runs[0], "scene.toml"))
     st = window_stats(os.path.join(runs[0], "series.csv"), P)
 

@@ -192,6 +192,7 @@ newton off
 communicate single vel yes
 units si
 soft_particles yes
+hard_particles yes
 read_data shear.data
 group flow id <> 1 {N}
 group bot id <> {b0} {b1}
