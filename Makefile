@@ -1088,7 +1088,7 @@ compare-liggghts-shear: build
 	wait $$lig || { tail -5 $(CMP_DIR)/liggghts.log; exit 1; }; [ $$cd = 0 ]
 	/usr/bin/python3 cd/bench/peers/shear_table.py $(CMP_DIR)
 
-# make compare-liggghts-ladder [LADDER_EP="1e4 1e5 1e6 1e7"] [LADDER_SEEDS=...] [LADDER_CD=...]
+# make compare-liggghts-ladder [LADDER_EP="1e4 1e5 1e6 1e7 1e8"] [LADDER_SEEDS=...] [LADDER_CD=...]
 # What each code costs for the same answer. LIGGGHTS (the deck of
 # compare-liggghts-shear, its top wall a body under -p A at any stiffness)
 # at each Hertz stiffness E/p of LADDER_EP at I = 0.01 (strain 2, window
@@ -1103,10 +1103,11 @@ compare-liggghts-shear: build
 # unit strain, each against the rigid reference of make accuracy-shear3
 # (cd/bench/peers/rigid_reference.csv, five samples) in combined standard
 # errors; LADDER_DIR/table.md and ladder.svg (cost against the stiffness).
+# About 40 CPU minutes (docs/accuracy.md, "LIGGGHTS at equal accuracy").
 LADDER_DIR ?= outputs/compare-liggghts-ladder
-LADDER_EP ?= 1e4 1e5 1e6 1e7
+LADDER_EP ?= 1e4 1e5 1e6 1e7 1e8
 LADDER_EP3 ?= 1e5 1e6
-LADDER_SEEDS ?= 12345
+LADDER_SEEDS ?= 1 2
 LADDER_CD ?= policy fast k1e4
 LADDER_CD3 ?= policy
 a3_set_k1e4 := --set contact.stiffness_number=1e4

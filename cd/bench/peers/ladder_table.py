@@ -7,8 +7,8 @@ usage: ladder_table.py DIR REFERENCE.csv [CDSIM_RUN ...]
   DIR/liggghts/I_<I>/Ep_<E/p>/s_<seed>/result.txt   (liggghts-shear/run.py)
   CDSIM_RUN: a make accuracy-shear3 continuation (series.csv, summary.toml)
 Prints a Markdown table; writes DIR/table.md, DIR/ladder.csv and
-DIR/ladder.svg (CPU per unit strain, and z's distance from the reference,
-against the contacts' stiffness number).
+DIR/ladder.svg (CPU per unit strain, and z beside the reference's,
+against the contacts' stiffness number, at I = 0.01).
 
 One estimator for both codes: mu the shear over the normal stress (LIGGGHTS:
 the walls' forces; cdsim: the contact stress), phi the packing fraction
@@ -108,8 +108,8 @@ def sigmas(row, ref):
     return out
 
 
-def svg(rows, path):
-    """Two panels against kappa (log): CPU per unit strain (log), and z - z_ref in sigma."""
+def svg(rows, ref, path):
+    """Two panels against kappa (log), at I = 0.01: CPU per unit strain (log), and z beside the reference's."""
     W, H, m = 640, 520, 60
     pts = [r for r in rows if abs(r["I"] - 0.01) < 1e-12]
     if not pts:
@@ -120,15 +120,15 @@ def svg(rows, path):
     x0, x1 = math.log10(min(xs)) - 0.3, math.log10(x_rigid) + 0.3
     cpu = [r["cpu"] for r in pts]
     y0, y1 = math.log10(min(cpu)) - 0.2, math.log10(max(cpu)) + 0.2
-    ds = [r["dz"] for r in pts]
-    d0, d1 = min(ds + [-1.0]) - 1, max(ds + [1.0]) + 1
+    ds = [r["z"] for r in pts] + [ref["z"]]
+    d0, d1 = min(ds) - 0.05, max(ds) + 0.05
     ph = (H - 3 * m) / 2
     X = lambda x: m + (math.log10(x) - x0) / (x1 - x0) * (W - 2 * m)
     Y1 = lambda y: m + ph - (math.log10(y) - y0) / (y1 - y0) * ph
     Y2 = lambda y: 2 * m + 2 * ph - (y - d0) / (d1 - d0) * ph
     o = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" font-family="sans-serif" font-size="11">'
          % (W, H), '<rect width="100%" height="100%" fill="white"/>']
-    for top, label in ((m, "CPU s per unit strain (log)"), (2 * m + ph, "z - z_ref (combined sigma)")):
+    for top, label in ((m, "CPU s per unit strain (log)"), (2 * m + ph, "z, force-bearing network without rattlers")):
         o.append('<rect x="%d" y="%d" width="%d" height="%d" fill="none" stroke="black"/>' % (m, top, W - 2 * m, ph))
         o.append('<text x="%d" y="%d">%s</text>' % (m, top - 6, label))
     for e in range(math.ceil(x0), math.floor(x1) + 1):
@@ -139,10 +139,13 @@ def svg(rows, path):
              '</text>' % (W / 2, H - m + 34))
     for e in range(math.ceil(y0), math.floor(y1) + 1):
         o.append('<text x="%d" y="%.1f" text-anchor="end">%g</text>' % (m - 4, Y1(10 ** e) + 4, 10 ** e))
-    for v in (-1, 0, 1):
-        o.append('<line x1="%d" x2="%d" y1="%.1f" y2="%.1f" stroke="%s"/>' %
-                 (m, W - m, Y2(v), Y2(v), "gray" if v else "black"))
-        o.append('<text x="%d" y="%.1f" text-anchor="end">%+d</text>' % (m - 4, Y2(v) + 4, v))
+    for k in range(math.ceil(d0 * 10), math.floor(d1 * 10) + 1):
+        if k % 2 == 0:
+            o.append('<text x="%d" y="%.1f" text-anchor="end">%.1f</text>' % (m - 4, Y2(k / 10) + 4, k / 10))
+    o.append('<line x1="%d" x2="%d" y1="%.1f" y2="%.1f" stroke="black" stroke-dasharray="4,3"/>' %
+             (m, W - m, Y2(ref["z"]), Y2(ref["z"])))
+    o.append('<text x="%d" y="%.1f">the rigid reference, z = %.3f +- %.3f</text>' %
+             (m + 8, Y2(ref["z"]) - 5, ref["z"], ref["z_se"]))
     colour = {"LIGGGHTS": "#c03020", "cdsim": "#2050b0"}
     for code in colour:
         sel = sorted([(x, r) for x, r in zip(xs, pts) if r["code"] == code], key=lambda t: t[0])
@@ -150,14 +153,14 @@ def svg(rows, path):
             o.append('<polyline fill="none" stroke="%s" points="%s"/>' %
                      (colour[code], " ".join("%.1f,%.1f" % (X(x), Y1(r["cpu"])) for x, r in sel)))
             o.append('<polyline fill="none" stroke="%s" points="%s"/>' %
-                     (colour[code], " ".join("%.1f,%.1f" % (X(x), Y2(r["dz"])) for x, r in sel)))
+                     (colour[code], " ".join("%.1f,%.1f" % (X(x), Y2(r["z"])) for x, r in sel)))
         for x, r in sel:
-            for yy in (Y1(r["cpu"]), Y2(r["dz"])):
+            for yy in (Y1(r["cpu"]), Y2(r["z"])):
                 o.append('<circle cx="%.1f" cy="%.1f" r="4" fill="%s"/>' % (X(x), yy, colour[code]))
             o.append('<text x="%.1f" y="%.1f" fill="%s">%s</text>' % (X(x) + 6, Y1(r["cpu"]) - 6, colour[code],
                                                                       r["setting"]))
-    o.append('<text x="%d" y="%d" fill="#c03020">LIGGGHTS (Hertz, walls)</text>' % (W - m - 150, m + 14))
-    o.append('<text x="%d" y="%d" fill="#2050b0">cdsim (Lees-Edwards cell)</text>' % (W - m - 150, m + 28))
+    o.append('<text x="%d" y="%d" fill="#c03020">LIGGGHTS (Hertz, walls)</text>' % (m + 8, m + 14))
+    o.append('<text x="%d" y="%d" fill="#2050b0">cdsim (Lees-Edwards cell)</text>' % (m + 8, m + 28))
     o.append("</svg>")
     with open(path, "w") as f:
         f.write("\n".join(o) + "\n")
@@ -208,7 +211,8 @@ def main():
         f.write(",".join(keys) + "\n")
         for r in rows:
             f.write(",".join(str(r.get(k, "")) for k in keys) + "\n")
-    svg([r for r in rows if "dz" in r], os.path.join(top, "ladder.svg"))
+    if 0.01 in refs:
+        svg([r for r in rows if "dz" in r], refs[0.01], os.path.join(top, "ladder.svg"))
     print(table)
 
 

@@ -37,8 +37,9 @@ def main():
     cpu_prep = None
     done = False
     with open(os.path.join(rundir, "out.txt"), "w") as out:
+        # errors="replace": LIGGGHTS' error lines can end in stray bytes.
         proc = subprocess.Popen(cmd, cwd=rundir, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                text=True)
+                                text=True, errors="replace")
         for line in proc.stdout:
             out.write(line)
             if cpu_prep is None and line.startswith("PREP_DONE"):
