@@ -24,10 +24,9 @@ force_normal + force_tangential of the pair (the force on one of the two:
 on body 1 when its normal part points against n, and then negated).
 Status 0: LIGGGHTS does not tell stick from slip.
 """
+import math
 import os
 import sys
-
-import numpy as np
 
 
 def frames(path, what):
@@ -37,27 +36,27 @@ def frames(path, what):
     for b in blocks:
         lines = b.strip().splitlines()
         start = next(k for k, l in enumerate(lines) if l.startswith("ITEM: " + what)) + 1
-        rows = [[float(x) for x in l.split()] for l in lines[start:]]
-        yield int(lines[0]), np.array(rows, ndmin=2) if rows else np.zeros((0, 9))
+        yield int(lines[0]), [[float(x) for x in l.split()] for l in lines[start:]]
 
 
 def ascii_array(name, values, comps=1, kind="Float64"):
+    """values: a flat list (comps values a tuple)."""
     fmt = "%d" if kind.startswith("Int") else "%.17g"
-    body = " ".join(fmt % v for v in np.asarray(values).ravel())
+    body = " ".join(fmt % v for v in values)
     return ('<DataArray type="%s" Name="%s" NumberOfComponents="%d" format="ascii">%s</DataArray>\n' %
             (kind, name, comps, body))
 
 
-def polydata(points, point_data="", cell_data="", lines=None):
-    n_lines = 0 if lines is None else len(lines) // 2  # lines: the two points of each
+def polydata(points, point_data="", cell_data="", n_lines=None):
+    """points: a flat list of x y z; n_lines: lines of two consecutive points each (None: no cells)."""
     out = ['<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n<PolyData>\n',
            '<Piece NumberOfPoints="%d" NumberOfVerts="0" NumberOfLines="%d" NumberOfStrips="0" NumberOfPolys="0">\n' %
-           (len(points), n_lines),
+           (len(points) // 3, n_lines or 0),
            "<Points>\n", ascii_array("Points", points, 3), "</Points>\n",
            "<PointData>\n", point_data, "</PointData>\n", "<CellData>\n", cell_data, "</CellData>\n"]
-    if lines is not None:
-        out += ["<Lines>\n", ascii_array("connectivity", lines, 1, "Int64"),
-                ascii_array("offsets", 2 * np.arange(1, n_lines + 1), 1, "Int64"), "</Lines>\n"]
+    if n_lines is not None:
+        out += ["<Lines>\n", ascii_array("connectivity", range(2 * n_lines), 1, "Int64"),
+                ascii_array("offsets", range(2, 2 * n_lines + 1, 2), 1, "Int64"), "</Lines>\n"]
     out.append("</Piece>\n</PolyData>\n</VTKFile>\n")
     return "".join(out)
 
@@ -66,6 +65,10 @@ def write(path, text):
     with open(path + ".tmp", "w") as f:
         f.write(text)
     os.replace(path + ".tmp", path)
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 def main():
@@ -84,38 +87,43 @@ def main():
     for k, ((st, a), (sc, c)) in enumerate(zip(atoms, pairs)):
         if st != sc:
             sys.exit("snapshots.py: frame %d: the atoms' step %d is not the contacts' %d" % (k, st, sc))
-        a = a[np.argsort(a[:, 0])]
-        ids = a[:, 0].astype(int)
-        if len(ids) != N + 2 * nwall or (ids != np.arange(1, N + 2 * nwall + 1)).any():
+        a.sort(key=lambda row: row[0])
+        if [int(row[0]) for row in a] != list(range(1, N + 2 * nwall + 1)):
             sys.exit("snapshots.py: frame %d (step %d) does not hold atoms 1..%d" % (k, st, N + 2 * nwall))
-        x = a[:, 2:5]
-        bot, top = x[N:N + nwall, 1].mean(), x[N + nwall:, 1].mean()
+        x = [row[2:5] for row in a]  # x[id - 1]
+        bot = sum(p[1] for p in x[N:N + nwall]) / nwall
+        top = sum(p[1] for p in x[N + nwall:]) / nwall
         lo, hi = bot + 2.5 * d, top - 2.5 * d
-        bulk = np.zeros(N + 2 * nwall + 1, bool)
-        bulk[1:N + 1] = (x[:N, 1] > lo) & (x[:N, 1] < hi)
+        bulk = [False] + [i < N and lo < x[i][1] < hi for i in range(N + 2 * nwall)]  # bulk[id]
         keep = [i for i in range(N) if bulk[i + 1]]
-        pd = ascii_array("id", ids[keep], 1, "Int32") + ascii_array("radius", a[keep, 1]) + \
-            ascii_array("velocity", a[keep, 5:8], 3)
-        write(os.path.join(out, "spheres_%05d.vtp" % k), polydata(x[keep], point_data=pd))
-        i1, i2 = c[:, 0].astype(int), c[:, 1].astype(int)
-        rows = bulk[i1] | bulk[i2]
-        i1, i2, f = i1[rows], i2[rows], c[rows, 3:6] + c[rows, 6:9]
-        l = x[i2 - 1] - x[i1 - 1]
-        for ax in (0, 2):
-            l[:, ax] -= L * np.round(l[:, ax] / L)
-        n = l / np.linalg.norm(l, axis=1)[:, None]
-        fnv = c[rows, 3:6]
-        on1 = np.einsum("ij,ij->i", fnv, n) < 0
-        f[on1] *= -1.0
-        fn = np.einsum("ij,ij->i", f, n)
-        ft = f - fn[:, None] * n
-        p1 = x[i1 - 1]
-        pts = np.empty((2 * len(i1), 3))
-        pts[0::2], pts[1::2] = p1, p1 + l
-        cd = ascii_array("fn", fn) + ascii_array("ft", ft, 3) + ascii_array("normal", n, 3) + \
-            ascii_array("branch", l, 3) + ascii_array("status", np.zeros(len(i1)), 1, "Int32") + \
-            ascii_array("b1", i1, 1, "Int32") + ascii_array("b2", i2, 1, "Int32")
-        write(os.path.join(out, "contacts_%05d.vtp" % k), polydata(pts, cell_data=cd, lines=np.arange(len(pts))))
+        pd = ascii_array("id", [i + 1 for i in keep], 1, "Int32") + ascii_array("radius", [a[i][1] for i in keep]) + \
+            ascii_array("velocity", [v for i in keep for v in a[i][5:8]], 3)
+        write(os.path.join(out, "spheres_%05d.vtp" % k), polydata([v for i in keep for v in x[i]], point_data=pd))
+        pts, fn, ft, nn, ll, b1, b2 = [], [], [], [], [], [], []
+        for row in c:
+            i1, i2 = int(row[0]), int(row[1])
+            if not (bulk[i1] or bulk[i2]):
+                continue
+            l = [x[i2 - 1][ax] - x[i1 - 1][ax] for ax in range(3)]
+            for ax in (0, 2):
+                l[ax] -= L * round(l[ax] / L)
+            r = math.sqrt(dot(l, l))
+            n = [v / r for v in l]
+            f = [row[3 + ax] + row[6 + ax] for ax in range(3)]
+            if dot(row[3:6], n) < 0:  # LIGGGHTS gave body 1's force
+                f = [-v for v in f]
+            g = dot(f, n)
+            fn.append(g)
+            ft += [f[ax] - g * n[ax] for ax in range(3)]
+            nn += n
+            ll += l
+            b1.append(i1)
+            b2.append(i2)
+            pts += x[i1 - 1] + [x[i1 - 1][ax] + l[ax] for ax in range(3)]
+        cd = ascii_array("fn", fn) + ascii_array("ft", ft, 3) + ascii_array("normal", nn, 3) + \
+            ascii_array("branch", ll, 3) + ascii_array("status", [0] * len(fn), 1, "Int32") + \
+            ascii_array("b1", b1, 1, "Int32") + ascii_array("b2", b2, 1, "Int32")
+        write(os.path.join(out, "contacts_%05d.vtp" % k), polydata(pts, cell_data=cd, n_lines=len(fn)))
         index.append("%d %d\n" % (k, st))
     write(os.path.join(out, "frames.txt"), "".join(index))
 
