@@ -200,7 +200,7 @@ def main():
                                         "%.2f" % (ref["cpu_per_strain"] / pol[I]) if I in pol else "—"))
     load = open("/proc/loadavg").read().split()[:3]
     note = ("\n1000 grains, one thread each; σ: combined standard errors against cdsim's rigid reference "
-            "(make accuracy-shear3, five samples; its CPU from that measurement, not this sitting's); "
+            "(make accuracy-shear3, five samples; its CPU from that measurement, not from these runs); "
             "load average at the end %s\n" % " ".join(load))
     table = "\n".join(out) + "\n" + note
     with open(os.path.join(top, "table.md"), "w") as f:
