@@ -61,6 +61,13 @@ int support_low_vertex(const Placed& P, const Vec3& n) {
 // min over the vertices of n . v
 double support_low(const Placed& P, const Vec3& n) { return n.dot(P.v[support_low_vertex(P, n)]); }
 
+// Whether x lies strictly inside P (below every face's plane).
+bool inside(const Placed& P, const Vec3& x) {
+  for (int h = 0; h < static_cast<int>(P.n.size()); ++h)
+    if (!(P.n[h].dot(x) < P.d[h])) return false;
+  return true;
+}
+
 // The separation of I from R along R's face f.
 double face_separation(const Placed& R, int f, const Placed& I) {
   return support_low(I, R.n[f]) - R.d[f];
@@ -264,16 +271,12 @@ PolyContact face_contact(const Placed& R, int f, const Placed& I, bool ref_b, do
   // and the extent.
   const bool none = cand.empty();
   const int v = support_low_vertex(I, n);
+  std::vector<char> kept(I.v.size(), 0);  // the vertices the clipping kept (candidates or above alert)
+  for (const ClipPoint& q : poly)
+    if (q.tag == PolyKeyTag::Vertex) kept[q.a] = 1;
   for (int k = 0; k < static_cast<int>(I.v.size()); ++k) {
-    bool clipped = false;
-    for (const ClipPoint& q : poly) clipped = clipped || (q.tag == PolyKeyTag::Vertex && q.a == static_cast<std::uint32_t>(k));
-    if (clipped) continue;
     const double g = n.dot(I.v[k]) - d;
-    bool take = none && k == v;
-    if (!take) {
-      take = g < -kAbsoluteTol * L;
-      for (int h = 0; take && h < static_cast<int>(R.n.size()); ++h) take = R.n[h].dot(I.v[k]) < R.d[h];
-    }
+    const bool take = (none && k == v) || (!kept[k] && g < -kAbsoluteTol * L && inside(R, I.v[k]));
     if (take)
       cand.push_back({I.v[k] - 0.5 * g * n, g,
                       poly_point_key(PolyKeyTag::Vertex, ref_b, fr, static_cast<std::uint32_t>(k), 0)});

@@ -31,22 +31,14 @@ import sys
 
 import numpy as np
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+from snapshots import frames  # noqa: E402  (LIGGGHTS' dump frames, one reader for both scripts)
+
 
 def cap(r, h):
     """Volume of a sphere of radius r below a plane at height h above its lowest point."""
     h = np.clip(h, 0.0, 2 * r)
     return math.pi * h * h * (3 * r - h) / 3
-
-
-def frames(path):
-    """(step, array of rows id radius x y z vx vy vz contacts) for each dump frame."""
-    with open(path) as f:
-        blocks = f.read().split("ITEM: TIMESTEP")[1:]
-    for b in blocks:
-        lines = b.strip().splitlines()
-        start = next(k for k, l in enumerate(lines) if l.startswith("ITEM: ATOMS")) + 1
-        a = np.array([[float(x) for x in l.split()] for l in lines[start:]])
-        yield int(lines[0]), a[np.argsort(a[:, 0])]
 
 
 def main():
@@ -92,7 +84,8 @@ def main():
 
     phis, zs, rates, window_frames = [], [], [], []
     s0 = None
-    for k, (st, a) in enumerate(frames(run + "/shear.dump")):
+    for k, (st, rows) in enumerate(frames(run + "/shear.dump", "ATOMS")):
+        a = np.array(sorted(rows))  # by id
         s0 = st if s0 is None else s0
         g = (st - s0) * dt * rate
         if g < g0 - 1e-9 or g > g1 + 1e-9:
