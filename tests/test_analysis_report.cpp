@@ -125,6 +125,33 @@ TEST(AnalysisReport, ScanRecordsWhatEachRunGaveAndWhyNot) {
   EXPECT_TRUE(std::isnan(three.eta));  // says nothing of the campaign's kind
 }
 
+TEST(AnalysisReport, AGivenWindowReplacesEachRunsDetectedOne) {
+  // The drifting run (q/p = 0.2 + 0.1 strain) has no steady window of its
+  // own; over a given strain window 1:2 its mean is 0.2 + 0.1 x 1.5 = 0.35
+  // (the rows at strain 1.00 to 2.00, one row either end making 5e-4), and
+  // every run's window is that one. A window outside a run's strain makes
+  // it not steady, naming the window.
+  const auto d = six_runs("window");
+  const ReportScan scan = scan_campaign(d.string(), 36, "1:2");
+  const ReportRun& drift = run_named(scan, "drift");
+  EXPECT_EQ(drift.status, "ok");
+  ASSERT_TRUE(drift.main_stats.has_value());
+  EXPECT_NEAR(drift.mu.v, 0.35, 6e-4);
+  for (const char* name : {"drift", "I_0.01", "I_0.1"}) {
+    const ReportRun& r = run_named(scan, name);
+    ASSERT_TRUE(r.main_stats.has_value()) << name;
+    EXPECT_NEAR(r.main_stats->window.x_begin, 1.0, 0.011) << name;
+    EXPECT_NEAR(r.main_stats->window.x_end, 2.0, 0.011) << name;
+  }
+  const ReportScan detected = scan_campaign(d.string());
+  EXPECT_EQ(run_named(detected, "drift").status, "not steady");
+
+  const ReportScan beyond = scan_campaign(d.string(), 36, "5:6");
+  EXPECT_EQ(run_named(beyond, "drift").status, "not steady");
+  EXPECT_NE(run_named(beyond, "drift").not_steady_why.find("window 5:6"), std::string::npos)
+      << run_named(beyond, "drift").not_steady_why;
+}
+
 TEST(AnalysisReport, SummaryAndTablesFromTheScan) {
   const auto d = six_runs("tables");
   const ReportScan scan = scan_campaign(d.string());

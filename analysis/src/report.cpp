@@ -222,8 +222,9 @@ std::vector<std::string> campaign_runs(const std::string& campaign) {
   return runs;
 }
 
-ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins) {
-  const ReportScan scan = scan_campaign(campaign, bins);
+ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins,
+                           const std::string& window) {
+  const ReportScan scan = scan_campaign(campaign, bins, window);
   fs::create_directories(out_dir);
   ReportSummary sum = summarize(scan);
   sum.plots_ok = draw_run_plots(scan, out_dir);

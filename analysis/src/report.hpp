@@ -72,7 +72,9 @@ struct ReportSummary {
 // anisotropies into fabric.csv, each the mean ± sem over the contact
 // snapshots in the run's steady window, else of the last snapshot alone
 // (docs/analysis.md, "Commands in 3D"); runs of the other dimension are
-// listed under problems and skipped.
-ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins = 36);
+// listed under problems and skipped. window: every run's steady window,
+// as scan_campaign's ("": each run's detected one).
+ReportSummary write_report(const std::string& campaign, const std::string& out_dir, int bins = 36,
+                           const std::string& window = "");
 
 }  // namespace cda

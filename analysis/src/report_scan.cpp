@@ -66,10 +66,12 @@ void read_cost(ReportRun& r) {
 }
 
 // The steady window of the main column and every mean over it, and the
-// shear profile's rate_min there. Throws AnalysisError when one of them
-// cannot be measured: the run is then not steady.
-void measure_steady(ReportRun& r, const Table& series, int dim) {
-  const auto rs = run_steady(r.folder, series, r.main_column, r.x_column, std::nullopt);
+// shear profile's rate_min there; over the given window if there is one
+// (scan_campaign). Throws AnalysisError when one of them cannot be
+// measured: the run is then not steady.
+void measure_steady(ReportRun& r, const Table& series, int dim, const std::string& window) {
+  const auto rs =
+      run_steady(r.folder, series, r.main_column, r.x_column, window_range(window, series.column(r.x_column)));
   r.main_stats = rs.stats;
   const Window& w = rs.stats.window;
   const auto mean = [&](const std::string& q) {
@@ -129,7 +131,7 @@ void measure_fabric(ReportRun& r, const Table& series, int dim, int bins) {
 
 // One run: scene, cost, then what its series and snapshots give, each
 // step's failure recorded and the next one tried where it still can be.
-ReportRun scan_run(const std::string& folder, std::size_t index, int dim, int bins) {
+ReportRun scan_run(const std::string& folder, std::size_t index, int dim, int bins, const std::string& window) {
   ReportRun r;
   r.index = index;
   r.folder = folder;
@@ -142,7 +144,7 @@ ReportRun scan_run(const std::string& folder, std::size_t index, int dim, int bi
     r.x_column = default_x_column(series);
     r.main_column = series.has(mu_column(dim)) ? mu_column(dim) : "kinetic_energy";
     try {
-      measure_steady(r, series, dim);
+      measure_steady(r, series, dim, window);
     } catch (const AnalysisError& e) {
       r.status = "not steady";
       r.not_steady_why = e.what();
@@ -164,7 +166,7 @@ ReportRun scan_run(const std::string& folder, std::size_t index, int dim, int bi
 
 std::string ReportRun::stem() const { return fmt::format("run{:03d}", index); }
 
-ReportScan scan_campaign(const std::string& campaign, int bins) {
+ReportScan scan_campaign(const std::string& campaign, int bins, const std::string& window) {
   ReportScan scan;
   scan.campaign = campaign;
   const auto folders = campaign_runs(campaign);
@@ -177,7 +179,7 @@ ReportScan scan_campaign(const std::string& campaign, int bins) {
     }
   }
   for (std::size_t k = 0; k < folders.size(); ++k)
-    scan.runs.push_back(scan_run(folders[k], k, scan.dimension, bins));
+    scan.runs.push_back(scan_run(folders[k], k, scan.dimension, bins, window));
   return scan;
 }
 

@@ -81,8 +81,11 @@ struct ReportScan {
 // Reads every run of the campaign (campaign_runs; throws as it does when
 // there is none). A run of the other dimension is recorded as skipped, a
 // failing step as a problem of its run: the scan itself never stops. bins:
-// the angular bins of the 2D fabric.
-ReportScan scan_campaign(const std::string& campaign, int bins = 36);
+// the angular bins of the 2D fabric. window: "a:b" of the strain, or
+// "a%:b%" of each run's span of it (steady's --window): every run's steady
+// means (and its 3D fabric) over that window instead of its detected one;
+// "": detected.
+ReportScan scan_campaign(const std::string& campaign, int bins = 36, const std::string& window = "");
 
 // The summary's counts (runs, steady, with fabric, left out, costed and
 // their summed cost), the dimension, and every run's problems in the

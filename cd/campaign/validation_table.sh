@@ -20,7 +20,8 @@
 # the end, cpu_s, sweeps_mean and build (cdlab_version) of each run.
 # periodic3 (CAMPAIGN/angularity/shape_*, make campaign-angularity DIM=3):
 #   `cdanalysis report` over the finished runs, each over its own steady
-#   window (WINDOW is not used: give -): protocol, shape, N, I, strain,
+#   window (WINDOW -) or over WINDOW (report --window; a run whose detected
+#   window holds too few independent samples): protocol, shape, N, I, strain,
 #   window_begin, window_end, then mu (-sigma_xy/sigma_yy), nu, z, p and
 #   the fabric (q/p of the snapshots, a_c, a_n, a_t, the contact kinds'
 #   shares, the q/p of the face-face contacts, the sliding share,
@@ -62,7 +63,9 @@ if [ "$PROTOCOL" = periodic3 ]; then
   for r in "${runs[@]}"; do ln -s "$r" "$out/runs/$(basename "$r")"; done
   # Exit 5: written with reservations, a run without a steady window left
   # out (it is named on stderr, and gets no row).
-  s=0; "$CDA" report "$out/runs" --out "$out/report" > "$out/log" 2>&1 || s=$?
+  window=()
+  [ "$WINDOW" = - ] || window=(--window "$WINDOW")
+  s=0; "$CDA" report "$out/runs" "${window[@]}" --out "$out/report" > "$out/log" 2>&1 || s=$?
   [ $s -eq 0 ] || [ $s -eq 5 ] || { cat "$out/log" >&2; exit 1; }
   [ $s -eq 0 ] || grep '^problem: ' "$out/log" >&2
   steady="mu:shear_stress_ratio nu:packing_fraction z:z p:p"

@@ -13,7 +13,7 @@ namespace cda::cli {
 
 Handler report(CLI::App& sub) {
   struct Opt {
-    std::string campaign, out;
+    std::string campaign, out, window;
     int bins = 36;
   };
   auto o = std::make_shared<Opt>();
@@ -22,9 +22,10 @@ Handler report(CLI::App& sub) {
   sub.add_option("--bins", o->bins, "angular bins over [0, pi)")
       ->check(CLI::Range(4, 36000))
       ->capture_default_str();
+  add_window_option(sub, o->window);
   return [o] {
     const std::string dir = o->out.empty() ? (std::filesystem::path(o->campaign) / "report").string() : o->out;
-    const auto s = write_report(o->campaign, dir, o->bins);
+    const auto s = write_report(o->campaign, dir, o->bins, o->window);
     fmt::print("report in {}: {} runs, {} steady, {} with fabric{}\n", dir, s.runs, s.steady, s.fabric,
                s.plots_ok ? "" : " (some plots failed: see the .gp.log files)");
     if (s.costed)
