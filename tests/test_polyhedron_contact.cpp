@@ -711,8 +711,10 @@ TEST(PolyhedronContact, OverlapPointsLieInTheOverlap) {
   // body, below the face's plane but outside the body; the bodies overlap
   // where an edge of one crosses the other's surface, and a row at that
   // vertex held nothing (irregular hulls in shear: an overlap grew from
-  // 0.01 to 0.045 d in 180 steps under it). Tried without a hint and with
-  // every face of A and of B as the hint (the engine's previous axis).
+  // 0.01 to 0.045 d in 180 steps under it); beside a vertex inside the
+  // body, it held the bodies apart where they are free. Tried without a
+  // hint and with every face of A and of B as the hint (the engine's
+  // previous axis).
   int contacts = 0, points = 0;
   auto depth_in = [](const ConvexPolyhedron& P, const Pose3& p, const Vec3& x) {
     double out = -1e300;
@@ -753,6 +755,40 @@ TEST(PolyhedronContact, OverlapPointsLieInTheOverlap) {
   std::vector<RandomPair> pairs{{ConvexPolyhedron(a_points), ConvexPolyhedron(b_points),
                                  pose(Vec3::Zero(), Quat(0.162299507276, 0.556387636358, -0.301767203380, 0.756986276633).normalized()),
                                  pose(Vec3(0.5358151374, -0.1510725174, -0.5167665219), Quat(-0.639264802818, 0.253984317724, 0.073412129820, 0.722110197563).normalized())}};
+  // And from its end (the same run): nothing clipped in, a vertex of B
+  // inside A, and B's deepest vertex along A's face 0.14 L outside A,
+  // which had been a second point beside the first.
+  const std::vector<Vec3> c_points{
+      {-0.1004652089, -0.0608981513, 0.3091788438},
+      {0.1508166283, 0.2613578643, 0.1695351189},
+      {0.2820060246, -0.2210572480, -0.1159349020},
+      {-0.3066227858, 0.1374007058, 0.0519616596},
+      {-0.2940748280, -0.1808333782, -0.0787900399},
+      {-0.2605991745, 0.1383887385, -0.2068793457},
+      {0.2977244288, 0.1593172889, -0.1652342334},
+      {0.0012193015, 0.3527453708, -0.0148399831},
+      {-0.0739995807, -0.3175838087, -0.1748659158},
+      {0.0509613114, -0.2195090804, 0.2576415986},
+      {-0.3376511675, 0.0508701651, 0.0224847343},
+      {0.3592730665, -0.0892741644, -0.0419018790},
+  };
+  const std::vector<Vec3> d_points{
+      {0.3902575487, 0.1698439620, -0.1322709984},
+      {-0.3137450315, 0.0890313473, -0.1918527400},
+      {-0.2725267643, -0.1631471581, -0.1147932924},
+      {-0.3179998641, 0.0931229601, -0.1528820594},
+      {-0.2270673939, -0.1335290059, 0.0676058063},
+      {-0.2331721044, 0.0305060012, 0.1185741356},
+      {0.0057426957, 0.2019243838, 0.1995314470},
+      {0.0051709919, -0.1116200790, 0.2166100863},
+      {0.3027725728, -0.2311346233, -0.0465312731},
+      {-0.3065539586, 0.1267617649, -0.0680648710},
+      {0.0463787393, 0.2045611435, 0.2007118331},
+      {0.2576567390, -0.2538136924, -0.0029459509},
+  };
+  pairs.push_back({ConvexPolyhedron(c_points), ConvexPolyhedron(d_points),
+                   pose(Vec3::Zero(), Quat(-0.442240251606, -0.894970703339, -0.051256488680, -0.028701435380).normalized()),
+                   pose(Vec3(0.4260272970, -0.0953261048, -0.1267897155), Quat(-0.885284110893, -0.361187908770, 0.173990938105, -0.235674544693).normalized())});
   for (RandomPair& r : random_pairs(1500)) pairs.push_back(std::move(r));
   for (const RandomPair& r : pairs) {
     std::vector<std::optional<PolyAxis>> hints{std::nullopt};

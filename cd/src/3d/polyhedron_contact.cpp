@@ -286,22 +286,27 @@ PolyContact face_contact(const Placed& R, int f, const Placed& I, bool ref_b, do
   // previous step's hinted face (0.002 d a step), and an edge beside the
   // face whose two vertices took the one row in turn, the other sinking
   // meanwhile (0.03 d in 30 steps, 0.19 d over a shear). Each joins the
-  // points; with nothing clipped in, the deepest vertex (the one that gives
-  // this axis its separation) always does. The reduction keeps the deepest
-  // and the extent.
-  const bool none = cand.empty();
-  const int v = support_low_vertex(I, n);
+  // points, and the reduction keeps the deepest and the extent.
   std::vector<char> kept(I.v.size(), 0);  // the vertices the clipping kept (candidates or above alert)
   for (const ClipPoint& q : poly)
     if (q.tag == PolyKeyTag::Vertex) kept[q.a] = 1;
+  auto add_vertex = [&](int k, double g) {
+    cand.push_back({I.v[k] - 0.5 * g * n, g,
+                    poly_point_key(PolyKeyTag::Vertex, ref_b, fr, static_cast<std::uint32_t>(k), 0)});
+  };
   for (int k = 0; k < static_cast<int>(I.v.size()); ++k) {
     const double g = n.dot(I.v[k]) - d;
-    const bool take = (none && k == v) || (!kept[k] && g < -kAbsoluteTol * L && inside(R, I.v[k]));
-    if (take)
-      cand.push_back({I.v[k] - 0.5 * g * n, g,
-                      poly_point_key(PolyKeyTag::Vertex, ref_b, fr, static_cast<std::uint32_t>(k), 0)});
+    if (!kept[k] && g < -kAbsoluteTol * L && inside(R, I.v[k])) add_vertex(k, g);
   }
-  if (beside) *beside = none && cand.size() == 1 && !in_prism(R, f, I.v[v], kSideSlack * L);
+  // With no point at all, the deepest vertex (the one that gives this axis
+  // its separation). Not beside others: outside the reference body, its
+  // row would hold the bodies apart where they are free (0.14 L outside it,
+  // seen beside a vertex inside it).
+  if (cand.empty()) {
+    const int v = support_low_vertex(I, n);
+    add_vertex(v, n.dot(I.v[v]) - d);
+    if (beside) *beside = !in_prism(R, f, I.v[v], kSideSlack * L);
+  }
   set_points(c, cand, n, kAbsoluteTol * L, origin);
   return c;
 }

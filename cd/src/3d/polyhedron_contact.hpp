@@ -35,11 +35,11 @@
 // side stays that vertex under round-off), and points within the alert
 // distance of the reference plane are kept, with every vertex of the
 // incident body inside the reference body that the clipping left out. If
-// no point is kept, the incident body's deepest vertex is the point; when
-// that vertex lies outside the face's prism (beside the reference body:
-// the face won only by the margin or the hint), the contact is made on
-// the axis of least penetration instead, the best edge pair unless a face
-// separates more.
+// there is none of either, the incident body's deepest vertex is the
+// point; when that vertex lies outside the face's prism (beside the
+// reference body: the face won only by the margin or the hint), the
+// contact is made on the axis of least penetration instead, the best edge
+// pair unless a face separates more.
 // Their number names the kind: 1 VertexFace, 2 EdgeFace, 3 or more
 // FaceFace, reduced to 4 (reduce_points). Edge pair: the closest points of
 // the two edges, 1 point, EdgeEdge. A point's position is midway between
