@@ -588,14 +588,18 @@ std::optional<PolyContact> collide(const ConvexPolyhedron& A, const Pose3& pose_
       ne = nh;
     }
   }
+  // The contact on face f of B (on_b) or of A, the other body incident.
+  auto on_face = [&](bool on_b, int f, double s, bool* beside = nullptr) {
+    return on_b ? face_contact(pb, f, pa, true, s, alert, L, origin, beside)
+                : face_contact(pa, f, pb, false, s, alert, L, origin, beside);
+  };
   if (ea >= 0 && beats(se, sf, L)) {
     if (face_too) {
       // The face's points that are not deeper than the edge pair's own
       // separation (within its margin): those about to close. A deeper one
       // is beside the other body, not in it (below the face's plane, beyond
       // the edge), and would hold the bodies apart where they are free.
-      PolyContact f = face_b ? face_contact(pb, face, pa, true, sf, alert, L, origin)
-                             : face_contact(pa, face, pb, false, sf, alert, L, origin);
+      const PolyContact f = on_face(face_b, face, sf);
       const double floor = se - margin(se, L);
       face_too->axis = f.axis;
       face_too->normal = f.normal;
@@ -613,19 +617,17 @@ std::optional<PolyContact> collide(const ConvexPolyhedron& A, const Pose3& pose_
   // instead, an irregular hull's overlap grew 0.01 to 0.045 d in 180 steps
   // of shear, under a row at the axis' full separation.
   bool beside = false;
-  PolyContact c = face_b ? face_contact(pb, face, pa, true, sf, alert, L, origin, &beside)
-                         : face_contact(pa, face, pb, false, sf, alert, L, origin, &beside);
+  PolyContact c = on_face(face_b, face, sf, &beside);
   if (!beside) return c;
   // Then the axis of least penetration, without margin or hint: the best
   // edge pair (the unhinted one) if no face beats it, else the best face.
   // At that axis the deepest point lies in its Minkowski face: the vertex
   // in the face's prism, the edges' closest points inside both segments.
   const bool fb_best = fb.s > fa.s;
-  const double s_face = fb_best ? fb.s : fa.s;
-  if (ee.ea >= 0 && ee.s >= s_face) return edge_contact(pa, ee.ea, pb, ee.eb, ee.n, origin);
-  if (fb_best == face_b && (fb_best ? fb.face : fa.face) == face) return c;
-  return fb_best ? face_contact(pb, fb.face, pa, true, fb.s, alert, L, origin)
-                 : face_contact(pa, fa.face, pb, false, fa.s, alert, L, origin);
+  const FaceQuery& best = fb_best ? fb : fa;
+  if (ee.ea >= 0 && ee.s >= best.s) return edge_contact(pa, ee.ea, pb, ee.eb, ee.n, origin);
+  if (fb_best == face_b && best.face == face) return c;
+  return on_face(fb_best, best.face, best.s);
 }
 
 std::optional<PolyContact> collide_plane(const Vec3& p0, const Vec3& n, const ConvexPolyhedron& B,
