@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "checkpoint.hpp"
+#include "cell_dof.hpp"
 #include "checkpoint3.hpp"
 #include "cli_util.hpp"
 #include "config.hpp"
@@ -102,6 +103,52 @@ TEST(CellControl, DilationWithTheGrainsIsNotKineticStress3D) {
   EXPECT_NEAR(w.cell().size.y(), L + v0 * t - 0.5 * a * t * t, 1e-12 * L);
   EXPECT_LT(std::abs(K(1, 1)), 1e-12 * p.pressure);
   EXPECT_EQ(w.cell().size.x(), p.cell.x());
+}
+
+// ---- the dof's update between sweeps (core/cell_dof.hpp) -----------------
+
+// A length of mass M closing at v0 < 0 on one grain of mass m at rest,
+// nothing else acting (no load, no gravity): a perfectly inelastic impact
+// (e = 0), after which both move at V = M v0 / (M + m) (momentum
+// conservation) and the contact carries the impulse r = m |V|. Solved as the
+// engines solve it: the row (normal from the grain to the length, relative
+// velocity u = v - v_g, Signorini on velocity) by its local solve with the
+// length frozen (W = 1/m), then cell_dof::update with the row's impulse
+// along the length (s = r, coefficient 1) and its response k = 1/W, to
+// convergence. For a length heavier than the grain and one 10 times lighter
+// (where the undamped update v = v0 + s/M does not converge: its Jacobi
+// factor is -m/M = -10, and here it cycles between -1 and 9). Round-off
+// tolerances: with the row's response exact (one grain, one row), the
+// damped update is the dof's Newton step and lands on the fixed point once
+// the row is active; 50 rounds are ample. A sign error in the update
+// (the contacts' impulse taken against the length) fails it at once.
+TEST(CellControl, TheLengthsUpdateConservesMomentumInAnImpact) {
+  for (const double M : {3.0, 0.1}) {
+    const double m = 1.0, v0 = -1.0;
+    struct Dof {
+      std::vector<int> rows{0};
+      double v0, v, inv_mass, scale;
+    } d{{0}, v0, v0, 1.0 / M, M * std::abs(v0)};
+    double r = 0.0, res = 0.0;
+    const double W = 1.0 / m;
+    for (int it = 0; it < 50; ++it) {
+      // The row's local solve with the length frozen: u = d.v - v_g, the
+      // grain's velocity v_g = -r/m (from rest), u = d.v + W r.
+      r = std::max(0.0, -d.v / W);
+      res = cd::cell_dof::update(
+          d, [&](std::size_t, double& s, double& k) { s += r, k += r > 0.0 ? 1.0 / W : 0.0; },
+          [](std::size_t, double) {});
+    }
+    const double V = M * v0 / (M + m);
+    const double vg = -r / m;
+    std::printf("M/m %g: length %.15g, grain %.15g (closed form %.15g); r %.15g (%.15g); residual %.2g\n",
+                M / m, d.v, vg, V, r, m * std::abs(V), res);
+    EXPECT_NEAR(d.v, V, 1e-14) << M;
+    EXPECT_NEAR(vg, V, 1e-14) << M;
+    EXPECT_NEAR(r, m * std::abs(V), 1e-14) << M;
+    EXPECT_NEAR(M * d.v + m * vg, M * v0, 1e-14) << M;
+    EXPECT_LT(res, 1e-13) << M;
+  }
 }
 
 // ---- steady shear at high I ---------------------------------------------
