@@ -2,7 +2,8 @@
 // (docs/shear.md, "The pressure control at high I"). A length at
 // imposed stress is loaded by (p - K_aa) times its face, K the kinetic
 // stress, which must not count the grains' own dilation flow (closed-form
-// tests, no contacts). Then simple shear
+// tests, no contacts); its update between sweeps conserves momentum (a
+// closed-form impact on one grain). Then simple shear
 // at imposed normal stress p from a sample compacted in the test, 2D at
 // I = 0.6 and 3D at I = 1, with a light cell (shear.cell_mass = 0.01): the
 // time mean of sigma_yy + K_yy is p, the height stays bounded, and the run
