@@ -330,10 +330,47 @@ TEST(Fabric3, ABranchAlongTheNormalHasNoBranchAnisotropy) {
   F.Ac = axisym(0.25, V3(0.3, -0.5, 1.0));
   F.An = axisym(0.35, V3(1, 0, 0));
   F.At = planar(0.1, 0.4);
-  const auto b = branch_anisotropy3(sample(F, 20000, 11));
+  const auto cs = sample(F, 20000, 11);
+  const auto b = branch_anisotropy3(cs);
   EXPECT_LT(E(b.Aln).norm(), 1e-12);
   EXPECT_LT(E(b.Alt).norm(), 1e-12);
   EXPECT_NEAR(b.mean_l, F.d, 1e-12 * F.d);
+  // and the branch directions are the normals: their fabric is A_c
+  EXPECT_LT((E(b.Acl) - E(anisotropy3(cs).Ac)).norm(), 1e-12);
+}
+
+// The fabric of the branch directions is the normals' fabric with l/|l| in
+// place of n, whatever the lengths: a face contact's normal and branch part
+// ways. Normals all along x (A_c = (15/2) dev diag(1, 0, 0), a_c = 5/2);
+// branches of several lengths along the six axis directions (<l^ l^> =
+// 1/3: no branch fabric), then all along z (a_c^l = 5/2 with the major axis
+// z: A_c^l = 5/2 (3 e_z e_z - 1)). Exact sums: round-off tolerances. A
+// zero branch is refused by name.
+TEST(Fabric3, TheBranchFabricIsTheBranchDirectionsNotTheNormals) {
+  const auto contact = [](V3 n, V3 l) {
+    Contact3 c;
+    for (int a = 0; a < 3; ++a) c.c.n[a] = n[a], c.c.l[a] = l[a];
+    c.c.fn = 1.0;
+    return c;
+  };
+  ContactSet3 spread, along_z;
+  const V3 x(1, 0, 0);
+  for (const V3& l : {V3(2, 0, 0), V3(-0.5, 0, 0), V3(0, 3, 0), V3(0, -1, 0), V3(0, 0, 0.7), V3(0, 0, -4)}) {
+    spread.push_back(contact(x, l));
+    along_z.push_back(contact(x, V3(0, 0, l.norm() * (l.sum() > 0 ? 1 : -1))));
+  }
+  EXPECT_LT(E(branch_fabric3(spread)).norm(), 1e-14);
+  const M3 Az = E(branch_fabric3(along_z));
+  EXPECT_LT((Az - axisym(2.5, V3(0, 0, 1))).norm(), 1e-14);
+  EXPECT_NEAR(spread3(branch_fabric3(along_z)), 2.5, 1e-14);
+  ContactSet3 zero = spread;
+  zero[3].c.l = {0.0, 0.0, 0.0};
+  try {
+    branch_fabric3(zero);
+    ADD_FAILURE() << "a zero branch was accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_NE(std::string(e.what()).find("branch vector of length 0"), std::string::npos) << e.what();
+  }
 }
 
 // Branch forms drawn as the force's (sample): the same estimator recovers

@@ -139,7 +139,21 @@ BranchAnisotropy3 branch_anisotropy3(const ContactSet3& cs) {
     for (int i = 0; i < 3; ++i) k.c.ft[i] = lt[i];
   }
   const Anisotropy3 a = anisotropy3(branch);
-  return {a.An, a.At, a.mean_f};
+  return {a.An, a.At, branch_fabric3(cs), a.mean_f};
+}
+
+Mat3 branch_fabric3(const ContactSet3& cs) {
+  if (cs.empty()) throw AnalysisError("branch fabric: no contacts");
+  Eigen::Matrix3d F = Eigen::Matrix3d::Zero();
+  for (const auto& k : cs) {
+    const Eigen::Vector3d l(k.c.l[0], k.c.l[1], k.c.l[2]);
+    const double len = l.norm();
+    if (!(len > 0.0) || !std::isfinite(len))
+      throw AnalysisError(fmt::format("branch fabric: a branch vector of length {} (bodies {} and {})", len,
+                                      k.c.b1, k.c.b2));
+    F += (l / len) * (l / len).transpose();
+  }
+  return from_eigen(7.5 * dev_sym(F / static_cast<double>(cs.size())));
 }
 
 }  // namespace cda

@@ -93,11 +93,21 @@ struct Anisotropy3 {
 //   q/p = (2/5)(a_c + a_n + a_t + a_ln + a_lt)
 // to first order. Spheres: l = |l| n, so A_lt = 0 and A_ln says only how the
 // pairs' sizes correlate with their direction.
+//
+// And the fabric of the branch directions, A_c^l = (15/2) dev <l^ l^> (l^ =
+// l/|l|): the fabric A_c with the branch direction in place of the normal.
+// Azema, Radjai & Saussine (Mech. Mater. 41, 729 (2009)) build their
+// harmonic approximation of the fabric on the branch vectors; for grains
+// whose contacts lie on faces the two fabrics differ (a face contact's
+// normal is the face's, its branch points at the other grain's centre).
+// Spheres: l^ = n, A_c^l = A_c.
 struct BranchAnisotropy3 {
   Mat3 Aln{}, Alt{};
+  Mat3 Acl{};         // the branch directions' fabric A_c^l
   double mean_l = 0;  // <l> of the forms
   double a_ln() const { return spread3(Aln); }
   double a_lt() const { return spread3(Alt); }
+  double a_c_branch() const { return spread3(Acl); }
 };
 
 // The anisotropies of the given contacts (each one force-bearing physical
@@ -107,5 +117,9 @@ struct BranchAnisotropy3 {
 Anisotropy3 anisotropy3(const ContactSet3& cs);
 // The branch anisotropies of the same contacts (thrown as anisotropy3).
 BranchAnisotropy3 branch_anisotropy3(const ContactSet3& cs);
+// (15/2) dev <l^ l^> over the given contacts: exact, no harmonic fit (so
+// defined for any sample of branches). Throws AnalysisError when there are
+// no contacts or a branch is not a finite nonzero vector.
+Mat3 branch_fabric3(const ContactSet3& cs);
 
 }  // namespace cda

@@ -412,7 +412,9 @@ const std::vector<std::string> kFabric3Columns = {
     "a_ln", "a_lt", "sum_2_5_branch",
     // polyhedra only (nan for spheres): RunFabric3's shares and face-face parts
     "face_face_share", "edge_face_share", "vertex_face_share", "edge_edge_share", "q_over_p_face_face",
-    "a_c_face_face", "a_n_face_face", "a_t_face_face", "a_c_other", "a_n_other", "a_t_other"};
+    "a_c_face_face", "a_n_face_face", "a_t_face_face", "a_c_other", "a_n_other", "a_t_other",
+    // the fabric of the branch directions (fabric3.hpp; = a_c for spheres)
+    "a_c_branch"};
 
 const Val& WindowFabric3::of(const std::string& column) const {
   const auto i = std::find(kFabric3Columns.begin(), kFabric3Columns.end(), column);
@@ -470,7 +472,8 @@ WindowFabric3 window_fabric3(const std::string& run_dir, const Table& series, co
                                    f.aniso_face_face ? f.aniso_face_face->a_t() : nan,
                                    f.aniso_other ? f.aniso_other->a_c() : nan,
                                    f.aniso_other ? f.aniso_other->a_n() : nan,
-                                   f.aniso_other ? f.aniso_other->a_t() : nan};
+                                   f.aniso_other ? f.aniso_other->a_t() : nan,
+                                   ok ? f.branch->a_c_branch() : nan};
     for (std::size_t i = 0; i < v.size(); ++i) per[i].push_back(v[i]);
     diff.push_back(v[3] - v[5]);          // sum_2_5 - q_over_p
     diff_branch.push_back(v[13] - v[5]);  // sum_2_5_branch - q_over_p

@@ -89,8 +89,9 @@ void fabric3(const Opt& o) {
                "axes {:.4f}\n",
                f.stress.q_over_p(), a.sum_2_5(), a.sum_2_5_tensor(), a.sum_2_5_on(f.stress));
     const auto& b = *f.branch;
-    fmt::print("branch     a_ln {:.4f}  a_lt {:.4f}  <l> {:.6g}  (2/5)(a_c + a_n + a_t + a_ln + a_lt) {:.4f}\n",
-               b.a_ln(), b.a_lt(), b.mean_l, a.sum_2_5() + 0.4 * (b.a_ln() + b.a_lt()));
+    fmt::print("branch     a_ln {:.4f}  a_lt {:.4f}  <l> {:.6g}  (2/5)(a_c + a_n + a_t + a_ln + a_lt) {:.4f}  "
+               "a_c of the branch directions {:.4f}\n",
+               b.a_ln(), b.a_lt(), b.mean_l, a.sum_2_5() + 0.4 * (b.a_ln() + b.a_lt()), b.a_c_branch());
   } else {
     fmt::print("harmonics  none: {}\n", f.aniso_problem);
   }
