@@ -69,7 +69,7 @@ if [ "$PROTOCOL" = periodic3 ]; then
   [ $s -eq 0 ] || [ $s -eq 5 ] || { cat "$out/log" >&2; exit 1; }
   [ $s -eq 0 ] || grep '^problem: ' "$out/log" >&2
   steady="mu:shear_stress_ratio nu:packing_fraction z:z p:p"
-  fabric="q_over_p a_c a_n a_t face_face_share edge_face_share vertex_face_share edge_edge_share q_over_p_face_face sliding check_rel a_ln a_lt check_rel_branch"
+  fabric="q_over_p a_c a_n a_t face_face_share edge_face_share vertex_face_share edge_edge_share q_over_p_face_face sliding check_rel a_ln a_lt check_rel_branch a_c_branch"
   head="protocol,shape,N,I,strain,window_begin,window_end"
   for c in $steady; do head="$head,${c%%:*},${c%%:*}_err"; done
   for c in $fabric; do head="$head,$c,${c}_err"; done
