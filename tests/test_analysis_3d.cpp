@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <fmt/format.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -454,6 +455,35 @@ TEST(Stress3, LatticeThroughImagesExact) {
   EXPECT_NEAR(st.q(), (Fz - (m - r)) * k / 3, 1e-9 * Fz * k);
   EXPECT_NEAR(st.mu(), -0.5 * g / Fy, 1e-12);
   EXPECT_NEAR(st.skew(), 0.5 * g * k, 1e-9 * Fz * k);
+}
+
+// The times of a snapshot collection (contacts.pvd), as cdsim writes it,
+// and a timestep that is not a number refused by name: trailing text, none
+// at all, infinity (each once a frame of a hand-edited collection).
+TEST(Snapshot3, TimesOfACollectionAreNumbers) {
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "pvd_times");
+  for (int k = 0; k < 2; ++k) std::ofstream(dir / fmt::format("contacts_{:05d}.vtp", k)) << "";
+  const auto pvd = [&](const std::string& t1) {
+    std::ofstream(dir / "contacts.pvd")
+        << "<VTKFile type=\"Collection\"><Collection>\n"
+           "<DataSet timestep=\"0.25\" file=\"contacts_00000.vtp\"/>\n"
+           "<DataSet file=\"contacts_00001.vtp\" timestep=\"" + t1 + "\"/>\n</Collection></VTKFile>\n";
+  };
+  pvd("5e-1");
+  const auto st = snapshot_times(dir.string(), "contacts");
+  ASSERT_EQ(st.size(), 2u);
+  EXPECT_EQ(st[0], 0.25);
+  EXPECT_EQ(st[1], 0.5);
+  for (const std::string bad : {"0.5s", "", "abc", "inf"}) {
+    pvd(bad);
+    try {
+      snapshot_times(dir.string(), "contacts");
+      ADD_FAILURE() << "timestep '" << bad << "' accepted";
+    } catch (const AnalysisError& e) {
+      EXPECT_NE(std::string(e.what()).find("timestep \"" + bad + "\" is not a number"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 // A real tri-periodic run: 64 spheres as a granular gas (random velocities)

@@ -507,7 +507,7 @@ TEST(AnalysisIo, BadInputExitsTwoWithAClearMessage) {
   EXPECT_EQ(f.code, 2) << f.out;
   EXPECT_NE(f.out.find("is a folder, not a file"), std::string::npos) << f.out;
   // Binary junk in a table: shown escaped.
-  write(d / "junk.csv", std::string("I,mu\n0.1,\x1b[2J\x07\xff\xfe\n", 21));
+  write(d / "junk.csv", std::string("I,mu\n0.1,\x1b[2J\x07\xff\xfe\n"));
   f = run_cda(fmt::format("fit mu-i --table {}", (d / "junk.csv").string()));
   EXPECT_EQ(f.code, 2) << f.out;
   for (const char c : f.out)

@@ -277,10 +277,12 @@ std::vector<std::optional<double>> snapshot_times(const std::string& run_dir, co
     const std::string tag = it->str();
     std::smatch t, f;
     if (!std::regex_search(tag, t, timestep) || !std::regex_search(tag, f, file)) continue;
+    // strtod's end points into the string it read: one that outlives it.
+    const std::string ts = t[1].str();
     char* end = nullptr;
-    const double v = std::strtod(t[1].str().c_str(), &end);
-    if (end == t[1].str().c_str() || *end || !std::isfinite(v))
-      throw AnalysisError(fmt::format("'{}': timestep \"{}\" is not a number", pvd.string(), t[1].str()));
+    const double v = std::strtod(ts.c_str(), &end);
+    if (end == ts.c_str() || *end || !std::isfinite(v))
+      throw AnalysisError(fmt::format("'{}': timestep \"{}\" is not a number", pvd.string(), ts));
     times[fs::path(f[1].str()).filename().string()] = v;
   }
   if (times.empty()) throw AnalysisError(fmt::format("'{}' lists no frame", pvd.string()));
