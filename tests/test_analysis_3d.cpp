@@ -16,7 +16,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-#include <fmt/format.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -25,6 +24,8 @@
 #include <random>
 #include <regex>
 #include <sstream>
+
+#include <fmt/format.h>
 
 #include "analysis/src/cohesion.hpp"
 #include "analysis/src/compare.hpp"

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "checkpoint.hpp"
 #include "cell_dof.hpp"
+#include "checkpoint.hpp"
 #include "checkpoint3.hpp"
 #include "cli_util.hpp"
 #include "config.hpp"
@@ -126,8 +126,8 @@ TEST(CellControl, DilationWithTheGrainsIsNotKineticStress3D) {
 TEST(CellControl, TheLengthsUpdateConservesMomentumInAnImpact) {
   for (const double M : {3.0, 0.1}) {
     const double m = 1.0, v0 = -1.0;
-    struct Dof {
-      std::vector<int> rows{0};
+    struct Dof {  // what cell_dof::update reads: one coupled row
+      std::vector<int> rows;
       double v0, v, inv_mass, scale;
     } d{{0}, v0, v0, 1.0 / M, M * std::abs(v0)};
     double r = 0.0, res = 0.0;
