@@ -629,7 +629,7 @@ TEST(Polyhedra3, CheckpointResumesBitForBit) {
 // The local solve's warm slide (law3.hpp, slide_unit_from) against the
 // scan: on random blocks of two bodies with full inertia tensors (the
 // blocks of polyhedra), from a guess whose slip is 0.2 rad off the
-// answer, the same slide to 1e-10 of its size, and the law's residual at
+// answer (of any size), the same slide to 1e-10 of its size, and the law's residual at
 // round-off. (Where the law has several slides the two may part; these
 // blocks, mu = 0.4, have one.)
 TEST(Polyhedra3, WarmSlideFindsTheScansSlide) {
@@ -645,11 +645,14 @@ TEST(Polyhedra3, WarmSlideFindsTheScansSlide) {
     if (solve_local3(W, q, cone, 0.0, scan) != Branch3::Slide) continue;
     ++slides;
     const double f = std::atan2(scan[2], scan[1]) + 0.2;
-    const Vec3 guess(scan[0], std::cos(f), std::sin(f));
-    EXPECT_EQ(solve_local3(W, q, cone, 0.0, warm, &guess), Branch3::Slide);
-    EXPECT_LT((warm - scan).norm(), 1e-10 * scan.norm()) << trial;
-    const double scale = q.norm() + W.norm() * warm.norm();
-    EXPECT_LT(law_residual3(W * warm + q, warm, cone, 0.0, 1.0 / W(0, 0)), 1e-12 * scale) << trial;
+    // The guess is an impulse: its slip direction counts, not its size.
+    for (const double size : {1e-6, 1.0, 1e6}) {
+      const Vec3 guess(scan[0], size * std::cos(f), size * std::sin(f));
+      EXPECT_EQ(solve_local3(W, q, cone, 0.0, warm, &guess), Branch3::Slide);
+      EXPECT_LT((warm - scan).norm(), 1e-10 * scan.norm()) << trial;
+      const double scale = q.norm() + W.norm() * warm.norm();
+      EXPECT_LT(law_residual3(W * warm + q, warm, cone, 0.0, 1.0 / W(0, 0)), 1e-12 * scale) << trial;
+    }
   }
   std::printf("%d slides of 400 blocks\n", slides);
   EXPECT_GT(slides, 50);

@@ -87,8 +87,10 @@ struct SlideUnit {
       : wnn(W_(0, 0)), bn(b_[0]), wt(W_(1, 0), W_(2, 0)), bt(b_[1], b_[2]), Wt(W_.bottomRightCorner<2, 2>()),
         W(W_), b(b_) {}
   static double cross(const Eigen::Vector2d& x, const Eigen::Vector2d& y) { return x[0] * y[1] - x[1] * y[0]; }
-  double h(double f, double* dh) const {
-    const Eigen::Vector2d d(std::cos(f), std::sin(f)), dd(-d[1], d[0]);
+  double h(double f, double* dh) const { return h_at(Eigen::Vector2d(std::cos(f), std::sin(f)), dh); }
+  // h at the unit direction d = (cos f, sin f), and its derivative in f.
+  double h_at(const Eigen::Vector2d& d, double* dh) const {
+    const Eigen::Vector2d dd(-d[1], d[0]);
     const double den = wnn + wt.dot(d);
     const Eigen::Vector2d g = wt + Wt * d;
     if (dh) *dh = wt.dot(dd) * cross(d, bt) + den * cross(dd, bt) - bn * (cross(dd, g) + cross(d, Wt * dd));
@@ -96,7 +98,9 @@ struct SlideUnit {
   }
   // The impulse at angle f and its error, or false if it is not a slide.
   bool candidate(double f, Vec3& q, double& err) const {
-    const Eigen::Vector2d d(std::cos(f), std::sin(f));
+    return candidate_at(Eigen::Vector2d(std::cos(f), std::sin(f)), q, err);
+  }
+  bool candidate_at(const Eigen::Vector2d& d, Vec3& q, double& err) const {
     const double den = wnn + wt.dot(d);
     if (!(den > 0.0)) return false;
     const double pn = -bn / den;
@@ -177,25 +181,34 @@ inline bool slide_unit(const Mat3& W, const Vec3& b, Vec3& p) {
   return found;
 }
 
-// Sliding from a guess f0 of the slip angle (the sweep's previous impulse):
-// Newton on h from f0, kept if it converges (the step below 1e-14 rad) to a
-// valid slide whose error is round-off (1e-12 of the problem's scale);
-// false otherwise, and the caller scans (slide_unit). A row's slip turns
-// little from one sweep to the next, so this takes 2 to 4 evaluations where
-// the scan takes over a hundred.
-inline bool slide_unit_from(const Mat3& W, const Vec3& b, double f0, Vec3& p) {
+// Sliding from a guess of the slip direction, d0 (the sweep's previous
+// impulse; any length but 0): Newton on h from d0, kept if it converges
+// (the step below 1e-14 rad) to a valid slide whose error is round-off
+// (1e-12 of the problem's scale); false otherwise, and the caller scans
+// (slide_unit). A row's slip turns little from one sweep to the next, so
+// this takes 2 to 4 evaluations where the scan takes over a hundred. The
+// direction is carried as a unit vector, not an angle: each Newton step
+// turns d by dx = h / h' along its tangent and normalises it again, d <-
+// (d - dx d_perp) / |d - dx d_perp| (a turn by atan(dx), which is dx to
+// third order: Newton's in the tangent's coordinate, quadratic as in the
+// angle), with a square root where the angle took a sine and a cosine
+// (perf, 1000 cubes in shear: sincos and atan2 were a tenth of a step).
+inline bool slide_unit_from(const Mat3& W, const Vec3& b, const Eigen::Vector2d& d0, Vec3& p) {
   const SlideUnit su(W, b);
-  double x = f0;
+  const double len = d0.norm();
+  if (!(len > 0.0) || !std::isfinite(len)) return false;
+  Eigen::Vector2d d = d0 / len;
   for (int it = 0; it < 12; ++it) {
     double dh;
-    const double hx = su.h(x, &dh);
+    const double hx = su.h_at(d, &dh);
     if (!(dh != 0.0) || !std::isfinite(hx)) return false;
     const double dx = hx / dh;
     if (std::abs(dx) > 0.5) return false;  // far from the guess: leave it to the scan
-    x -= dx;
-    if (std::abs(dx) <= 1e-14 * (1.0 + std::abs(x))) {
+    const Eigen::Vector2d e(d[0] + dx * d[1], d[1] - dx * d[0]);  // d - dx (-d1, d0)
+    d = e / std::sqrt(e[0] * e[0] + e[1] * e[1]);
+    if (std::abs(dx) <= 1e-14) {
       double err;
-      return su.candidate(x, p, err) && err <= 1e-12 * su.scale(p);
+      return su.candidate_at(d, p, err) && err <= 1e-12 * su.scale(p);
     }
   }
   return false;
@@ -255,7 +268,11 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
     br = solve_plane(W(0, 0), W(0, k), W(k, k), b[0], b[k], std::max(c.mu_a, c.mu_b), s[0], s[k]);
   } else {
     const Vec3 g = W_inv ? Vec3(-(*W_inv * b)) : Vec3(-W.ldlt().solve(b));
-    if (g[0] >= 0.0 && std::hypot(g[1] / c.mu_a, g[2] / c.mu_b) <= g[0]) {
+    // Inside the cone: |D^-1 g_t| <= g_n, on the squares (no hypot: impulses
+    // are far from where the squares leave the double range, as in
+    // project_sphere3).
+    const double ga = g[1] / c.mu_a, gb = g[2] / c.mu_b;
+    if (g[0] >= 0.0 && ga * ga + gb * gb <= g[0] * g[0]) {
       s = g;
       br = Branch3::Stick;
     } else {
@@ -266,11 +283,11 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
       bool warm = false;
       if (guess) {
         if ((*guess)[1] != 0.0 || (*guess)[2] != 0.0)
-          warm = slide_unit_from(Wt, bt, std::atan2((*guess)[2] / c.mu_b, (*guess)[1] / c.mu_a), p);
+          warm = slide_unit_from(Wt, bt, Eigen::Vector2d((*guess)[1] / c.mu_a, (*guess)[2] / c.mu_b), p);
         // A slide that starts (the guess sticks) or turned far: from the
         // stick trial's direction, the slide's own for an isotropic block
         // and near it otherwise; the scan only if that fails too.
-        if (!warm) warm = slide_unit_from(Wt, bt, std::atan2(g[2] / c.mu_b, g[1] / c.mu_a), p);
+        if (!warm) warm = slide_unit_from(Wt, bt, Eigen::Vector2d(g[1] / c.mu_a, g[2] / c.mu_b), p);
       }
       if (warm || slide_unit(Wt, bt, p)) {
         s = T.cwiseProduct(p);
