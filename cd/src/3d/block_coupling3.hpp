@@ -171,15 +171,18 @@ struct BlockCoupling3 {
   static constexpr bool kSubspaceLaw = !L::orthotropic;
   using Scratch = std::vector<BodyVel3>;
   Scratch subspace_scratch() const { return Scratch(vel, vel + nbodies); }
-  // The row's free components (subspace3.hpp), its velocity, W's diagonal.
+  // The row's free components (subspace3.hpp), its velocity, W's diagonal;
+  // an open row (no free component: most rows of a polyhedra step) leaves
+  // the last two unwritten, as the correction reads them on free ones only.
   template <class L>
   void subspace_row(const BlockRow3& r, double* free, double* diag, double* u) const {
+    subspace3::free_components<L>(r.r, r.mu, r.adh, free);
+    if (free[0] == 0.0) return;
     const Vec3 v = velocity(r);
     for (int j = 0; j < 3; ++j) {
       u[j] = v[j];
       diag[j] = r.W(j, j);
     }
-    subspace3::free_components<L>(r.r, r.mu, r.adh, free);
   }
   // y = W p on the rows listed in live, through s (no offsets, no b_n);
   // the other rows' p is zero and their y is not read.

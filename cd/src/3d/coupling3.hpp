@@ -176,13 +176,14 @@ struct BodyCouplingT3 {
   // The row's free components (subspace3.hpp), its velocity, W's diagonal.
   template <class L>
   void subspace_row(const SweepRow3& r, double* free, double* diag, double* u) const {
+    subspace3::free_components<L>(r.r, r.mu, r.adh, free);
+    if (free[0] == 0.0) return;  // open: u and diag unread (block_coupling3.hpp)
     const Vec3 v = law_velocity(r);
     u[0] = v[0];
     u[1] = v[1];
     u[2] = v[2];
     diag[0] = 1.0 / r.iwnn;  // compliant: W_nn + rho (the row's iwnn)
     diag[1] = diag[2] = 1.0 / r.iwtt;
-    subspace3::free_components<L>(r.r, r.mu, r.adh, free);
   }
   // y = W p on the rows listed in live, through s (offsets and b_n left
   // out; compliant: (W + diag(rho, rho_t, rho_t)) p); the other rows' p is

@@ -245,6 +245,8 @@ class Stall {
 //   C::Scratch c.subspace_scratch()     bodies' storage for the products
 //   c.subspace_row<L>(row, free, diag, u)  per component: 1/0 free, W_kk's
 //       diagonal, the row's velocity; all-zero free when L has no such step
+//       (diag and u are read on free components only: a row without one
+//       may leave them)
 //   c.subspace_apply(rows, live, p, y, scratch)   y = W p on the rows listed
 //       in live (the others' p is 0 and their y unread; no offsets)
 //   c.subspace_put<L>(row, d, sticking)    r <- proj(r + d), bodies follow
