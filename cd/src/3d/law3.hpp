@@ -268,9 +268,10 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
     br = solve_plane(W(0, 0), W(0, k), W(k, k), b[0], b[k], std::max(c.mu_a, c.mu_b), s[0], s[k]);
   } else {
     const Vec3 g = W_inv ? Vec3(-(*W_inv * b)) : Vec3(-W.ldlt().solve(b));
-    // Inside the cone: |D^-1 g_t| <= g_n, on the squares (no hypot: impulses
-    // are far from where the squares leave the double range, as in
-    // project_sphere3).
+    // The stick trial's tangential part in the unit cone's scale, D^-1 g_t
+    // (the stick test, the slide's second guess, the fallback). Inside the
+    // cone: |D^-1 g_t| <= g_n, on the squares (no hypot: impulses are far
+    // from where the squares leave the double range, as in project_sphere3).
     const double ga = g[1] / c.mu_a, gb = g[2] / c.mu_b;
     if (g[0] >= 0.0 && ga * ga + gb * gb <= g[0] * g[0]) {
       s = g;
@@ -287,14 +288,14 @@ inline Branch3 solve_local3(const Mat3& W, const Vec3& q, const Cone3& c, double
         // A slide that starts (the guess sticks) or turned far: from the
         // stick trial's direction, the slide's own for an isotropic block
         // and near it otherwise; the scan only if that fails too.
-        if (!warm) warm = slide_unit_from(Wt, bt, Eigen::Vector2d(g[1] / c.mu_a, g[2] / c.mu_b), p);
+        if (!warm) warm = slide_unit_from(Wt, bt, Eigen::Vector2d(ga, gb), p);
       }
       if (warm || slide_unit(Wt, bt, p)) {
         s = T.cwiseProduct(p);
         br = Branch3::Slide;
       } else {  // not seen for W SPD; kept so that the sweep never stalls
         s[0] = std::max(g[0], 0.0);
-        const double gt = std::hypot(g[1] / c.mu_a, g[2] / c.mu_b);
+        const double gt = std::hypot(ga, gb);
         const double f = gt > s[0] ? s[0] / gt : 1.0;
         s[1] = f * g[1];
         s[2] = f * g[2];
