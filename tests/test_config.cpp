@@ -36,14 +36,14 @@ void compare(const WallSpec& x, const WallSpec& y, bool same) {
 
 void compare(const Scene& x, const Scene& y, bool same) {
   const auto& [name, source, dimension, dt, duration, gravity, mu, mu_wall, mu_b, mu_wall_b, axis_a, e_n, e_t, alert, rotation, overlap_correction, overlap_projection, adhesion, stiffness, debond, tol,
-               max_iter, residual_tol, anderson, subspace, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, shape, shape_fractions, aspect, vertices, region,
+               max_iter, residual_tol, anderson, subspace, stop_rows, threads, n, d_mean, size_ratio, size_dist, diameters, diameters_file, density, seed, nsides, shape, shape_fractions, aspect, vertices, region,
                box_width, box_height, box_depth, disks, walls, series_interval, snapshot_interval, series_strain, snapshot_strain,
                checkpoint_interval, checkpoint_strain, checkpoint_wall, quiet, shear_mode, cell_width, cell_height, cell_depth, shear_control, pressure,
                imposed_rate, rate_tp, volume_fraction, inertial_number, cell_mass, isotropic, compaction_rate, settle_stress, settle_phi, settle_time, strain, dt_tp, start, cohesion_number, stiffness_number, stiffness_ratio] = x;
   (void)source;  // not a parameter: the file the scene was read from
   CHECK_FIELD(name); CHECK_FIELD(dimension); CHECK_FIELD(dt); CHECK_FIELD(duration); CHECK_FIELD(gravity);
   CHECK_FIELD(mu); CHECK_FIELD(mu_wall); CHECK_FIELD(mu_b); CHECK_FIELD(mu_wall_b); CHECK_FIELD(axis_a); CHECK_FIELD(e_n); CHECK_FIELD(e_t); CHECK_FIELD(alert);
-  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(overlap_projection); CHECK_FIELD(adhesion); CHECK_FIELD(stiffness); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(anderson); CHECK_FIELD(subspace); CHECK_FIELD(threads);
+  CHECK_FIELD(rotation); CHECK_FIELD(overlap_correction); CHECK_FIELD(overlap_projection); CHECK_FIELD(adhesion); CHECK_FIELD(stiffness); CHECK_FIELD(debond); CHECK_FIELD(tol); CHECK_FIELD(max_iter); CHECK_FIELD(residual_tol); CHECK_FIELD(anderson); CHECK_FIELD(subspace); CHECK_FIELD(stop_rows); CHECK_FIELD(threads);
   CHECK_FIELD(n); CHECK_FIELD(d_mean); CHECK_FIELD(size_ratio); CHECK_FIELD(size_dist);
   CHECK_FIELD(diameters); CHECK_FIELD(diameters_file);
   CHECK_FIELD(density); CHECK_FIELD(seed); CHECK_FIELD(nsides); CHECK_FIELD(shape); CHECK_FIELD(shape_fractions); CHECK_FIELD(aspect); CHECK_FIELD(vertices); CHECK_FIELD(region); CHECK_FIELD(box_width);
@@ -91,6 +91,7 @@ Scene nondefault() {
   s.residual_tol = 2e-3;
   s.anderson = 4;
   s.subspace = 7;
+  s.stop_rows = cd::StopRows::Loaded;
   s.threads = 2;
   s.n = 3;
   s.d_mean = 2e-3;
@@ -419,9 +420,9 @@ TEST(Markdown, OneRowPerParameter) {
   EXPECT_EQ(md.rfind("| key | default | unit | rule | meaning |\n|---|---|---|---|---|\n", 0), 0u);
   std::size_t rows = 0;
   for (std::size_t k = 0; (k = md.find("\n| `", k)) != std::string::npos; ++k) ++rows;
-  // 72 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
+  // 73 scene keys + 8 per [[disk]] + 4 per [[wall]]: the members of Scene,
   // DiskSpec and WallSpec but Scene::source, disks and walls.
-  EXPECT_EQ(rows, 72u + 8u + 4u) << md;
+  EXPECT_EQ(rows, 73u + 8u + 4u) << md;
   EXPECT_NE(md.find("| `contact.e_n` | `0.0` |  | in [0, 1] | normal restitution coefficient |"),
             std::string::npos) << md;
   EXPECT_NE(md.find("| `solver.max_iter` | `2000` |  | integer in [1, 100000000] |"), std::string::npos) << md;

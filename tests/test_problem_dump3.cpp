@@ -207,12 +207,14 @@ TEST(ProblemDump3, ShearStepReplaysExactlyAndItsFclibFileIsTheStep) {
 // 4, the tensors after the bodies) replays bit for bit on 1 and 2 threads,
 // and the FCLib file holds W = H^T M^-1 H with the tensors' angular blocks,
 // checked against the assembly above; a tensor that is not positive
-// semidefinite is refused, by line.
+// semidefinite is refused, by line. The step's stop over the loaded rows
+// (solver.stop_rows) travels in the file: the replay is the step's solve.
 TEST(ProblemDump3, PolyhedraStepReplaysExactlyAndItsFclibFileIsTheStep) {
   const fs::path dir = cdtest::scratch_dir("problem_dump3", "polyhedra");
   const auto r = cdtest::run_command(kCdsim + " " + kConfigs +
                                      "pile-polyhedra.toml --set particles.n=27 --set time.duration=0.2 "
                                      "--set particles.shape=cuboid --set particles.aspect=[1,1.5,2] "
+                                     "--set solver.stop_rows=loaded "
                                      "--set output.snapshot_interval=0 --quiet --dump-problem 150 --out " +
                                      dir.string());
   ASSERT_EQ(r.code, 0) << r.out;
@@ -224,6 +226,7 @@ TEST(ProblemDump3, PolyhedraStepReplaysExactlyAndItsFclibFileIsTheStep) {
 
   cd::SolverParams prm;
   const cd::ContactProblem3 p = cd::read_contact_problem3(cdp.string(), prm);
+  EXPECT_EQ(prm.stop_rows, cd::StopRows::Loaded);
   ASSERT_EQ(p.inv_inertia.size(), p.vel.size());
   // Resting blocks: more rows than bodies (face contacts of 4 points), and
   // tensors that are not multiples of the identity (a cube's would be).

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -436,3 +437,53 @@ TEST(ShearPolicy, AnExplicitTolKeepsTheAutoMixingAndCappedStepsNameTheSetting) {
 }
 
 }  // namespace
+
+// solver.stop_rows = "loaded": an "auto" stop is the band's, measured over
+// every row of sphere packings (2.13 rows per loaded row), expressed over
+// the loaded rows: tol / sqrt(2.13), residual_tol / 2.13 (the residual's
+// scale, mean |p|, taken over the rows with an impulse); the acceleration
+// is the band's as before. A 2D scene refuses it (not measured there),
+// naming both keys; a number for the tolerance is taken as given.
+TEST(ShearPolicy, TheLoadedStopTakesTheBandsStopOverTheLoadedRows) {
+  const std::string scene =
+      "dimension = 3\ngravity.g = [0.0, 0.0, 0.0]\n[solver]\ntol = \"auto\"\nresidual_tol = \"auto\"\n"
+      "anderson = \"auto\"\nsubspace = \"auto\"\nstop_rows = \"loaded\"\n"
+      "[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.01\n";
+  for (const double I : {0.001, 0.01, 0.3}) {
+    const std::string is = fmt::format("shear.inertial_number={}", I);
+    const cd::Scene s = cd::parse_scene(scene, "a.toml", {is});
+    const cd::Scene all = cd::parse_scene(scene, "a.toml", {is, "solver.stop_rows=all"});
+    EXPECT_EQ(s.stop_rows, cd::StopRows::Loaded);
+    EXPECT_EQ(all.stop_rows, cd::StopRows::All);
+    EXPECT_EQ(s.anderson, all.anderson) << I;
+    EXPECT_EQ(s.subspace, all.subspace) << I;
+    EXPECT_NEAR(s.tol, all.tol / std::sqrt(2.13), 1e-15) << I;
+    EXPECT_NEAR(s.residual_tol, all.residual_tol / 2.13, 1e-15) << I;
+    // The subspace band's 7e-4 over every row is 4.796e-4 over the loaded ones.
+    if (I == 0.01) {
+      EXPECT_NEAR(s.tol, 4.796e-4, 1e-7);
+    }
+  }
+  const cd::Scene given = cd::parse_scene(scene, "a.toml", {"solver.tol=2e-3", "solver.residual_tol=0"});
+  EXPECT_EQ(given.tol, 2e-3);
+  const std::string two = "dimension = 2\n[solver]\ntol = \"auto\"\nstop_rows = \"loaded\"\n"
+                          "[shear]\nmode = \"periodic\"\npressure = 100.0\ninertial_number = 0.01\n";
+  try {
+    cd::parse_scene(two, "b.toml", {});
+    ADD_FAILURE() << "a 2D auto stop over the loaded rows was accepted";
+  } catch (const cd::ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("b.toml"), std::string::npos) << m;
+    EXPECT_NE(m.find("solver.tol"), std::string::npos) << m;
+    EXPECT_NE(m.find("solver.stop_rows"), std::string::npos) << m;
+  }
+  EXPECT_EQ(cd::parse_scene(two, "b.toml", {"solver.tol=1e-3"}).stop_rows, cd::StopRows::Loaded);
+  // Not a name of it: refused with the names.
+  try {
+    cd::parse_scene(scene, "a.toml", {"solver.stop_rows=forces"});
+    ADD_FAILURE() << "solver.stop_rows = forces was accepted";
+  } catch (const cd::ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("loaded"), std::string::npos) << m;
+  }
+}

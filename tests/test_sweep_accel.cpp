@@ -270,3 +270,56 @@ TEST(SweepStop, TheBoundedNormStopsWhereTheExactOneDoes) {
     for (std::size_t k = 0; k < rl.size(); ++k) ASSERT_EQ(rl[k], re[k]) << "tol " << tol << ", row " << k;
   }
 }
+
+// The stop over the loaded rows (SolverParams::stop_rows) does not see the
+// open rows within the alert distance. The step's problem padded with twice
+// its rows again as open rows (copies of its rows held apart by a normal
+// velocity offset of 1000 m/s, zero impulse, at the end of its last colour;
+// one thread) stops at the same sweep with the same impulses on every row,
+// bit for bit, plain, with the subspace correction and with the law-residual
+// stop (whose scale is then the mean |p| of the rows with an impulse), and
+// leaves the open rows at zero; the stop over every row counts them as rows
+// that have converged and, held sqrt(3) times tighter over the forces,
+// sweeps more.
+TEST(SweepStop, TheLoadedStopDoesNotSeeOpenRows) {
+  World3 w = sheared();
+  ContactProblem3 frozen;
+  w.set_problem_hook([&](const ContactProblem3& p, const SolverParams&) { frozen = p; });
+  w.step();
+  const std::size_t n = frozen.rows.size();
+  ASSERT_GT(n, 500u);
+  ContactProblem3 padded = frozen;
+  for (std::size_t k = 0; k < 2 * n; ++k) {
+    SphereRow r = frozen.rows[k % n];
+    r.bn = 1000.0;  // m/s: no velocity of the step closes it
+    r.r = Vec3::Zero();
+    padded.rows.push_back(r);
+    if (!frozen.extra.empty()) padded.extra.push_back(frozen.extra[k % n]);
+    padded.colouring.perm.push_back(static_cast<std::int32_t>(n + k));
+  }
+  padded.colouring.start.back() += static_cast<std::int32_t>(2 * n);
+  for (const auto& [tol, residual_tol, subspace] : {std::tuple{7e-4, 0.0, 0}, {7e-4, 0.0, 10}, {1e-5, 3e-3, 0}}) {
+    SolverParams prm = w.params().solver;
+    prm.tol = tol;
+    prm.max_iter = 20000;
+    prm.residual_tol = residual_tol;
+    prm.anderson = 0;
+    prm.subspace = subspace;
+    prm.min_parallel = INT_MAX;  // one thread: the padding shares bodies with its colour
+    prm.stop_rows = StopRows::Loaded;
+    const auto [loaded, rl] = solve_with<sweep::BodyCoupling3>(frozen, prm);
+    const auto [loaded_padded, rlp] = solve_with<sweep::BodyCoupling3>(padded, prm);
+    EXPECT_FALSE(loaded.cap_hit) << tol;
+    EXPECT_EQ(loaded.iterations, loaded_padded.iterations) << tol;
+    EXPECT_EQ(loaded.dp_rel, loaded_padded.dp_rel) << tol;
+    EXPECT_EQ(loaded.residual_max, loaded_padded.residual_max) << tol;
+    for (std::size_t k = 0; k < n; ++k) ASSERT_EQ(rl[k], rlp[k]) << "tol " << tol << ", row " << k;
+    for (std::size_t k = n; k < 3 * n; ++k) ASSERT_EQ(rlp[k], Vec3::Zero()) << "tol " << tol << ", row " << k;
+    if (residual_tol > 0) continue;
+    prm.stop_rows = StopRows::All;
+    const auto [all, ra] = solve_with<sweep::BodyCoupling3>(frozen, prm);
+    const auto [all_padded, rap] = solve_with<sweep::BodyCoupling3>(padded, prm);
+    EXPECT_GT(all_padded.iterations, all.iterations) << tol;
+    EXPECT_GE(all.iterations, loaded.iterations) << tol;
+  }
+}

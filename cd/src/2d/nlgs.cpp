@@ -37,9 +37,9 @@ void apply_impulses(const std::vector<ContactRow>& rows, std::vector<BodyVel>& v
 void law_residuals(const ContactProblem& p, const SolverParams& prm, SolveStats& st) {
   auto* vel = const_cast<BodyVel*>(p.vel.data());  // read only: velocity() does not write
   if (p.rotation)
-    sweep::residuals(p.rows, sweep::BodyCoupling<true>{vel}, prm.min_parallel, st);
+    sweep::residuals(p.rows, sweep::BodyCoupling<true>{vel}, prm, st);
   else
-    sweep::residuals(p.rows, sweep::BodyCoupling<false>{vel}, prm.min_parallel, st);
+    sweep::residuals(p.rows, sweep::BodyCoupling<false>{vel}, prm, st);
 }
 
 double update_dof(BoundaryDof& d, ContactRow* rows) {

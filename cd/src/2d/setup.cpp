@@ -52,6 +52,7 @@ WorldParams world_params(const CompleteScene& c) {
   p.solver.tol = s.tol;
   p.solver.residual_tol = s.residual_tol;
   p.solver.anderson = s.anderson;
+  p.solver.stop_rows = s.stop_rows;
   p.solver.max_iter = s.max_iter;
   p.rotation = s.rotation;
   return p;

@@ -64,6 +64,7 @@ WorldParams3 world_params3(const CompleteScene& c) {
   p.solver.residual_tol = s.residual_tol;
   p.solver.anderson = s.anderson;
   p.solver.subspace = s.subspace;
+  p.solver.stop_rows = s.stop_rows;
   p.solver.max_iter = s.max_iter;
   if (s.shear_mode == ShearMode::Periodic) {
     p.cell = Vec3(s.cell_width, s.cell_height, s.cell_depth);

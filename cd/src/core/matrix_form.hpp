@@ -123,7 +123,9 @@ NlgsStats nlgs(const P& p, Eigen::VectorXd& r, const NlgsOptions& opt, const For
   const int every = std::max(1, opt.check_every);
   auto record = [&](int sweep, double dp_rel) {
     SolveStats s;
-    sweep::residuals(rows, c, INT_MAX, s);
+    SolverParams one = prm;
+    one.min_parallel = INT_MAX;  // the history's pass on this thread
+    sweep::residuals(rows, c, one, s);
     st.history.push_back({sweep, dp_rel, s.residual_max, s.residual_mean});
   };
   SolveStats s;

@@ -27,12 +27,14 @@ namespace cd::problem_file {
 inline std::string hex(double v) { return fmt::format("{:a}", v); }
 
 // "tol T", "max_iter N", "min_parallel N" and, when > 0, "residual_tol R"
-// , "anderson M" and "subspace K" (so that a replay takes the step's own solve).
+// , "anderson M" and "subspace K", and "stop_rows loaded" when the stop
+// averages over the loaded rows (so that a replay takes the step's own solve).
 inline void write_solver(std::ostream& out, const SolverParams& prm) {
   out << "tol " << hex(prm.tol) << "\nmax_iter " << prm.max_iter << "\nmin_parallel " << prm.min_parallel << "\n";
   if (prm.residual_tol > 0) out << "residual_tol " << hex(prm.residual_tol) << "\n";
   if (prm.anderson > 0) out << "anderson " << prm.anderson << "\n";
   if (prm.subspace > 0) out << "subspace " << prm.subspace << "\n";
+  if (prm.stop_rows == StopRows::Loaded) out << "stop_rows loaded\n";
 }
 
 inline void read_solver(TextReader& rd, SolverParams& prm, const std::string& after) {
@@ -54,6 +56,12 @@ inline void read_solver(TextReader& rd, SolverParams& prm, const std::string& af
   if (rd.peek() == "subspace") {  // optional: written when > 0
     rd.token();
     prm.subspace = static_cast<int>(rd.integer("the subspace correction's iterations", 1, 1000));
+  }
+  if (rd.peek() == "stop_rows") {  // optional: written when not every row
+    rd.token();
+    const std::string v(rd.token());
+    if (v != "loaded") rd.fail(fmt::format("stop_rows is '{}', expected 'loaded'", v));
+    prm.stop_rows = StopRows::Loaded;
   }
 }
 

@@ -17,6 +17,15 @@ inline constexpr int kAndersonMaxMemory = 50;
 
 struct SolverParams {
   double tol = defaults::tol;  // eps_f on rms |dp| / mean |p| over a sweep (LMGC90's "Quad" norm)
+  // All: the rms and the mean over every row, the open rows within the alert
+  // distance included (each counts as a row that has converged: with n rows
+  // of which n_f are loaded, the test is sqrt(n/n_f) times the same test
+  // over the loaded rows alone, and how tight it is depends on the alert
+  // distance). Loaded: over the rows loaded in the sweep (an impulse after
+  // their update, or a change in it), and the law-residual stop's scale,
+  // mean |p|, over the rows with an impulse: the test of the forces alone,
+  // whatever the alert distance keeps open.
+  StopRows stop_rows = defaults::stop_rows;
   int max_iter = defaults::max_iter;  // iteration cap
   // Below this many rows the sweep runs on one thread: a colour of a few
   // dozen rows costs less than the barrier that ends it (measured: a

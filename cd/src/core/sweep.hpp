@@ -33,6 +33,7 @@
 #include <concepts>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -50,6 +51,7 @@ struct RowBlock {
 
 struct BlockStats {
   double dp2sum = 0, psum = 0, rmax = 0, rsum = 0;
+  int loaded = 0;  // rows with an impulse after their update, or a change in it
 };
 
 // Splits [begin, end) into fixed blocks.
@@ -60,12 +62,14 @@ inline void push_blocks(std::vector<RowBlock>& out, int begin, int end, bool wri
 template <class L, class Row, class C>
 void run_block(const RowBlock& k, Row* rows, C& c, BlockStats& s) {
   double dsum = 0, psum = 0;
+  int loaded = 0;
   if (k.write1) {
     for (int i = k.begin; i < k.end; ++i) {
       double dp2, pabs;
       c.template update<L, true>(rows[i], dp2, pabs);
       dsum += dp2;
       psum += pabs;
+      loaded += (pabs > 0) | (dp2 > 0);
     }
   } else {
     for (int i = k.begin; i < k.end; ++i) {
@@ -73,10 +77,12 @@ void run_block(const RowBlock& k, Row* rows, C& c, BlockStats& s) {
       c.template update<L, false>(rows[i], dp2, pabs);
       dsum += dp2;
       psum += pabs;
+      loaded += (pabs > 0) | (dp2 > 0);
     }
   }
   s.dp2sum = dsum;
   s.psum = psum;
+  s.loaded = loaded;
 }
 
 // Anderson acceleration of the sweep (SolverParams::anderson; Walker & Ni,
@@ -329,20 +335,27 @@ class Subspace {
   std::vector<int> live_, comp_;
 };
 
-// Mean |p| over the rows (summed in row order) and the residuals' scale
-// (mean |p|, or 1 when it is 0): one definition for residuals() and for
-// residual_below(), whose stop decision must be residuals()'s exactly.
+// Mean |p| over the rows (summed in row order; StopRows::Loaded: over the
+// rows with an impulse) and the residuals' scale (mean |p|, or 1 when it is
+// 0): one definition for residuals() and for residual_below(), whose stop
+// decision must be residuals()'s exactly.
 template <class Row>
-std::pair<double, double> p_mean_and_scale(const std::vector<Row>& rows) {
+std::pair<double, double> p_mean_and_scale(const std::vector<Row>& rows, StopRows over) {
   double psum = 0;
-  for (const Row& r : rows) psum += impulse_norm(r);
-  const double p_mean = psum / static_cast<double>(rows.size());
+  int loaded = 0;
+  for (const Row& r : rows) {
+    const double p = impulse_norm(r);
+    psum += p;
+    loaded += p > 0;
+  }
+  const int n = over == StopRows::Loaded ? std::max(loaded, 1) : static_cast<int>(rows.size());
+  const double p_mean = psum / static_cast<double>(n);
   return {p_mean, p_mean > 0 ? p_mean : 1.0};
 }
 
 // Law residual of every row (normalised by mean |p|), read-only.
 template <class Row, class C>
-void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, SolveStats& st) {
+void residuals(const std::vector<Row>& rows, const C& c, const SolverParams& prm, SolveStats& st) {
   const int n = static_cast<int>(rows.size());
   if (n == 0) {
     st.residual_max = st.residual_mean = 0;
@@ -352,7 +365,7 @@ void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, Solve
   push_blocks(blocks, 0, n, true);
   std::vector<BlockStats> bs(blocks.size());
   const int nb = static_cast<int>(blocks.size());
-#pragma omp parallel for schedule(static) if (n >= min_parallel)
+#pragma omp parallel for schedule(static) if (n >= prm.min_parallel)
   for (int b = 0; b < nb; ++b) {
     double rmax = 0, rsum = 0;
     for (int i = blocks[b].begin; i < blocks[b].end; ++i) {
@@ -368,7 +381,7 @@ void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, Solve
     rmax = std::max(rmax, s.rmax);
     rsum += s.rsum;
   }
-  const auto [p_mean, scale] = p_mean_and_scale(rows);
+  const auto [p_mean, scale] = p_mean_and_scale(rows, prm.stop_rows);
   st.p_mean = p_mean;
   st.residual_max = rmax / scale;
   st.residual_mean = rsum / n / scale;
@@ -383,11 +396,11 @@ void residuals(const std::vector<Row>& rows, const C& c, int min_parallel, Solve
 // scale >= tol (rounded division is monotone), and a NaN residual is
 // skipped as std::max skips it there. Read-only, one thread.
 template <class Row, class C>
-bool residual_below(const std::vector<Row>& rows, const C& c, double tol) {
+bool residual_below(const std::vector<Row>& rows, const C& c, const SolverParams& prm) {
   if (rows.empty()) return true;
-  const double scale = p_mean_and_scale(rows).second;
+  const double scale = p_mean_and_scale(rows, prm.stop_rows).second;
   for (const Row& r : rows)
-    if (row_residual(c, r) / scale >= tol) return false;
+    if (row_residual(c, r) / scale >= prm.residual_tol) return false;
   return true;
 }
 
@@ -400,7 +413,8 @@ SolveStats no_rows(std::vector<Dof>* dofs) {
 }
 
 // The end of a sweep: the convergence test on the sweep's sums (dsum of
-// |dp|^2, psum of |p| over the n rows), the dofs' update, the observer.
+// |dp|^2, psum of |p| over the rows, averaged over n: every row, or the
+// loaded ones under StopRows::Loaded), the dofs' update, the observer.
 // Returns true when the solve stops (dp_rel < tol and every dof converged,
 // or max_iter sweeps).
 template <class Row, class Dof>
@@ -475,6 +489,7 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
   int it = 0;
   bool psum_exact = true;  // kNormBound: was the last sweep's |p| sum exact
   double last_dsum = 0;
+  int last_n = n;  // the rows the last sweep's test averaged over
   // kNormBound: an upper bound of the exact |p| sum, tighter than the
   // sweep's bound sum in a slow tail (where the stop stays near and the exact
   // sum would be taken every sweep: 4 % of a 1000-sphere step at I = 1e-3):
@@ -526,24 +541,30 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
 #pragma omp single
       {
         double dsum = 0, psum = 0;
+        int loaded = 0;
         for (int b = 0; b < nb; ++b) {
           dsum += bs[b].dp2sum;
           psum += bs[b].psum;
+          loaded += bs[b].loaded;
         }
+        // The rows the test averages over: every row, or the loaded ones
+        // (their sums are the whole sums: an unloaded row adds 0 to both).
+        const int nt = prm.stop_rows == StopRows::Loaded ? std::max(loaded, 1) : n;
         if constexpr (norm_bound<C>()) {
           psum_up += std::sqrt(static_cast<double>(n) * dsum) * (1.0 + 1e-9);
           psum = std::min(psum, psum_up);  // >= the exact sum: the test fails at it when it fails here
-          psum_exact = observer || it + 1 >= prm.max_iter || bound_leaves_stop_open(dsum, psum, n, prm.tol);
+          psum_exact = observer || it + 1 >= prm.max_iter || bound_leaves_stop_open(dsum, psum, nt, prm.tol);
           if (psum_exact) psum_up = psum = exact_psum(blocks, R);
           last_dsum = dsum;
+          last_n = nt;
         }
         const double pair_dsum = dsum;
-        done = end_sweep(++it, dsum, psum, n, R, dofs, prm, observer, st);
+        done = end_sweep(++it, dsum, psum, nt, R, dofs, prm, observer, st);
         // The optional second criterion: the law residual itself, checked
         // every kResidualEvery sweeps (a read-only pass over the rows, on
         // this thread). Off (residual_tol = 0) it costs nothing.
         if (!done && prm.residual_tol > 0 && it % kResidualEvery == 0) {
-          st.residual_met = residual_below(rows, c, prm.residual_tol) && st.dof_rel < prm.tol;
+          st.residual_met = residual_below(rows, c, prm) && st.dof_rel < prm.tol;
           done = st.residual_met;
         }
         if constexpr (AddsImpulse<C, Row>) {
@@ -575,12 +596,12 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
 
   if constexpr (norm_bound<C>()) {
     if (!psum_exact) {  // stopped by the law residual on a sweep the bound ruled out: the exact figures
-      const double p_mean = exact_psum(blocks, R) / n;
+      const double p_mean = exact_psum(blocks, R) / last_n;
       st.p_mean = p_mean;
-      st.dp_rel = std::sqrt(last_dsum / n) / (p_mean > 0 ? p_mean : 1.0);
+      st.dp_rel = std::sqrt(last_dsum / last_n) / (p_mean > 0 ? p_mean : 1.0);
     }
   }
-  residuals(rows, c, prm.min_parallel, st);
+  residuals(rows, c, prm, st);
   st.cap_hit = not_converged(st, prm);
   return st;
 }
@@ -591,10 +612,13 @@ SolveStats solve(std::vector<Row>& rows, const Colouring& col, C& c, const Solve
 // dp2, pabs) updates unit k (dp2 and pabs summed over its rows, pabs the
 // exact |p| also for a kNormBound coupling's rows); units go forward on odd
 // sweeps, backward on even ones, and dp2, pabs are summed in visiting order. The convergence test, the
-// dofs, the observer and the residuals are solve's. One thread.
+// dofs, the observer and the residuals are solve's, over every row (a unit
+// does not say how many of its rows are loaded: StopRows::Loaded is refused). One thread.
 template <class Row, class C, class Dof, class Update>
 SolveStats solve_units(std::vector<Row>& rows, int units, const C& c, const SolverParams& prm,
                        std::vector<Dof>* dofs, const SweepObserver& observer, Update&& update) {
+  if (prm.stop_rows != StopRows::All)
+    throw std::invalid_argument("solve_units: the stop over the loaded rows needs the rows' own sweep");
   if (rows.empty()) return no_rows(dofs);
   SolveStats st;
   const int n = static_cast<int>(rows.size());
@@ -609,7 +633,7 @@ SolveStats solve_units(std::vector<Row>& rows, int units, const C& c, const Solv
     }
     if (end_sweep(++it, dsum, psum, n, rows.data(), dofs, prm, observer, st)) break;
   }
-  residuals(rows, c, prm.min_parallel, st);
+  residuals(rows, c, prm, st);
   st.cap_hit = not_converged(st, prm);
   return st;
 }

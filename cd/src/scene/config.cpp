@@ -111,7 +111,7 @@ Rule disk_density() {
 template <class T>
 using Field = std::variant<double T::*, int T::*, unsigned T::*, bool T::*, std::string T::*,
                            std::array<double, 2> T::*, std::vector<double> T::*, ShearMode T::*,
-                           ShearControl T::*, SizeDist T::*, std::vector<Shape3d> T::*>;
+                           ShearControl T::*, SizeDist T::*, StopRows T::*, std::vector<Shape3d> T::*>;
 
 template <class T>
 struct Param {
@@ -152,6 +152,7 @@ const std::vector<Param<Scene>>& scene_params() {
       {"solver", "residual_tol", &Scene::residual_tol, "", ge(0), "> 0: a step's solve also stops when its largest law residual (relative to the mean impulse, the series' residual column) is below this, checked every 10 sweeps; 0: the rms |dp| test (solver.tol) alone; \"auto\": set by shear.inertial_number (docs/shear.md, Settings by I)"},
       {"solver", "anderson", &Scene::anderson, "", in(0, 50), "> 0: Anderson acceleration of the sweep with this memory (5 is the measured choice): after each forward-backward pair of sweeps the impulses are mixed over the last pairs, and the mixing is off for the rest of a step's solve once it stalls (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it (docs/shear.md, Settings by I); 0: plain NLGS; \"auto\": the shear policy's choice by shear.inertial_number (measured on spheres), kept with a number for solver.tol (docs/accuracy.md)"},
       {"solver", "subspace", &Scene::subspace, "", in(0, 1000), "> 0: the subspace correction of the sweep (3D only; it acts on the round cone, with adhesion or not: an orthotropic scene refuses it): every two forward-backward pairs of sweeps, the linear problem of the contacts that stick (u = 0) and slide (u_n = 0) is solved by at most this many conjugate-gradient iterations and put into the impulses, until a stall stops them for the step (docs/accuracy.md); an \"auto\" solver.tol then takes the shear policy's tolerance for it; 0: off; \"auto\": the shear policy's choice by shear.inertial_number (docs/shear.md, Settings by I)"},
+      {"solver", "stop_rows", &Scene::stop_rows, "", one_of<StopRows>(), "the rows the stop test (solver.tol) averages its rms |dp| and mean |p| over: all, every row, the open ones within the alert distance included (each counts as converged, so the test tightens with the share of open rows: with n rows of which n_f carry force it is sqrt(n/n_f) times the test over those); loaded, the rows loaded in the sweep (an impulse, or a change in it), whatever the alert distance keeps open, and the law-residual stop's scale (solver.residual_tol) the mean |p| of the rows with an impulse; an \"auto\" solver.tol or solver.residual_tol then takes the shear policy's stop expressed over the loaded rows (docs/shear.md, Settings by I)"},
       {"solver", "threads", &Scene::threads, "", in(0, 1024), "OpenMP threads; 0: OpenMP default"},
       {"particles", "n", &Scene::n, "", in(0, 1e8), "number of randomly generated disks; 0: none"},
       {"particles", "d_mean", &Scene::d_mean, "m", gt(0), "mean diameter of the generated disks"},
@@ -567,7 +568,7 @@ Scene read_scene(const toml::value& root, const std::string& path) {
   // override is read, so that --set shear.inertial_number counts).
   const SceneKind kind{s.dimension, s.adhesion > 0 || s.cohesion_number > 0,
                        std::any_of(s.nsides.begin(), s.nsides.end(), [](double k) { return k >= 3; }),
-                       s.orthotropic()};
+                       s.orthotropic(), s.stop_rows == StopRows::Loaded};
   // Under volume control, the nominal I of shear.rate at the pressure scale
   // (scene/protocol.hpp); no "auto" key changes what it is made of.
   const double I = nominal_inertial_number(s);
@@ -587,6 +588,14 @@ Scene read_scene(const toml::value& root, const std::string& path) {
                     : fmt::format("{} = \"auto\" is set by shear.inertial_number (docs/shear.md, \"Settings "
                                   "by I\"), which is {}: give shear.inertial_number > 0 or a number",
                                   a->key, text(s.inertial_number, false)));
+        continue;
+      }
+      if (kind.loaded_stop && s.dimension == 2 && (a->key == "solver.tol" || a->key == "solver.residual_tol")) {
+        out.add(at, a->key.substr(a->key.find('.') + 1),
+                fmt::format("{} = \"auto\" with solver.stop_rows = \"loaded\": the shear policy's stops over "
+                            "the loaded rows are measured in 3D only (shear_policy.hpp); give a number, or "
+                            "solver.stop_rows = \"all\"",
+                            a->key));
         continue;
       }
       const Acceleration acc = s.subspace > 0  ? Acceleration::Subspace
@@ -756,6 +765,7 @@ void apply_override(toml::value& root, const std::string& set) {
                       std::holds_alternative<ShearMode Scene::*>(p->field) ||
                       std::holds_alternative<ShearControl Scene::*>(p->field) ||
                       std::holds_alternative<SizeDist Scene::*>(p->field) ||
+                      std::holds_alternative<StopRows Scene::*>(p->field) ||
                       std::holds_alternative<std::vector<Shape3d> Scene::*>(p->field) ||
                       (value == "auto" && auto_key(key));
     if (!word)

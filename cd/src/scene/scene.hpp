@@ -36,6 +36,10 @@ inline constexpr std::array<std::string_view, 2> kSizeDistNames = {"uniform", "u
 // particles.aspect, or an irregular polyhedron, each grain its own: the
 // hull of particles.vertices random points on the ellipsoid of semi-axes in
 // those ratios.
+// solver.stop_rows: the rows the solver's stop test averages over
+// (core/solver.hpp, SolverParams::stop_rows).
+inline constexpr std::array<std::string_view, 2> kStopRowsNames = {"all", "loaded"};
+
 enum class Shape3d { Sphere, Tetrahedron, Cube, Octahedron, Dodecahedron, Icosahedron, Cuboid, Irregular };
 inline constexpr std::array<std::string_view, 8> kShape3dNames = {
     "sphere", "tetrahedron", "cube", "octahedron", "dodecahedron", "icosahedron", "cuboid", "irregular"};
@@ -47,6 +51,7 @@ constexpr const auto& enum_names(ShearMode) { return kShearModeNames; }
 constexpr const auto& enum_names(ShearControl) { return kShearControlNames; }
 constexpr const auto& enum_names(SizeDist) { return kSizeDistNames; }
 constexpr const auto& enum_names(Shape3d) { return kShape3dNames; }
+constexpr const auto& enum_names(StopRows) { return kStopRowsNames; }
 template <class E>
 constexpr std::string_view name_of(E e) { return enum_names(e)[static_cast<std::size_t>(e)]; }
 
@@ -105,6 +110,7 @@ struct Scene {
   double residual_tol = defaults::residual_tol;  // > 0: also stop on the law residual
   int anderson = defaults::anderson;         // > 0: Anderson acceleration memory
   int subspace = defaults::subspace;         // > 0: subspace correction's CG iterations
+  StopRows stop_rows = defaults::stop_rows;  // the stop test over every row, or the loaded ones
   int threads = 0;           // 0: OpenMP default
 
   // [particles]: random generation (n = 0 for none)

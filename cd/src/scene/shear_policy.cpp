@@ -22,7 +22,9 @@ ShearSettings shear_settings(double I, Acceleration acc, SceneKind kind) {
                      : acc == Acceleration::Anderson ? (kind.cohesive ? b->cohesive : b->anderson)
                      : polygons                      ? b->polygons
                                                      : b->plain;
-  return {stop.tol, stop.residual_tol, stop.overlap_projection, dt_tp, b->cell_mass, anderson, subspace};
+  const double over = kind.loaded_stop ? kRowsPerLoadedRow : 1.0;
+  return {stop.tol / std::sqrt(over), stop.residual_tol / over, stop.overlap_projection, dt_tp, b->cell_mass,
+          anderson, subspace};
 }
 
 }  // namespace cd
