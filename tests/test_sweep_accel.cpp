@@ -54,7 +54,8 @@ const World3& sheared() {
 }
 
 // One step of the sheared state with the given solver settings.
-World3 solve_step(double tol, int max_iter, int anderson, int subspace = 0, int min_parallel = -1) {
+World3 solve_step(double tol, int max_iter, int anderson, int subspace = 0, int min_parallel = -1,
+                  StopRows stop_rows = StopRows::All) {
   World3 w = sheared();
   WorldParams3 p = w.params();
   p.solver.tol = tol;
@@ -62,6 +63,7 @@ World3 solve_step(double tol, int max_iter, int anderson, int subspace = 0, int 
   p.solver.residual_tol = 0.0;
   p.solver.anderson = anderson;
   p.solver.subspace = subspace;
+  p.solver.stop_rows = stop_rows;
   if (min_parallel >= 0) p.solver.min_parallel = min_parallel;
   w.set_params(p);
   w.step();
@@ -190,17 +192,22 @@ TEST(SweepSubspace, RegressionGuardWorkToTol7e4) {
 
 // The corrections run on one thread between sweeps: the step's impulses are
 // the same, bit for bit, whether the sweeps run on one thread or two (the
-// parallel sweep forced on: min_parallel 64 for ~600 rows).
+// parallel sweep forced on: min_parallel 64 for ~600 rows), with the stop
+// over every row and over the loaded ones (their count summed by block in
+// a fixed order).
 TEST(SweepSubspace, ResultsDoNotDependOnThreads) {
-  const int before = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const World3 one = solve_step(7e-4, 2000, 0, 10, 64);
-  omp_set_num_threads(2);
-  const World3 two = solve_step(7e-4, 2000, 0, 10, 64);
-  omp_set_num_threads(before);
-  ASSERT_EQ(one.rows().size(), two.rows().size());
-  EXPECT_EQ(one.last().solve.iterations, two.last().solve.iterations);
-  for (std::size_t k = 0; k < one.rows().size(); ++k) ASSERT_EQ(one.rows()[k].r, two.rows()[k].r) << "row " << k;
+  for (const StopRows over : {StopRows::All, StopRows::Loaded}) {
+    const int before = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const World3 one = solve_step(7e-4, 2000, 0, 10, 64, over);
+    omp_set_num_threads(2);
+    const World3 two = solve_step(7e-4, 2000, 0, 10, 64, over);
+    omp_set_num_threads(before);
+    ASSERT_EQ(one.rows().size(), two.rows().size());
+    EXPECT_EQ(one.last().solve.iterations, two.last().solve.iterations);
+    EXPECT_EQ(one.last().solve.dp_rel, two.last().solve.dp_rel);
+    for (std::size_t k = 0; k < one.rows().size(); ++k) ASSERT_EQ(one.rows()[k].r, two.rows()[k].r) << "row " << k;
+  }
 }
 
 namespace {
