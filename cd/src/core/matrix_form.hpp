@@ -121,11 +121,11 @@ NlgsStats nlgs(const P& p, Eigen::VectorXd& r, const NlgsOptions& opt, const For
 
   const SolverParams prm = solver_params(opt);
   const int every = std::max(1, opt.check_every);
+  SolverParams serial = prm;
+  serial.min_parallel = INT_MAX;  // the history's residual pass on this thread
   auto record = [&](int sweep, double dp_rel) {
     SolveStats s;
-    SolverParams one = prm;
-    one.min_parallel = INT_MAX;  // the history's pass on this thread
-    sweep::residuals(rows, c, one, s);
+    sweep::residuals(rows, c, serial, s);
     st.history.push_back({sweep, dp_rel, s.residual_max, s.residual_mean});
   };
   SolveStats s;
