@@ -30,16 +30,16 @@ inline constexpr std::array<std::string_view, 2> kShearControlNames = {"pressure
 enum class SizeDist { Uniform, UniformArea };
 inline constexpr std::array<std::string_view, 2> kSizeDistNames = {"uniform", "uniform_area"};
 
+// solver.stop_rows: the rows the solver's stop test averages over
+// (core/solver.hpp, SolverParams::stop_rows).
+inline constexpr std::array<std::string_view, 2> kStopRowsNames = {"all", "loaded"};
+
 // particles.shape: the generated grains' shape in 3D: spheres, or a convex
 // polyhedron whose circumscribed diameter is the grain's size (the
 // engine's, docs/3d.md): a Platonic solid, a cuboid of sides in the ratios
 // particles.aspect, or an irregular polyhedron, each grain its own: the
 // hull of particles.vertices random points on the ellipsoid of semi-axes in
 // those ratios.
-// solver.stop_rows: the rows the solver's stop test averages over
-// (core/solver.hpp, SolverParams::stop_rows).
-inline constexpr std::array<std::string_view, 2> kStopRowsNames = {"all", "loaded"};
-
 enum class Shape3d { Sphere, Tetrahedron, Cube, Octahedron, Dodecahedron, Icosahedron, Cuboid, Irregular };
 inline constexpr std::array<std::string_view, 8> kShape3dNames = {
     "sphere", "tetrahedron", "cube", "octahedron", "dodecahedron", "icosahedron", "cuboid", "irregular"};
