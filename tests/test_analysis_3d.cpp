@@ -1329,16 +1329,27 @@ TEST(ShearProfile, RefusesWhatItCannotMeasure) {
   } catch (const AnalysisError& e) {
     EXPECT_NE(std::string(e.what()).find("2 needed"), std::string::npos) << e.what();
   }
-  // a wall-bounded shear has no Lees-Edwards images to unwrap: refused
+  // a run that is not sheared: refused; a walls run needs its cell_width
+  // (the period its displacements are unwrapped by)
+  const auto still = cdtest::scratch_dir("test_analysis_3d", "profile_none");
+  write_profile_run(still, {1.0, 2.0}, {false, false});
+  std::ofstream(still / "scene.toml") << "dimension = 3\n[shear]\nmode = \"none\"\n";
+  try {
+    const auto sn = read_series(still.string());
+    shear_profile(still.string(), sn, "strain", strain_window(sn, 0.5, 5), 5);
+    ADD_FAILURE() << "mode none: accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_NE(std::string(e.what()).find("mode is 'none'"), std::string::npos) << e.what();
+  }
   const auto walls = cdtest::scratch_dir("test_analysis_3d", "profile_walls");
   write_profile_run(walls, {1.0, 2.0}, {false, false});
   std::ofstream(walls / "scene.toml") << "dimension = 3\n[shear]\nmode = \"walls\"\n";
   try {
     const auto sw = read_series(walls.string());
     shear_profile(walls.string(), sw, "strain", strain_window(sw, 0.5, 5), 5);
-    ADD_FAILURE() << "walls: accepted";
+    ADD_FAILURE() << "walls without cell_width: accepted";
   } catch (const AnalysisError& e) {
-    EXPECT_NE(std::string(e.what()).find("mode is 'walls'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cell_width"), std::string::npos) << e.what();
   }
   // the command: banded runs are named, homogeneous ones not
   const auto plug = cdtest::scratch_dir("test_analysis_3d", "profile_cli_plug");
@@ -1351,6 +1362,91 @@ TEST(ShearProfile, RefusesWhatItCannotMeasure) {
   EXPECT_EQ(rh.out.find("banded"), std::string::npos) << rh.out;
   const auto bad = cdtest::run_command(fmt::format("{} profile {} --layers 1", exe.string(), ok.string()));
   EXPECT_NE(bad.code, 0) << bad.out;
+}
+
+// A 2D walls-protocol run for shear_profile: series.csv (time, strain,
+// shear_rate = kGd, cell_height = cell_width = kL0, q_over_p) and particles_NNNNN.vtp
+// at the given strains: 5 layers of the gap [0, L] of 40 particles each,
+// placed symmetrically about the layer's centre, every particle at
+// x = x0 + strain f(y) folded into the period [0, W) (so the unwrapping is
+// exercised), written in reverse order in odd snapshots (matched by id).
+// f(y) = y: a homogeneous shear; banded: all the shear in the first layer
+// (f = 5 y below L/5, L above: the rest moves with the top wall).
+void write_walls_profile_run(const fs::path& dir, const std::vector<double>& strains, bool banded) {
+  fs::create_directories(dir);
+  std::ofstream csv(dir / "series.csv");
+  csv << "step,time,strain,shear_rate,cell_height,cell_width,q_over_p\n";
+  for (int i = 0; i <= 500; ++i)
+    csv << fmt::format("{},{:.10g},{:.10g},{},{:.10g},{:.10g},0.4\n", i, 0.01 * i / kGd, 0.01 * i, kGd, kL0, kL0);
+  std::ofstream(dir / "scene.toml") << "dimension = 2\n[shear]\nmode = \"walls\"\n";
+  const double L = kL0, W = kL0;
+  const auto f = [&](double y) { return banded ? (y < 0.2 * L ? 5 * y : L) : y; };
+  std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+  for (std::size_t k = 0; k < strains.size(); ++k) {
+    ParticleSet ps;
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 40; ++j) {
+        Particle p;
+        p.id = static_cast<int>(ps.size());
+        p.radius = 1e-4;
+        p.nsides = 0;
+        p.y = (i + (j + 0.5) / 40) * L / 5;
+        p.x = std::fmod(W * j / 40 + strains[k] * f(p.y), W);
+        ps.push_back(p);
+      }
+    if (k % 2 == 1) std::reverse(ps.begin(), ps.end());
+    write_particles((dir / fmt::format("particles_{:05d}.vtp", k)).string(), ps);
+    pvd += fmt::format("    <DataSet timestep=\"{:.17g}\" group=\"\" part=\"0\" file=\"particles_{:05d}.vtp\"/>\n",
+                       strains[k] / kGd, k);
+  }
+  std::ofstream(dir / "particles.pvd") << pvd + "  </Collection>\n</VTKFile>\n";
+}
+
+TEST(ShearProfile, WallsProtocolFromTheDisplacementsBetweenSnapshots) {
+  // homogeneous: 1 in the 6 gaps (the two at the walls half a layer wide)
+  // and in the bulk, whatever the folding into the period and the order
+  const auto dir = cdtest::scratch_dir("test_analysis_3d", "profile_walls_homog");
+  write_walls_profile_run(dir, {1.0, 1.2, 1.4, 1.6}, false);
+  const auto series = read_series(dir.string());
+  const auto pr = shear_profile(dir.string(), series, "strain", strain_window(series, 0.5, 5), 5);
+  ASSERT_TRUE(pr.walls);
+  ASSERT_EQ(pr.snapshots, 4u);
+  ASSERT_EQ(pr.rate.size(), 6u);
+  for (const auto& r : pr.rate) EXPECT_NEAR(r.v, 1.0, 1e-9);  // round-off of the folded positions
+  EXPECT_NEAR(pr.rate_min.v, 1.0, 1e-9);
+  EXPECT_NEAR(pr.bulk_rate.v, 1.0, 1e-9);
+
+  // all the shear in the first layer: by hand, its mean displacement over
+  // the imposed strain is 5 (L/10) = L/2, the other layers' L, so the
+  // wall-0 gap gives (L/2) / (L/10) = 5 (a homogeneous shear: L/10 over the
+  // half layer), gap 0-1 (L - L/2) / (L/5) = 2.5 and the rest 0 (5/2 + 2.5
+  // = 5 layers); the bulk moves rigidly: 0
+  const auto band = cdtest::scratch_dir("test_analysis_3d", "profile_walls_band");
+  write_walls_profile_run(band, {1.0, 1.2, 1.4}, true);
+  const auto sb = read_series(band.string());
+  const auto pb = shear_profile(band.string(), sb, "strain", strain_window(sb, 0.5, 5), 5);
+  const double want[6] = {5, 2.5, 0, 0, 0, 0};
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(pb.rate[i].v, want[i], 1e-9) << "gap " << i;
+  EXPECT_NEAR(pb.bulk_rate.v, 0.0, 1e-9);
+  EXPECT_NEAR(pb.max_rate.v, 5.0, 1e-9);
+  EXPECT_TRUE(is_banded(pb.rate_min.v));
+
+  // snapshots so far apart that the top wall moved a whole period: refused
+  const auto far = cdtest::scratch_dir("test_analysis_3d", "profile_walls_far");
+  write_walls_profile_run(far, {1.0, 2.0}, false);
+  const auto sf = read_series(far.string());
+  try {
+    shear_profile(far.string(), sf, "strain", strain_window(sf, 0.5, 5), 5);
+    ADD_FAILURE() << "unwrappable displacements: accepted";
+  } catch (const AnalysisError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot be unwrapped"), std::string::npos) << e.what();
+  }
+  // the command prints the bulk's rate
+  const auto r = cdtest::run_command(fmt::format("{} profile {} --window 0.5:5", exe.string(), band.string()));
+  EXPECT_EQ(r.code, 0) << r.out;
+  const auto at = r.out.find("bulk_rate");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_NEAR(std::stod(r.out.substr(at + 9)), 0.0, 1e-3) << r.out;
 }
 
 TEST(ShearProfile, ReportFlagsBandedRuns) {

@@ -22,7 +22,7 @@ namespace {
 const Command kCommands[] = {
     {"steady", "steady-state mean and error bar of one series column", cli::steady},
     {"fabric", "anisotropies, stress and connectivity of a contact snapshot", cli::fabric},
-    {"profile", "is the shear homogeneous? local shear rate across the layers of a periodic shear run, over its "
+    {"profile", "is the shear homogeneous? local shear rate across the layers of a shear run (periodic or walls), over its "
                 "steady window (run.hpp shear_profile)",
      cli::profile},
     // "fit" (the group below) comes here in --help

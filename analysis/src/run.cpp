@@ -335,6 +335,88 @@ WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& ser
   return ws;
 }
 
+namespace {
+
+// The walls protocol's profile (shear_profile): from the displacements of
+// the particles between consecutive snapshots of the window, the mean
+// velocity over each interval, far less noisy than one instant's. With D
+// the imposed strain of the interval (the mean of gd at its ends times its
+// duration), u = dx / D is y for a homogeneous shear, 0 on the bottom wall
+// and L at the top one.
+ShearProfile walls_profile(const std::vector<std::string>& files, const WindowSnapshots& ws, const Table& series,
+                           int layers) {
+  if (!series.has("cell_width"))
+    throw AnalysisError(fmt::format("'{}' has no cell_width column: not a walls shear run", series.source()));
+  ShearProfile pr;
+  pr.layers = layers;
+  pr.walls = true;
+  const auto n = static_cast<std::size_t>(layers);
+  std::vector<std::vector<double>> per(n + 1);
+  std::vector<double> maxima, bulk;
+  std::map<int, std::pair<double, double>> before;  // id -> (x, y) at the previous snapshot
+  for (std::size_t j = 0; j < ws.index.size(); ++j) {
+    const auto& file = files[static_cast<std::size_t>(ws.index[j])];
+    const ParticleSet ps = read_particles(file);
+    if (j > 0) {
+      const double t0 = ws.time[j - 1], t1 = ws.time[j], tm = 0.5 * (t0 + t1);
+      const double L = x_at_time(series, "cell_height", tm), W = x_at_time(series, "cell_width", tm);
+      const double D = 0.5 * (x_at_time(series, "shear_rate", t0) + x_at_time(series, "shear_rate", t1)) * (t1 - t0);
+      if (!(L > 0) || !(W > 0) || !(D > 0))
+        throw AnalysisError(fmt::format("'{}': cell_height {}, cell_width {} and imposed strain {} since the last "
+                                        "snapshot give no shear profile", file, L, W, D));
+      if (D * L > 0.5 * W)
+        throw AnalysisError(fmt::format("'{}': the top wall moved {:.3g} periods since the last snapshot (more than "
+                                        "half): the displacements cannot be unwrapped; snapshots closer in strain "
+                                        "are needed", file, D * L / W));
+      std::vector<double> sum(n, 0.0);
+      std::vector<std::size_t> count(n, 0);
+      double sy = 0, su = 0, syy = 0, syu = 0, nb = 0;  // the central half's least squares
+      for (const Particle& p : ps) {
+        const auto it = before.find(p.id);
+        if (it == before.end()) continue;
+        double dx = p.x - it->second.first;
+        dx -= W * std::round(dx / W);  // periodic along x
+        const double y = 0.5 * (p.y + it->second.second), u = dx / D;
+        const auto b = std::min(n - 1, static_cast<std::size_t>(std::max(0.0, y / L * static_cast<double>(n))));
+        sum[b] += u;
+        ++count[b];
+        if (y >= 0.25 * L && y < 0.75 * L) sy += y, su += u, syy += y * y, syu += y * u, nb += 1;
+      }
+      std::vector<double> v(n);  // the layers' mean u
+      for (std::size_t b = 0; b < n; ++b) {
+        if (count[b] == 0) throw AnalysisError(fmt::format("'{}': layer {} of {} holds no particle", file, b, n));
+        v[b] = sum[b] / static_cast<double>(count[b]);
+      }
+      const double h = L / static_cast<double>(n);  // a layer's thickness: u steps by h in a homogeneous shear
+      double most = -std::numeric_limits<double>::infinity();
+      const auto gap = [&](std::size_t i, double du, double width) {
+        per[i].push_back(du / (width * h));
+        most = std::max(most, per[i].back());
+      };
+      gap(0, v[0], 0.5);  // the bottom wall's grains, at rest, half a layer below layer 0's centre
+      for (std::size_t i = 1; i < n; ++i) gap(i, v[i] - v[i - 1], 1.0);
+      gap(n, L - v[n - 1], 0.5);  // to the top wall's grains
+      maxima.push_back(most);
+      const double var = syy - sy * sy / std::max(nb, 1.0);
+      if (nb < 2 || !(var > 0))
+        throw AnalysisError(fmt::format("'{}': {} particles in the central half of the gap, 2 at distinct heights "
+                                        "needed", file, nb));
+      bulk.push_back((syu - sy * su / nb) / var);
+    }
+    before.clear();
+    for (const Particle& p : ps) before[p.id] = {p.x, p.y};
+    pr.x.push_back(ws.x[j]);
+  }
+  pr.snapshots = ws.index.size();
+  for (const auto& v : per) pr.rate.push_back(mean_sem(v));
+  pr.rate_min = *std::min_element(pr.rate.begin(), pr.rate.end(), [](const Val& a, const Val& b) { return a.v < b.v; });
+  pr.max_rate = mean_sem(maxima);
+  pr.bulk_rate = mean_sem(bulk);
+  return pr;
+}
+
+}  // namespace
+
 ShearProfile shear_profile(const std::string& run_dir, const Table& series, const std::string& x_column,
                            const Window& w, int layers) {
   if (layers < 2) throw AnalysisError(fmt::format("profile: {} layers, 2 or more needed", layers));
@@ -342,9 +424,10 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
     if (!series.has(c))
       throw AnalysisError(fmt::format("'{}' has no {} column: not a periodic shear run", series.source(), c));
   const auto scene = read_scene_info(run_dir);
-  if (scene.shear_mode && *scene.shear_mode != "periodic")
+  const bool walls = scene.shear_mode && *scene.shear_mode == "walls";
+  if (scene.shear_mode && !walls && *scene.shear_mode != "periodic")
     throw AnalysisError(fmt::format("'{}': [shear] mode is '{}': the shear profile needs a periodic (Lees-Edwards) "
-                                    "cell", scene.file, *scene.shear_mode));
+                                    "cell or the walls protocol", scene.file, *scene.shear_mode));
   const std::string prefix = particles_prefix(scene.dimension);
   const auto ws = snapshots_in_window(run_dir, series, x_column, w, prefix);
   if (!ws.problem.empty()) throw AnalysisError(ws.problem);
@@ -352,6 +435,7 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
     throw AnalysisError(fmt::format("'{}': {} of its {} {} snapshots in the window {:.4g}–{:.4g}, 2 needed", run_dir,
                                     ws.index.size(), ws.total, prefix, w.x_begin, w.x_end));
   const auto files = list_snapshots(run_dir, prefix);
+  if (walls) return walls_profile(files, ws, series, layers);
   ShearProfile pr;
   pr.layers = layers;
   const auto n = static_cast<std::size_t>(layers);

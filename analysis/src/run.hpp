@@ -151,30 +151,53 @@ WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& ser
                                     const std::string& prefix = "contacts");
 
 // Is the shear homogeneous? The profile of the local shear rate across the
-// gradient direction y of a periodic (Lees-Edwards) shear run, from the
-// particle snapshots (particles_/spheres_NNNNN.vtp) in the window w. Each
-// snapshot's particles are brought into one period [0, L_y) of the images
-// (y - k L_y with velocity v_x - k gd L_y, k = floor(y/L_y): the Lees-Edwards
-// image of the particle, so nothing depends on where the cell's origin is),
-// L_y and gd the series' cell_height and shear_rate at the snapshot's time
-// (interpolated); sorted into `layers` equal layers, whose mean v_x give
-// the rate of each gap between neighbouring layer centres, the last across
-// the periodic boundary (+ gd L_y):
-//   s_i = (v_{i+1} - v_i) / (gd L_y / layers),   sum_i s_i = layers exactly,
-// so s = 1 in every gap for a homogeneous shear, and a layer moving as a
+// gradient direction y of a shear run, from the particle snapshots
+// (particles_/spheres_NNNNN.vtp) in the window w, L_y and gd the series'
+// cell_height and shear_rate at the snapshot's time (interpolated).
+// Periodic (Lees-Edwards) cell: each snapshot's particles are brought into
+// one period [0, L_y) of the images (y - k L_y with velocity v_x - k gd L_y,
+// k = floor(y/L_y): the Lees-Edwards image of the particle, so nothing
+// depends on where the cell's origin is), sorted into `layers` equal
+// layers, whose mean v_x give the rate of each gap between neighbouring
+// layer centres, the last across the periodic boundary (+ gd L_y):
+//   s_i = (v_{i+1} - v_i) / (gd L_y / layers),   sum_i s_i = layers exactly.
+// Walls protocol (shear mode walls): [0, L_y] is the gap between the wall
+// grains' centres, the bottom row at rest, the top row at v_x = gd L_y.
+// The profile is that of the mean velocity over each interval between
+// consecutive snapshots of the window (the particles' displacements,
+// periodic along x, over the interval's imposed strain: far less noisy than
+// one instant's velocities; the top wall may move at most half the period
+// between them), so its samples are the intervals, not the snapshots; the
+// `layers` equal layers of the gap give layers + 1 gaps: from the bottom
+// wall (at rest, y = 0) to the first layer's centre and from the last
+// layer's centre to the top wall (y = L_y), each half a layer wide, and the
+// layers - 1 between centres, so that
+//   s_0/2 + s_1 + ... + s_{layers-1} + s_layers/2 = layers exactly
+// (grains slipping on a wall show as a rate above 1 in its gap). Either
+// way s = 1 in every gap for a homogeneous shear, and a layer moving as a
 // rigid plug gives s near 0 on both sides of it. rate: each gap's s, mean
 // +- sem over the snapshots; rate_min: the smallest of those means (with
 // its sem), the plug indicator; max_rate: the per-snapshot max of s, mean
-// +- sem (a band that wanders between snapshots still shows there). The
+// +- sem (a band that wanders between snapshots still shows there);
+// bulk_rate (walls only, else nan): the rate of the central half of the
+// gap, [L_y/4, 3L_y/4) (the walls protocol's bulk, docs/shear.md): the
+// least-squares slope of the displacement against y over the particles
+// whose centre is in it, / the imposed strain, mean +- sem over the
+// intervals (1: the bulk shears at the imposed rate; it does not depend on
+// `layers`). The
 // per-snapshot noise of s is about sqrt(layers/n) times the particles'
 // velocity fluctuation in units of gd L_y / layers. Throws AnalysisError
-// when the scene's [shear] mode is not periodic (walls: no Lees-Edwards
-// images), the series lacks cell_height, shear_rate or time, no particle snapshot of the window can be placed (2 needed), or
-// layers < 2 or a layer is empty.
+// when the scene's [shear] mode is neither periodic nor walls, the series
+// lacks cell_height, shear_rate or time (walls: cell_width), no particle
+// snapshot of the window can be placed (2 needed), or layers < 2 or a layer
+// is empty.
 struct ShearProfile {
   int layers = 0;
-  std::vector<Val> rate;  // per gap i (between layers i and i+1; the last: across the boundary)
+  bool walls = false;
+  std::vector<Val> rate;  // per gap (periodic: i between layers i and i+1, the last across the boundary;
+                          // walls: bottom wall-0, i-1 to i, last layer-top wall)
   Val rate_min, max_rate;
+  Val bulk_rate;          // walls: the central half's rate / gd; periodic: nan
   std::size_t snapshots = 0;
   std::vector<double> x;  // each snapshot's x (the window's column)
 };
