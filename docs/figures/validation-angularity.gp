@@ -11,9 +11,17 @@
 #   tests/data/validation/angularity-periodic.csv (`make validate-angularity`,
 #     its columns those of `cdanalysis fit angularity`):
 #     N = 1000, d_max/d_min = 4, I = 1e-3, window 1-3; one row per finished
-#     shape, so the figure grows as the campaign's rows are added.
+#     shape, so the figure grows as the campaign's rows are added; with the
+#     fit stored beside it (angularity-periodic-fits.toml, read here) and
+#     the same grains between rough walls (angularity-walls.csv: the bulk's
+#     q/p and packing fraction under the names mu and nu).
 if (!exists("study")) study = 'docs/figures/angularity.csv'
 if (!exists("val")) val = 'tests/data/validation/angularity-periodic.csv'
+if (!exists("walls")) walls = 'tests/data/validation/angularity-walls.csv'
+if (!exists("fits")) fits = 'tests/data/validation/angularity-periodic-fits.toml'
+# a parameter's value from the fits' TOML: the "value" line of [mu_alpha.params.<name>]
+param(name) = real(system(sprintf("awk '/^\\[mu_alpha.params.%s\\]/{f=1} f && /^value/{print $3; exit}' %s", name, fits)))
+v0 = param("mu0"); v1 = param("mu1"); vc = param("alpha_c")
 if (!exists("out")) out = 'docs/figures/validation-angularity.png'
 set datafile separator ","
 set datafile columnheaders
@@ -29,16 +37,19 @@ set x2tics font ",10"
 set multiplot layout 1,3
 set ylabel "μ* = q/p"
 set yrange [0.25:0.55]
-set key top left
+set key bottom right font ",10"
 mu0 = 0.296; mu1 = 0.480; ac = 1.16
 plot mu0 + (mu1 - mu0)*(1 - exp(-x/ac)) with lines lw 2 lc rgb '#1f3b73' title 'fit, N = 300, I = 0.01', \
+     v0 + (v1 - v0)*(1 - exp(-x/vc)) with lines lw 2 dt 2 lc rgb '#b03a2e' title 'fit, N = 1000, periodic', \
      study using (column("alpha")):(column("mu")):(column("mu_err")) with yerrorbars pt 7 ps 1.2 lc rgb 'black' title 'N = 300, r = 2, I = 0.01', \
-     val using (column("alpha")):(column("mu")):(column("mu_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}'
+     val using (column("alpha")):(column("mu")):(column("mu_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}, periodic', \
+     walls using (column("alpha")+0.02):(column("mu")):(column("mu_err")) with yerrorbars pt 4 ps 1.4 lc rgb '#2e7d32' title 'the same, walls (bulk)'
 set ylabel "packing fraction φ"
 set yrange [0.77:0.83]
-set key top right
+set key bottom left font ",10"
 plot study using (column("alpha")):(column("nu")):(column("nu_err")) with yerrorbars pt 7 ps 1.2 lc rgb 'black' title 'N = 300, r = 2, I = 0.01', \
-     val using (column("alpha")):(column("nu")):(column("nu_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}'
+     val using (column("alpha")):(column("nu")):(column("nu_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}, periodic', \
+     walls using (column("alpha")+0.02):(column("nu")):(column("nu_err")) with yerrorbars pt 4 ps 1.4 lc rgb '#2e7d32' title 'the same, walls (bulk)'
 set ylabel "anisotropy (black, blue, red: N = 300; open: N = 1000)"
 set yrange [0:0.6]
 set key top left
