@@ -337,6 +337,14 @@ WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& ser
 
 namespace {
 
+// A profile's rates from their samples (per gap, and each sample's largest
+// gap rate): each gap's mean +- sem, the slowest gap's, and max_rate.
+void set_rates(ShearProfile& pr, const std::vector<std::vector<double>>& per, const std::vector<double>& maxima) {
+  for (const auto& v : per) pr.rate.push_back(mean_sem(v));
+  pr.rate_min = *std::min_element(pr.rate.begin(), pr.rate.end(), [](const Val& a, const Val& b) { return a.v < b.v; });
+  pr.max_rate = mean_sem(maxima);
+}
+
 // The walls protocol's profile (shear_profile): from the displacements of
 // the particles between consecutive snapshots of the window, the mean
 // velocity over each interval, far less noisy than one instant's. With D
@@ -408,9 +416,7 @@ ShearProfile walls_profile(const std::vector<std::string>& files, const WindowSn
     pr.x.push_back(ws.x[j]);
   }
   pr.snapshots = ws.index.size();
-  for (const auto& v : per) pr.rate.push_back(mean_sem(v));
-  pr.rate_min = *std::min_element(pr.rate.begin(), pr.rate.end(), [](const Val& a, const Val& b) { return a.v < b.v; });
-  pr.max_rate = mean_sem(maxima);
+  set_rates(pr, per, maxima);
   pr.bulk_rate = mean_sem(bulk);
   return pr;
 }
@@ -422,7 +428,7 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
   if (layers < 2) throw AnalysisError(fmt::format("profile: {} layers, 2 or more needed", layers));
   for (const char* c : {"time", "cell_height", "shear_rate"})
     if (!series.has(c))
-      throw AnalysisError(fmt::format("'{}' has no {} column: not a periodic shear run", series.source(), c));
+      throw AnalysisError(fmt::format("'{}' has no {} column: not a shear run", series.source(), c));
   const auto scene = read_scene_info(run_dir);
   const bool walls = scene.shear_mode && *scene.shear_mode == "walls";
   if (scene.shear_mode && !walls && *scene.shear_mode != "periodic")
@@ -473,9 +479,7 @@ ShearProfile shear_profile(const std::string& run_dir, const Table& series, cons
     pr.x.push_back(ws.x[j]);
   }
   pr.snapshots = maxima.size();
-  for (const auto& v : per) pr.rate.push_back(mean_sem(v));
-  pr.rate_min = *std::min_element(pr.rate.begin(), pr.rate.end(), [](const Val& a, const Val& b) { return a.v < b.v; });
-  pr.max_rate = mean_sem(maxima);
+  set_rates(pr, per, maxima);
   return pr;
 }
 

@@ -31,13 +31,10 @@ Handler profile(CLI::App& sub) {
     const auto& w = r.stats.window;
     const auto pr = shear_profile(o->run, series, x, w, layers);
     fmt::print("window     {} {:.4g} to {:.4g}: {} particle snapshots\n", x, w.x_begin, w.x_end, pr.snapshots);
-    if (pr.walls)
+    if (pr.walls) {
       fmt::print("local shear rate / imposed rate between layer centres (1: homogeneous), from the displacements "
                  "over each of the {} intervals between them, mean +- sem:\n",
                  pr.snapshots - 1);
-    else
-      fmt::print("local shear rate / mean rate between layer centres (1: homogeneous), mean +- sem over them:\n");
-    if (pr.walls) {
       const auto name = [&](int i) { return i == 0 ? std::string("wall") : std::to_string(i - 1); };
       for (int i = 0; i <= layers; ++i)
         fmt::print("  gap {:>4}-{:<4} {:.3f} +- {:.3f}{}\n", name(i), i == layers ? std::string("wall") : name(i + 1),
@@ -45,6 +42,7 @@ Handler profile(CLI::App& sub) {
                    i == 0 ? "  (the bottom wall's grains to layer 0's centre)"
                           : (i == layers ? "  (to the top wall's grains)" : ""));
     } else {
+      fmt::print("local shear rate / mean rate between layer centres (1: homogeneous), mean +- sem over them:\n");
       for (int i = 0; i < layers; ++i)
         fmt::print("  gap {:>3}-{:<3} {:.3f} +- {:.3f}{}\n", i, (i + 1) % layers, pr.rate[i].v, pr.rate[i].err,
                    i + 1 == layers ? "  (across the periodic boundary)" : "");
