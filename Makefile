@@ -144,6 +144,7 @@ help:
 	$(call help_var,VAL_NS,its shapes (polygon sides; 0: disks))
 	$(call help_var,VAL_I,its inertial number)
 	$(call help_var,VAL_STRAIN,its strain)
+	$(call help_var,VAL_SEED,its samples' random seed)
 	$(call help_var,PRESSURE_P,pressures of campaign-pressure[-ladder])
 	$(call help_var,PRESSURE_I,their inertial number)
 	$(call help_var,VOLUME_PHI,packing fractions of campaign-volume (defaults below jamming: 2D or 3D))
@@ -673,8 +674,12 @@ VAL_N ?= 1000
 VAL_NS ?= 0 6 3 4 5 7 8 10 12 20 60
 VAL_I ?= 0.001
 VAL_STRAIN ?= 3
+# VAL_SEED: another sample of the same protocol (the sizes and positions'
+# random seed; 1, the committed tables', adds no setting).
+VAL_SEED ?= 1
 val_vars = CAMPAIGNS=$(VALIDATE) DIM=2 N=$(VAL_N) SIZE_RATIO=4 SIZE_DIST=uniform_area STRAIN=$(VAL_STRAIN) \
-  ANGULAR_NS="$(VAL_NS)" ANGULAR_I=$(VAL_I) SHEAR_TOL= SHEAR_SET= PREP_SET=
+  ANGULAR_NS="$(VAL_NS)" ANGULAR_I=$(VAL_I) SHEAR_TOL= SHEAR_SET= \
+  PREP_SET="$(if $(filter-out 1,$(VAL_SEED)),--set particles.seed=$(VAL_SEED))"
 .PHONY: validate-angularity validate-angularity-walls
 validate-angularity: programs
 	+$(MAKE) --no-print-directory $(val_vars) campaign-angularity
