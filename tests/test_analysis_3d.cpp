@@ -1282,6 +1282,7 @@ TEST(ShearProfile, HomogeneousShearGivesOneInEveryGapWhateverTheImages) {
   EXPECT_NEAR(pr.rate_min.v, 1.0, 1e-9);
   EXPECT_NEAR(pr.max_rate.v, 1.0, 1e-9);
   EXPECT_NEAR(pr.x.front(), 1.3, 1e-9);
+  EXPECT_TRUE(std::isnan(pr.bulk_rate.v) && std::isnan(pr.bulk_phi.v));  // the walls' bulk only
 }
 
 TEST(ShearProfile, RigidPlugGivesTheHandComputedRates) {
@@ -1364,6 +1365,43 @@ TEST(ShearProfile, RefusesWhatItCannotMeasure) {
   EXPECT_NE(bad.code, 0) << bad.out;
 }
 
+TEST(BandArea, DisksAndPolygonsByHand) {
+  // A disk: whole, half (the band's edge through its centre), and the slab
+  // |y - y_c| < h: 2 (h sqrt(r^2 - h^2) + r^2 asin(h / r)).
+  Particle d;
+  d.x = 0.3, d.y = 2.0, d.radius = 0.5, d.nsides = 0;
+  const double pi = std::numbers::pi, r = 0.5, h = 0.2;
+  EXPECT_NEAR(area_in_band(d, 1.0, 3.0), pi * r * r, 1e-14);
+  EXPECT_NEAR(area_in_band(d, 2.0, 3.0), 0.5 * pi * r * r, 1e-14);
+  EXPECT_NEAR(area_in_band(d, 2.0 - h, 2.0 + h), 2 * (h * std::sqrt(r * r - h * h) + r * r * std::asin(h / r)), 1e-14);
+  EXPECT_EQ(area_in_band(d, 2.6, 3.0), 0.0);
+  d.nsides = -1;  // a snapshot without nsides: disks
+  EXPECT_NEAR(area_in_band(d, 2.0, 3.0), 0.5 * pi * r * r, 1e-14);
+  // A square with horizontal sides (angle pi/4: side R sqrt 2) cut through
+  // its centre: R^2 of its 2 R^2; a band 0.1 R thick inside it: its width
+  // R sqrt 2 times 0.1 R.
+  Particle s;
+  s.y = 1.0, s.radius = 2.0, s.nsides = 4, s.angle = pi / 4;
+  EXPECT_NEAR(area_in_band(s, 1.0, 9.0), 4.0, 1e-12);
+  EXPECT_NEAR(area_in_band(s, 0.5, 0.7), 2.0 * std::sqrt(2.0) * 0.2, 1e-12);
+  // A triangle, apex up (angle pi/2): its height is 1.5 R, the part above
+  // its centre a similar triangle of height R, (R / 1.5 R)^2 = 4/9 of its
+  // area 3 sqrt(3) R^2 / 4.
+  Particle t;
+  t.x = -1.0, t.y = 0.0, t.radius = 1.0, t.nsides = 3, t.angle = pi / 2;
+  EXPECT_NEAR(area_in_band(t, 0.0, 5.0), 4.0 / 9.0 * 3 * std::sqrt(3.0) / 4, 1e-12);
+  // Any shape and orientation: the bands of a tiling of the heights sum to
+  // the grain's area (what counting whole grains by their centre does not do
+  // band by band).
+  for (const int n : {0, 3, 5, 7, 20, 60}) {
+    Particle p;
+    p.x = 0.1, p.y = 0.37, p.radius = 0.8, p.nsides = n, p.angle = 0.3 + 0.1 * n;
+    double sum = 0;
+    for (int k = -10; k < 10; ++k) sum += area_in_band(p, 0.13 * k, 0.13 * (k + 1));
+    EXPECT_NEAR(sum, cd::obs::particle_area(0.8, n), 1e-12) << n << " sides";
+  }
+}
+
 // A 2D walls-protocol run for shear_profile: series.csv (time, strain,
 // shear_rate = kGd, cell_height = cell_width = kL0, q_over_p) and particles_NNNNN.vtp
 // at the given strains: 5 layers of the gap [0, L] of 40 particles each,
@@ -1415,6 +1453,16 @@ TEST(ShearProfile, WallsProtocolFromTheDisplacementsBetweenSnapshots) {
   for (const auto& r : pr.rate) EXPECT_NEAR(r.v, 1.0, 1e-9);  // round-off of the folded positions
   EXPECT_NEAR(pr.rate_min.v, 1.0, 1e-9);
   EXPECT_NEAR(pr.bulk_rate.v, 1.0, 1e-9);
+  // the bulk's packing fraction: the 200 centres are evenly spaced 5e-5
+  // apart in y, 100 of them in the band [L/4, 3L/4), whose edges fall
+  // midway between two centres: the disks cut by an edge pair up (at +-d),
+  // what one leaves out the other brings in, so the area in the band is
+  // 100 disks' by either count: 100 pi r^2 / (W L / 2), the same in every
+  // snapshot
+  const double phi = 100 * std::numbers::pi * 1e-8 / (kL0 * 0.5 * kL0);
+  EXPECT_NEAR(pr.bulk_phi.v, phi, 1e-12);
+  EXPECT_NEAR(pr.bulk_phi.err, 0.0, 1e-12);
+  EXPECT_NEAR(pr.bulk_phi_centres.v, phi, 1e-12);
 
   // all the shear in the first layer: by hand, its mean displacement over
   // the imposed strain is 5 (L/10) = L/2, the other layers' L, so the
@@ -1447,6 +1495,9 @@ TEST(ShearProfile, WallsProtocolFromTheDisplacementsBetweenSnapshots) {
   const auto at = r.out.find("bulk_rate");
   ASSERT_NE(at, std::string::npos) << r.out;
   EXPECT_NEAR(std::stod(r.out.substr(at + 9)), 0.0, 1e-3) << r.out;
+  const auto phi_at = r.out.find("bulk_phi");
+  ASSERT_NE(phi_at, std::string::npos) << r.out;
+  EXPECT_NEAR(std::stod(r.out.substr(phi_at + 8)), 100 * std::numbers::pi * 1e-8 / (0.5 * kL0 * kL0), 1e-4) << r.out;
 }
 
 TEST(ShearProfile, ReportFlagsBandedRuns) {

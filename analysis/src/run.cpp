@@ -360,11 +360,24 @@ ShearProfile walls_profile(const std::vector<std::string>& files, const WindowSn
   pr.walls = true;
   const auto n = static_cast<std::size_t>(layers);
   std::vector<std::vector<double>> per(n + 1);
-  std::vector<double> maxima, bulk;
+  std::vector<double> maxima, bulk, phi, phi_centres;
   std::map<int, std::pair<double, double>> before;  // id -> (x, y) at the previous snapshot
   for (std::size_t j = 0; j < ws.index.size(); ++j) {
     const auto& file = files[static_cast<std::size_t>(ws.index[j])];
     const ParticleSet ps = read_particles(file);
+    {
+      const double L = x_at_time(series, "cell_height", ws.time[j]), W = x_at_time(series, "cell_width", ws.time[j]);
+      if (!(L > 0) || !(W > 0))
+        throw AnalysisError(fmt::format("'{}': cell_height {} and cell_width {} give no packing fraction", file, L, W));
+      const double lo = 0.25 * L, hi = 0.75 * L;  // cdsim's bulk band (docs/shear.md)
+      double clipped = 0, whole = 0;
+      for (const Particle& p : ps) {
+        clipped += area_in_band(p, lo, hi);
+        if (p.y >= lo && p.y < hi) whole += cd::obs::particle_area(p.radius, std::max(p.nsides, 0));
+      }
+      phi.push_back(clipped / (W * (hi - lo)));
+      phi_centres.push_back(whole / (W * (hi - lo)));
+    }
     if (j > 0) {
       const double t0 = ws.time[j - 1], t1 = ws.time[j], tm = 0.5 * (t0 + t1);
       const double L = x_at_time(series, "cell_height", tm), W = x_at_time(series, "cell_width", tm);
@@ -418,6 +431,8 @@ ShearProfile walls_profile(const std::vector<std::string>& files, const WindowSn
   pr.snapshots = ws.index.size();
   set_rates(pr, per, maxima);
   pr.bulk_rate = mean_sem(bulk);
+  pr.bulk_phi = mean_sem(phi);
+  pr.bulk_phi_centres = mean_sem(phi_centres);
   return pr;
 }
 

@@ -184,7 +184,12 @@ WindowSnapshots snapshots_in_window(const std::string& run_dir, const Table& ser
 // least-squares slope of the displacement against y over the particles
 // whose centre is in it, / the imposed strain, mean +- sem over the
 // intervals (1: the bulk shears at the imposed rate; it does not depend on
-// `layers`). The
+// `layers`); bulk_phi (walls only): the central half's packing fraction,
+// each particle's area in it (area_in_band) over W L_y / 2, mean +- sem
+// over the snapshots, and bulk_phi_centres the same counting whole
+// particles by their centre (cdsim's series column
+// bulk_packing_fraction), whose error bar the grains cut by the band's
+// edges widen. The
 // per-snapshot noise of s is about sqrt(layers/n) times the particles'
 // velocity fluctuation in units of gd L_y / layers. Throws AnalysisError
 // when the scene's [shear] mode is neither periodic nor walls, the series
@@ -198,6 +203,7 @@ struct ShearProfile {
                           // walls: bottom wall-0, i-1 to i, last layer-top wall)
   Val rate_min, max_rate;
   Val bulk_rate;          // walls: the central half's rate / gd; periodic: nan
+  Val bulk_phi, bulk_phi_centres;  // walls: the central half's packing fraction; periodic: nan
   std::size_t snapshots = 0;
   std::vector<double> x;  // each snapshot's x (the window's column)
 };

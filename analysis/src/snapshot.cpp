@@ -16,9 +16,11 @@
 #include <vtkXMLPolyDataWriter.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <regex>
 
 namespace fs = std::filesystem;
@@ -100,6 +102,46 @@ ContactSet3 merge_points3(const ContactSet3& cs) {
     m.status = std::max(m.status, c.status);
   }
   return out;
+}
+
+double area_in_band(const Particle& p, double lo, double hi) {
+  if (!(hi > lo)) return 0.0;
+  const double r = p.radius;
+  if (p.nsides <= 0) {
+    // the disk's area below the height t above its centre
+    const auto below = [r](double t) {
+      const double u = std::clamp(t / r, -1.0, 1.0);
+      return r * r * (std::asin(u) + u * std::sqrt(1.0 - u * u) + 0.5 * std::numbers::pi);
+    };
+    return below(hi - p.y) - below(lo - p.y);
+  }
+  std::vector<std::array<double, 2>> poly;
+  for (int k = 0; k < p.nsides; ++k) {
+    const double a = p.angle + 2.0 * std::numbers::pi * k / p.nsides;
+    poly.push_back({p.x + r * std::cos(a), p.y + r * std::sin(a)});
+  }
+  // Sutherland-Hodgman against y >= lo, then y <= hi (sign -1)
+  for (const auto& [h, sign] : {std::pair{lo, 1.0}, std::pair{hi, -1.0}}) {
+    std::vector<std::array<double, 2>> out;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const auto& a = poly[i];
+      const auto& b = poly[(i + 1) % poly.size()];
+      const double da = sign * (a[1] - h), db = sign * (b[1] - h);
+      if (da >= 0) out.push_back(a);
+      if ((da >= 0) != (db >= 0)) {
+        const double t = da / (da - db);
+        out.push_back({a[0] + t * (b[0] - a[0]), h});
+      }
+    }
+    poly = std::move(out);
+  }
+  double twice = 0.0;  // the shoelace
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const auto& a = poly[i];
+    const auto& b = poly[(i + 1) % poly.size()];
+    twice += a[0] * b[1] - b[0] * a[1];
+  }
+  return 0.5 * std::abs(twice);
 }
 
 namespace {

@@ -116,6 +116,15 @@ void write_particles(const std::string& vtp_path, const ParticleSet& ps);
 // `centres`, the origin if absent), no `branch` array, as output3.cpp.
 void write_contacts3(const std::string& vtp_path, const ContactSet3& cs, const ParticleSet& centres);
 
+// The area of a 2D particle between the heights lo and hi (lo <= hi): a
+// disk's (nsides 0, or -1: no nsides array) by its circular segments, a
+// regular polygon's (circumradius `radius`, vertex k at angle + 2 pi k / n,
+// cdsim's convention) by clipping it to the band. The area in a band
+// counted this way sums to the grains' area over any tiling of the heights,
+// where counting whole grains by their centre is off by the grains cut by
+// the band's edges.
+double area_in_band(const Particle& p, double lo, double hi);
+
 // The prefix of the particle snapshots: "particles" in 2D, "spheres" in 3D.
 inline const char* particles_prefix(int dimension) { return dimension == 3 ? "spheres" : "particles"; }
 

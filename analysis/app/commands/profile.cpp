@@ -54,10 +54,15 @@ Handler profile(CLI::App& sub) {
                                         : std::string());
     fmt::print("max_rate   {:.3f} +- {:.3f} (per {}, then averaged)\n", pr.max_rate.v, pr.max_rate.err,
                pr.walls ? "interval" : "snapshot");
-    if (pr.walls)
+    if (pr.walls) {
       fmt::print("bulk_rate  {:.3f} +- {:.3f} (the central half of the gap, where the bulk is measured: the slope "
                  "of its displacement against y / the imposed strain)\n",
                  pr.bulk_rate.v, pr.bulk_rate.err);
+      fmt::print("bulk_phi   {:.4f} +- {:.4f} (the central half's packing fraction, each grain's area in it, over the "
+                 "{} snapshots; counting whole grains by their centre, as the series' bulk_packing_fraction: "
+                 "{:.4f} +- {:.4f})\n",
+                 pr.bulk_phi.v, pr.bulk_phi.err, pr.snapshots, pr.bulk_phi_centres.v, pr.bulk_phi_centres.err);
+    }
     return 0;
   };
 }
