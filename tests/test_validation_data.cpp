@@ -189,7 +189,7 @@ TEST(ValidationData, AngularPolygonsAreStrongerThanDisks) {
 }
 
 // The I probe (angularity-I-probe.csv: the same shapes and samples at
-// I = 1e-2 and 3e-3) against the campaign's I = 1e-3: the packing fraction
+// I = 1e-2 and 3e-3, and the disks at 3e-4) at 1e-2 against the campaign's I = 1e-3: the packing fraction
 // rises as I falls (phi(I) = phi_max - b I, da Cruz et al. 2005) beyond 3
 // combined standard errors for every shape, and mu* falls (mu(I) rises with
 // I): the shapes' summed difference mu*(I) - mu*(1e-3) positive beyond 3
@@ -213,6 +213,36 @@ TEST(ValidationData, TheIProbeMovesTowardTheQuasiStaticLimit) {
   }
   EXPECT_GE(compared, 3);
   EXPECT_GT(dmu, 3 * std::sqrt(var));
+}
+
+// The disks of the I probe and the campaign (I = 1e-2, 3e-3, 1e-3, 3e-4)
+// follow the laws of small I (GDR MiDi 2004; da Cruz et al. 2005): mu* =
+// mu_s + b I and phi = phi_max - a I, each within the 99 % quantile of chi2
+// for its degrees of freedom (9.21 for 2), with b > 0 and a > 0 beyond 3
+// standard errors (docs/validation.md: b 1.8 +- 0.3, a 0.92 +- 0.10).
+TEST(ValidationData, TheDisksFollowTheLinearLawsOfSmallI) {
+  const Table probe = Table::read_csv((data / "angularity-I-probe.csv").string(), true, words);
+  const Table camp = table("periodic");
+  FitData mu, nu;
+  for (const Table* t : {&probe, &camp})
+    for (std::size_t i = 0; i < t->rows(); ++i) {
+      if (t->column("ns")[i] != 0) continue;
+      const double I = t->column("I")[i];
+      mu.add({I}, t->column("mu")[i], t->column("mu_err")[i]);
+      nu.add({I}, t->column("nu")[i], t->column("nu_err")[i]);
+    }
+  ASSERT_EQ(mu.size(), 4u);
+  const Model line{"mu_lin", "mu_s + b I", {"mu_s", "b"}, {"I"}, [](const double* x, const double* q) {
+                     return q[0] + q[1] * x[0];
+                   }};
+  const FitResult m = fit(line, mu, {0.3, 1.0});
+  ASSERT_TRUE(m.converged) << m.message;
+  EXPECT_LT(m.chi2, 9.21);
+  EXPECT_GT(m["b"], 3 * m.err("b"));
+  const FitResult n = fit_nu_I(nu.x, nu.y, nu.sigma);
+  ASSERT_TRUE(n.converged) << n.message;
+  EXPECT_LT(n.chi2, 9.21);
+  EXPECT_GT(n["a"], 3 * n.err("a"));
 }
 
 // The 3D angularity campaign's table (angularity3d-periodic.csv, make
