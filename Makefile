@@ -145,6 +145,7 @@ help:
 	$(call help_var,VAL_I,its inertial number)
 	$(call help_var,VAL_STRAIN,its strain)
 	$(call help_var,VAL_SEED,its samples' random seed)
+	$(call help_var,VAL_TOL,its solver.tol at every I (empty: the shear policy's))
 	$(call help_var,PRESSURE_P,pressures of campaign-pressure[-ladder])
 	$(call help_var,PRESSURE_I,their inertial number)
 	$(call help_var,VOLUME_PHI,packing fractions of campaign-volume (defaults below jamming: 2D or 3D))
@@ -677,8 +678,13 @@ VAL_STRAIN ?= 3
 # VAL_SEED: another sample of the same protocol (the sizes and positions'
 # random seed; 1, the committed tables', adds no setting).
 VAL_SEED ?= 1
+# VAL_TOL: one solver stop at every VAL_I, solver.tol = VAL_TOL with no
+# law-residual stop and the overlap projection 0.5 (0.0003: the campaign's
+# at I = 1e-3, for the I probe); empty: the shear policy's stop at VAL_I.
+VAL_TOL ?=
 val_vars = CAMPAIGNS=$(VALIDATE) DIM=2 N=$(VAL_N) SIZE_RATIO=4 SIZE_DIST=uniform_area STRAIN=$(VAL_STRAIN) \
-  ANGULAR_NS="$(VAL_NS)" ANGULAR_I=$(VAL_I) SHEAR_TOL= SHEAR_SET= \
+  ANGULAR_NS="$(VAL_NS)" ANGULAR_I=$(VAL_I) SHEAR_TOL=$(VAL_TOL) \
+  SHEAR_SET="$(if $(VAL_TOL),--set contact.overlap_projection=0.5)" \
   PREP_SET="$(if $(filter-out 1,$(VAL_SEED)),--set particles.seed=$(VAL_SEED))"
 .PHONY: validate-angularity validate-angularity-walls
 validate-angularity: programs
