@@ -45,7 +45,7 @@ plot mu0 + (mu1 - mu0)*(1 - exp(-x/ac)) with lines lw 2 lc rgb '#1f3b73' title '
      val using (column("alpha")):(column("mu")):(column("mu_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}, periodic', \
      walls using (column("alpha")+0.02):(column("mu")):(column("mu_err")) with yerrorbars pt 4 ps 1.4 lc rgb '#2e7d32' title 'the same, walls (bulk)'
 set ylabel "packing fraction φ"
-set yrange [0.77:0.83]
+set yrange [0.77:0.835]
 set key bottom left font ",10"
 plot study using (column("alpha")):(column("nu")):(column("nu_err")) with yerrorbars pt 7 ps 1.2 lc rgb 'black' title 'N = 300, r = 2, I = 0.01', \
      val using (column("alpha")):(column("nu")):(column("nu_err")) with yerrorbars pt 5 ps 1.4 lc rgb '#b03a2e' title 'N = 1000, r = 4, I = 10^{-3}, periodic', \
