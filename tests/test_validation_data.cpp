@@ -189,7 +189,7 @@ TEST(ValidationData, AngularPolygonsAreStrongerThanDisks) {
 }
 
 // The I probe (angularity-I-probe.csv: the same shapes and samples at
-// I = 1e-2 and 3e-3, and the disks at 3e-4, every row at the campaign's
+// I = 1e-2 and 3e-3, and disks and triangles at 3e-4, every row at the campaign's
 // solver stop) at 1e-2 against the campaign's I = 1e-3: the packing
 // fraction rises as I falls (phi(I) = phi_max - b I, da Cruz et al. 2005)
 // beyond 3 combined standard errors for every shape (measured: 3.8 to 13),
